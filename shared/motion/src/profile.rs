@@ -48,7 +48,11 @@ impl State {
     }
 
     fn mirrored(self, sigma: f64) -> Self {
-        Self { p: sigma * self.p, v: sigma * self.v, a: sigma * self.a }
+        Self {
+            p: sigma * self.p,
+            v: sigma * self.v,
+            a: sigma * self.a,
+        }
     }
 }
 
@@ -164,7 +168,11 @@ impl Profile {
     pub fn at(&self, t: f64) -> State {
         if t >= self.duration || self.n == 0 {
             let dt = (t - self.duration).max(0.0);
-            return State { p: self.end.p + self.end.v * dt, v: self.end.v, a: 0.0 };
+            return State {
+                p: self.end.p + self.end.v * dt,
+                v: self.end.v,
+                a: 0.0,
+            };
         }
         let segs = self.segments();
         let mut i = segs.len() - 1;
@@ -210,7 +218,11 @@ impl<const REC: bool> Builder<REC> {
         if dt <= 0.0 {
             return;
         }
-        let seg = Segment { t0: self.t, start: self.s, jerk: j };
+        let seg = Segment {
+            t0: self.t,
+            start: self.s,
+            jerk: j,
+        };
         if REC && self.n < MAX_SEGMENTS {
             self.segs[self.n] = seg;
         }
@@ -463,7 +475,11 @@ fn brent(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64, tol_f: f64) -> O
         }
         a = b;
         fa = fb;
-        b += if d.abs() > tol_x { d } else { tol_x.copysign(m) };
+        b += if d.abs() > tol_x {
+            d
+        } else {
+            tol_x.copysign(m)
+        };
         fb = f(b);
     }
     Some(b)
@@ -483,7 +499,12 @@ fn finish<const REC: bool>(b: Builder<REC>, origin: f64, sigma: f64, end: State)
             jerk: sigma * src.jerk,
         };
     }
-    Profile { segs, n, duration: b.t, end }
+    Profile {
+        segs,
+        n,
+        duration: b.t,
+        end,
+    }
 }
 
 /// Plans a time-optimal profile from `start` to rest at `target`.
@@ -506,7 +527,11 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
     let d = goal - s0.p;
     let trap = pre.trapezoidal();
     let vn = if trap { s0.v } else { pre.v_nat() };
-    let tau_max = if !trap && s0.a < 0.0 { -s0.a / pre.jerk } else { 0.0 };
+    let tau_max = if !trap && s0.a < 0.0 {
+        -s0.a / pre.jerk
+    } else {
+        0.0
+    };
 
     let scale = goal.abs().max(s0.p.abs()).max(1e-9);
     let tol = 1e-13 * scale;
@@ -526,8 +551,13 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
             .ok_or(ProfileError::NoSolution)?;
         (Family::Peak, x, 0.0)
     } else if d < d_vn && tau_max > 0.0 {
-        let x = brent(|x| dist(sub, lim, Family::Relaxed, x) - d, 0.0, tau_max, tol)
-            .ok_or(ProfileError::NoSolution)?;
+        let x = brent(
+            |x| dist(sub, lim, Family::Relaxed, x) - d,
+            0.0,
+            tau_max,
+            tol,
+        )
+        .ok_or(ProfileError::NoSolution)?;
         (Family::Relaxed, x, 0.0)
     } else if d <= d_vn {
         (Family::Peak, vn, 0.0)
@@ -562,7 +592,16 @@ pub fn plan_velocity(start: State, target_v: f64, lim: &Limits) -> Result<Profil
     if b.n > MAX_SEGMENTS {
         return Err(ProfileError::NoSolution);
     }
-    Ok(finish(b, start.p, 1.0, State { p: start.p + end_p, v: vt, a: 0.0 }))
+    Ok(finish(
+        b,
+        start.p,
+        1.0,
+        State {
+            p: start.p + end_p,
+            v: vt,
+            a: 0.0,
+        },
+    ))
 }
 
 #[cfg(test)]
@@ -570,15 +609,24 @@ mod tests {
     use super::*;
 
     fn lim(vel: f64, acc: f64, dec: f64, jerk: f64) -> Limits {
-        Limits { vel, acc, dec, jerk }
+        Limits {
+            vel,
+            acc,
+            dec,
+            jerk,
+        }
     }
 
     #[test]
     fn rest_to_rest_symmetric_known_answer() {
         // v=100, a=1000, j=10000, distance 1000: t_j = 0.1, t_a = 0.1 (ramp reaches v in
         // 0.2 s over 10 units... ) total = distance/v + v/a + a/j = 10 + 0.1 + 0.1.
-        let p = plan_position(State::rest(0.0), 1000.0, &lim(100.0, 1000.0, 1000.0, 10000.0))
-            .unwrap();
+        let p = plan_position(
+            State::rest(0.0),
+            1000.0,
+            &lim(100.0, 1000.0, 1000.0, 10000.0),
+        )
+        .unwrap();
         assert!((p.duration() - 10.2).abs() < 1e-9, "{}", p.duration());
         let e = p.at(p.duration() - 1e-12);
         assert!((e.p - 1000.0).abs() < 1e-9);
@@ -594,8 +642,12 @@ mod tests {
     #[test]
     fn velocity_ramp_known_answer() {
         // 0 -> 100 with a = 1000, j = 10000: t = v/a + a/j = 0.2.
-        let p = plan_velocity(State::rest(0.0), 100.0, &lim(200.0, 1000.0, 1000.0, 10000.0))
-            .unwrap();
+        let p = plan_velocity(
+            State::rest(0.0),
+            100.0,
+            &lim(200.0, 1000.0, 1000.0, 10000.0),
+        )
+        .unwrap();
         assert!((p.duration() - 0.2).abs() < 1e-12);
         assert_eq!(p.end().v, 100.0);
     }

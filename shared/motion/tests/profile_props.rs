@@ -1,5 +1,6 @@
 //! Property tests of the 1-DoF trajectory generator: limits, continuity across re-plans, exact
 //! end state; and a cross-check of durations against `rsruckig` (a port of ruckig).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use proptest::prelude::*;
 use tandem_motion::profile::{plan_position, plan_velocity, Limits, Profile, State};
@@ -10,10 +11,16 @@ fn check_profile(p: &Profile, start: State, lim: &Limits, end_pos: Option<f64>) 
     let trap = lim.jerk == 0.0;
     let tol = 1e-9;
     let mut prev = p.at(0.0);
-    assert!((prev.p - start.p).abs() <= tol * (1.0 + start.p.abs()), "start p");
+    assert!(
+        (prev.p - start.p).abs() <= tol * (1.0 + start.p.abs()),
+        "start p"
+    );
     assert!((prev.v - start.v).abs() <= tol * (1.0 + lim.vel), "start v");
     if !trap {
-        assert!((prev.a - start.a).abs() <= tol * (1.0 + lim.acc.max(lim.dec)), "start a");
+        assert!(
+            (prev.a - start.a).abs() <= tol * (1.0 + lim.acc.max(lim.dec)),
+            "start a"
+        );
     }
     let n = 2000;
     let d = p.duration();
@@ -21,7 +28,11 @@ fn check_profile(p: &Profile, start: State, lim: &Limits, end_pos: Option<f64>) 
     for i in 1..=n {
         let t = d * i as f64 / n as f64;
         let s = p.at(t);
-        assert!(s.v.abs() <= lim.vel.max(start.v.abs()) * (1.0 + tol) + tol, "v {} at {t}", s.v);
+        assert!(
+            s.v.abs() <= lim.vel.max(start.v.abs()) * (1.0 + tol) + tol,
+            "v {} at {t}",
+            s.v
+        );
         assert!(
             s.a.abs() <= amax.max(start.a.abs()) * (1.0 + tol) + tol,
             "a {} at {t}",
@@ -45,15 +56,32 @@ fn check_profile(p: &Profile, start: State, lim: &Limits, end_pos: Option<f64>) 
         let e = p.at(d);
         let travel = (target - start.p).abs().max(1e-6);
         let just_before = p.at(d * (1.0 - 1e-15));
-        assert!((e.p - target).abs() <= 1e-9 * travel, "end p {} vs {target}", e.p);
-        assert!((just_before.p - target).abs() <= 1e-9 * travel + 1e-9, "landing p");
-        assert!(just_before.v.abs() <= 1e-6 * lim.vel, "landing v {}", just_before.v);
+        assert!(
+            (e.p - target).abs() <= 1e-9 * travel,
+            "end p {} vs {target}",
+            e.p
+        );
+        assert!(
+            (just_before.p - target).abs() <= 1e-9 * travel + 1e-9,
+            "landing p"
+        );
+        assert!(
+            just_before.v.abs() <= 1e-6 * lim.vel,
+            "landing v {}",
+            just_before.v
+        );
     }
 }
 
 fn limits() -> impl Strategy<Value = Limits> {
-    (0.5f64..3.3, 1.0f64..4.3, 0.0f64..0.7, 0.0f64..2.3, prop::bool::weighted(0.15)).prop_map(
-        |(lv, la, ld, lj, trap)| {
+    (
+        0.5f64..3.3,
+        1.0f64..4.3,
+        0.0f64..0.7,
+        0.0f64..2.3,
+        prop::bool::weighted(0.15),
+    )
+        .prop_map(|(lv, la, ld, lj, trap)| {
             let acc = 10f64.powf(la);
             Limits {
                 vel: 10f64.powf(lv),
@@ -61,14 +89,20 @@ fn limits() -> impl Strategy<Value = Limits> {
                 dec: acc * 10f64.powf(ld - 0.35),
                 jerk: if trap { 0.0 } else { acc * 10f64.powf(lj) },
             }
-        },
-    )
+        })
 }
 
 fn start_within(lim: Limits) -> impl Strategy<Value = (Limits, State)> {
     (0.0f64..1.0, 0.0f64..1.0, -1000.0f64..1000.0).prop_map(move |(fv, fa, p)| {
         if lim.jerk == 0.0 {
-            return (lim, State { p, v: (2.0 * fv - 1.0) * lim.vel, a: 0.0 });
+            return (
+                lim,
+                State {
+                    p,
+                    v: (2.0 * fv - 1.0) * lim.vel,
+                    a: 0.0,
+                },
+            );
         }
         let mut a = (2.0 * fa - 1.0) * lim.acc.min(lim.dec);
         let mut shift = a * a.abs() / (2.0 * lim.jerk);
@@ -78,7 +112,14 @@ fn start_within(lim: Limits) -> impl Strategy<Value = (Limits, State)> {
         }
         let lo = (-lim.vel).max(-lim.vel - shift);
         let hi = lim.vel.min(lim.vel - shift);
-        (lim, State { p, v: lo + fv * (hi - lo), a })
+        (
+            lim,
+            State {
+                p,
+                v: lo + fv * (hi - lo),
+                a,
+            },
+        )
     })
 }
 

@@ -1,6 +1,7 @@
 //! Independent oracle: profile durations against the `ruckig` package (PyPI, ruckig 0.19.4).
 //! Fixtures are produced by `tests/oracle/gen_ruckig_fixtures.py` and committed; see its header
 //! for how Siemens acc/dec semantics are mapped onto ruckig's signed limits.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use tandem_motion::profile::{plan_position, plan_velocity, Limits, State};
 
@@ -15,7 +16,11 @@ fn durations_match_ruckig() {
         let f: Vec<&str> = line.split(',').collect();
         assert_eq!(f.len(), 11, "line {}", line_no + 1);
         let num = |i: usize| -> f64 { f[i].parse().unwrap() };
-        let start = State { p: num(2), v: num(3), a: num(4) };
+        let start = State {
+            p: num(2),
+            v: num(3),
+            a: num(4),
+        };
         let target = num(5);
         let jerk = num(9);
         let lim = Limits {
@@ -40,14 +45,30 @@ fn durations_match_ruckig() {
         let ours = profile.duration();
         let allowed = (1e-6f64).max(1e-4 * expected);
         if (ours - expected).abs() > allowed {
-            failures.push(format!("id {}: ours {ours} ruckig {expected} ({line})", f[0]));
+            failures.push(format!(
+                "id {}: ours {ours} ruckig {expected} ({line})",
+                f[0]
+            ));
         }
         if f[1] == "pos" {
             let end = profile.at(ours);
             let travel = (target - start.p).abs().max(1e-9);
-            assert!((end.p - target).abs() <= 1e-9 * travel.max(1.0), "id {} end", f[0]);
+            assert!(
+                (end.p - target).abs() <= 1e-9 * travel.max(1.0),
+                "id {} end",
+                f[0]
+            );
         }
     }
-    assert!(n_pos >= 1000 && n_vel >= 500, "fixture too small: {n_pos} pos, {n_vel} vel");
-    assert!(failures.is_empty(), "{} of {} cases differ:\n{}", failures.len(), n_pos + n_vel, failures.join("\n"));
+    assert!(
+        n_pos >= 1000 && n_vel >= 500,
+        "fixture too small: {n_pos} pos, {n_vel} vel"
+    );
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases differ:\n{}",
+        failures.len(),
+        n_pos + n_vel,
+        failures.join("\n")
+    );
 }

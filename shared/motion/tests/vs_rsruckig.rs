@@ -1,6 +1,7 @@
 //! Durations of our profiles against `rsruckig` (a Rust port of ruckig) on random symmetric
 //! cases that start within the limits. The Python ruckig fixtures (`ruckig_oracle.rs`) are the
 //! primary oracle; this one runs many more cases cheaply.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use rsruckig::prelude::*;
 use tandem_motion::profile::{plan_position, plan_velocity, Limits, State};
@@ -64,7 +65,12 @@ fn durations_match_rsruckig_symmetric() {
         let vel = rng.log_uniform(1.0, 2000.0);
         let acc = rng.log_uniform(10.0, 20000.0);
         let jerk = acc * rng.log_uniform(1.0, 200.0);
-        let lim = Limits { vel, acc, dec: acc, jerk };
+        let lim = Limits {
+            vel,
+            acc,
+            dec: acc,
+            jerk,
+        };
         let kind = case % 3;
         let (v, a) = if kind == 0 {
             (0.0, 0.0)
@@ -97,9 +103,17 @@ fn durations_match_rsruckig_symmetric() {
         let err = (ours - expected).abs();
         let allowed = (1e-6f64).max(1e-4 * expected);
         if err / allowed > worst.0 {
-            worst = (err / allowed, format!("case {case}: {start:?} -> {target} {lim:?} ours {ours} ruckig {expected}"));
+            worst = (
+                err / allowed,
+                format!("case {case}: {start:?} -> {target} {lim:?} ours {ours} ruckig {expected}"),
+            );
         }
     }
     assert!(compared > 19_000, "only {compared} cases compared");
-    assert!(worst.0 <= 1.0, "worst case {:.3}x allowed: {}", worst.0, worst.1);
+    assert!(
+        worst.0 <= 1.0,
+        "worst case {:.3}x allowed: {}",
+        worst.0,
+        worst.1
+    );
 }

@@ -1,0 +1,201 @@
+//! The instructions an axis accepts, with their inputs as in the references (seed 001 §3.2).
+
+use crate::dynamics::Dynamics;
+
+/// `MC_Power.StartMode`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum StartMode {
+    /// 0: enable without position control.
+    NonPositionControlled,
+    /// 1: enable position-controlled (default).
+    PositionControlled,
+}
+
+/// `MC_Power.StopMode` (applies to user disables only; alarms use their reaction).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum StopMode {
+    /// 0: emergency stop ramp (`EmergencyDeceleration`, no jerk), then remove enable.
+    Emergency,
+    /// 1: remove enable at once; the drive brakes on its own ramp.
+    Immediate,
+    /// 2: maximum dynamics (`MaxDeceleration` with `MaxJerk`), then remove enable.
+    MaxDynamics,
+}
+
+/// `MC_MoveAbsolute.Direction` on modulo axes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// 1: positive direction.
+    Positive,
+    /// 2: negative direction.
+    Negative,
+    /// 3: shortest way.
+    Shortest,
+}
+
+impl Direction {
+    /// From the reference's number (1, 2, 3).
+    pub fn from_code(c: i32) -> Option<Self> {
+        match c {
+            1 => Some(Self::Positive),
+            2 => Some(Self::Negative),
+            3 => Some(Self::Shortest),
+            _ => None,
+        }
+    }
+}
+
+/// `MC_MoveVelocity.Direction`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum VelocityDirection {
+    /// 0: the sign of `Velocity`.
+    BySign,
+    /// 1: positive.
+    Positive,
+    /// 2: negative.
+    Negative,
+}
+
+impl VelocityDirection {
+    /// From the reference's number (0, 1, 2).
+    pub fn from_code(c: i32) -> Option<Self> {
+        match c {
+            0 => Some(Self::BySign),
+            1 => Some(Self::Positive),
+            2 => Some(Self::Negative),
+            _ => None,
+        }
+    }
+}
+
+/// An instruction for an axis. Execute-type instructions start a job per command;
+/// enable-type ones (`Power`, `MoveJog`, `MotionIn*`, the `Stop` lock) are re-sent with their
+/// current inputs and keep one job while enabled.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Command {
+    /// `MC_Power`.
+    #[doc(alias = "MC_Power")]
+    Power {
+        /// `Enable`.
+        enable: bool,
+        /// `StartMode`.
+        start_mode: StartMode,
+        /// `StopMode`.
+        stop_mode: StopMode,
+    },
+    /// `MC_Reset`.
+    #[doc(alias = "MC_Reset")]
+    Reset {
+        /// `Restart`: re-initialize the TO (needs it disabled).
+        restart: bool,
+    },
+    /// `MC_Home` (modes 0..10 of seed 001 §6.2).
+    #[doc(alias = "MC_Home")]
+    Home {
+        /// `Mode`.
+        mode: u8,
+        /// `Position`.
+        position: f64,
+    },
+    /// `MC_Halt`.
+    #[doc(alias = "MC_Halt")]
+    Halt {
+        /// `Deceleration` (< 0: default).
+        deceleration: f64,
+        /// `Jerk` (< 0: default, 0: trapezoidal).
+        jerk: f64,
+        /// `AbortAcceleration`: drop the acceleration to 0 at once.
+        abort_acceleration: bool,
+    },
+    /// `MC_Stop` (PLCopen; S7-Technology FB404): stops and locks the axis while `execute`
+    /// is held; `execute: false` releases the lock.
+    #[doc(alias = "MC_Stop")]
+    Stop {
+        /// `Execute` level.
+        execute: bool,
+        /// `Deceleration`.
+        deceleration: f64,
+        /// `Jerk`.
+        jerk: f64,
+    },
+    /// `MC_MoveAbsolute`.
+    #[doc(alias = "MC_MoveAbsolute")]
+    MoveAbsolute {
+        /// `Position`.
+        position: f64,
+        /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk`.
+        dynamics: Dynamics,
+        /// `Direction` (modulo axes only).
+        direction: Direction,
+    },
+    /// `MC_MoveRelative`.
+    #[doc(alias = "MC_MoveRelative")]
+    MoveRelative {
+        /// `Distance`.
+        distance: f64,
+        /// Dynamics.
+        dynamics: Dynamics,
+    },
+    /// `MC_MoveVelocity`.
+    #[doc(alias = "MC_MoveVelocity")]
+    MoveVelocity {
+        /// Dynamics (`Velocity` may be 0; its sign counts with `Direction` 0).
+        dynamics: Dynamics,
+        /// `Direction`.
+        direction: VelocityDirection,
+        /// `Current`: keep the velocity and direction at job start.
+        current: bool,
+        /// `PositionControlled`.
+        position_controlled: bool,
+    },
+    /// `MC_MoveJog`.
+    #[doc(alias = "MC_MoveJog")]
+    MoveJog {
+        /// `JogForward`.
+        forward: bool,
+        /// `JogBackward`.
+        backward: bool,
+        /// Dynamics (the absolute value of `Velocity` is used; 0 allowed).
+        dynamics: Dynamics,
+        /// `PositionControlled`.
+        position_controlled: bool,
+    },
+    /// `MC_MoveSuperimposed`.
+    #[doc(alias = "MC_MoveSuperimposed")]
+    MoveSuperimposed {
+        /// `Distance`.
+        distance: f64,
+        /// `VelocityDiff` (as `velocity`), `Acceleration`, `Deceleration`, `Jerk`.
+        dynamics: Dynamics,
+    },
+    /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
+    #[doc(alias = "MC_SetOverride")]
+    SetOverride {
+        /// Velocity override in %.
+        velocity: f64,
+    },
+    /// `MC_MotionInPosition`: direct position setpoints, no profile, no limits.
+    #[doc(alias = "MC_MotionInPosition")]
+    MotionInPosition {
+        /// `Enable`.
+        enable: bool,
+        /// `Position`.
+        position: f64,
+        /// `Velocity` (precontrol).
+        velocity: f64,
+        /// `Acceleration`.
+        acceleration: f64,
+    },
+    /// `MC_MotionInVelocity`: direct velocity setpoints, no profile, no limits.
+    #[doc(alias = "MC_MotionInVelocity")]
+    MotionInVelocity {
+        /// `Enable`.
+        enable: bool,
+        /// `Velocity`.
+        velocity: f64,
+        /// `Acceleration` (only used when another job takes over).
+        acceleration: f64,
+        /// `PositionControlled`.
+        position_controlled: bool,
+    },
+}

@@ -1,0 +1,447 @@
+//! Configuration of an axis technology object (the "technology DB" start values).
+
+use crate::drive::{DriveModel, Plant};
+use crate::dynamics::{DynamicDefaults, DynamicLimits};
+use crate::modulo::Modulo;
+
+/// Speed axis or positioning axis (seed 001 §1.4, §1.5). The synchronous axis comes with
+/// synchronous operation.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AxisKind {
+    /// `TO_SpeedAxis`: velocity setpoints only, no position control, no homing.
+    Speed,
+    /// `TO_PositioningAxis`.
+    Positioning,
+}
+
+/// `Properties.MotionType`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum MotionType {
+    /// Linear axis.
+    Linear,
+    /// Rotary axis.
+    Rotary,
+}
+
+/// Encoder type (`Sensor[1].Type`): decides which homing modes are allowed.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum EncoderType {
+    /// Incremental: not homed after start; active and passive homing.
+    Incremental,
+    /// Absolute: homed once adjusted (modes 6, 7).
+    Absolute,
+}
+
+/// A direction of travel.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Sense {
+    /// Positive direction.
+    Positive,
+    /// Negative direction.
+    Negative,
+}
+
+impl Sense {
+    /// +1 or -1.
+    pub fn sign(self) -> f64 {
+        match self {
+            Sense::Positive => 1.0,
+            Sense::Negative => -1.0,
+        }
+    }
+}
+
+/// What an active or passive homing job looks for (`Sensor[n].ActiveHoming.Mode`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum HomingMark {
+    /// Encoder zero mark only.
+    ZeroMark,
+    /// Reference cam, then the first zero mark after leaving the cam.
+    CamAndZeroMark,
+    /// Edge of a digital input (the reference cam signal) on the side given by the homing
+    /// direction (positive side = the edge at the higher position).
+    DigitalInput,
+}
+
+/// Passive homing direction (`PassiveHoming.Direction`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum PassiveDirection {
+    /// Armed only while moving positive.
+    Positive,
+    /// Armed only while moving negative.
+    Negative,
+    /// Armed in the direction the axis moves in.
+    Current,
+}
+
+/// `Homing.*` and `Sensor[1].ActiveHoming/PassiveHoming.*`.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct HomingConfig {
+    /// Mark for active homing.
+    pub active_mark: HomingMark,
+    /// Mark for passive homing.
+    pub passive_mark: HomingMark,
+    /// `Homing.ApproachDirection`: where to search for the cam.
+    pub approach_direction: Sense,
+    /// `Sensor[1].ActiveHoming.Direction`: the direction in which the mark is approached
+    /// (for a digital input: the side of the edge).
+    pub homing_direction: Sense,
+    /// `PassiveHoming.Direction`.
+    pub passive_direction: PassiveDirection,
+    /// `Homing.ApproachVelocity` (> 0).
+    pub approach_velocity: f64,
+    /// `Homing.ReferencingVelocity` (> 0).
+    pub referencing_velocity: f64,
+    /// `Homing.HomePosition` (modes 5 and 10).
+    pub home_position: f64,
+    /// `Sensor[1].ActiveHoming.HomePositionOffset`: home position minus mark position.
+    pub home_position_offset: f64,
+    /// `Homing.AutoReversal`: reverse at a hardware limit switch while searching.
+    pub auto_reversal: bool,
+}
+
+impl Default for HomingConfig {
+    fn default() -> Self {
+        Self {
+            active_mark: HomingMark::CamAndZeroMark,
+            passive_mark: HomingMark::CamAndZeroMark,
+            approach_direction: Sense::Positive,
+            homing_direction: Sense::Positive,
+            passive_direction: PassiveDirection::Current,
+            approach_velocity: 10.0,
+            referencing_velocity: 2.0,
+            home_position: 0.0,
+            home_position_offset: 0.0,
+            auto_reversal: true,
+        }
+    }
+}
+
+/// `PositioningMonitoring.*` (seed 001 §4.6).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct PositioningMonitoring {
+    /// `Window` (>= 0).
+    pub window: f64,
+    /// `ToleranceTime` (s): time to enter the window after the setpoint reached the target.
+    pub tolerance_time: f64,
+    /// `MinDwellTime` (s): time the actual value must stay in the window.
+    pub min_dwell_time: f64,
+}
+
+/// `FollowingError.*` (seed 001 §4.7).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct FollowingErrorMonitoring {
+    /// `EnableMonitoring`.
+    pub enable: bool,
+    /// `MinValue`: permitted error below `min_velocity`.
+    pub min_value: f64,
+    /// `MaxValue`: permitted error at maximum velocity.
+    pub max_value: f64,
+    /// `MinVelocity`.
+    pub min_velocity: f64,
+    /// `WarningLevel` (% of the permitted value).
+    pub warning_level: f64,
+}
+
+/// `StandstillSignal.*` (seed 001 §4.8).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct StandstillSignal {
+    /// `VelocityThreshold`.
+    pub velocity_threshold: f64,
+    /// `MinDwellTime` (s).
+    pub min_dwell_time: f64,
+}
+
+/// `PositionLimits_SW.*` (active when present; seed 001 §4.5).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SoftwareLimits {
+    /// `MinPosition`.
+    pub min: f64,
+    /// `MaxPosition` (> min).
+    pub max: f64,
+}
+
+/// Everything an axis is built from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisConfig {
+    /// Speed or positioning axis.
+    pub kind: AxisKind,
+    /// Linear or rotary.
+    pub motion_type: MotionType,
+    /// Modulo settings (positioning axes).
+    pub modulo: Option<Modulo>,
+    /// Encoder type.
+    pub encoder: EncoderType,
+    /// Virtual axis / simulation mode (seed 001 §7): homing completes at once without motion,
+    /// hardware limit switches have no effect.
+    pub virtual_axis: bool,
+    /// Servo cycle (s, > 0).
+    pub cycle: f64,
+    /// `DynamicLimits`.
+    pub limits: DynamicLimits,
+    /// `DynamicDefaults`.
+    pub defaults: DynamicDefaults,
+    /// Software limit switches (non-modulo axes), active when set.
+    pub sw_limits: Option<SoftwareLimits>,
+    /// `PositionLimits_HW.Active`: evaluate the plant's hardware limit switches.
+    pub hw_limits_active: bool,
+    /// Positioning monitoring.
+    pub positioning: PositioningMonitoring,
+    /// Following-error monitoring.
+    pub following_error: FollowingErrorMonitoring,
+    /// Standstill signal.
+    pub standstill: StandstillSignal,
+    /// Homing.
+    pub homing: HomingConfig,
+    /// Simulated drive model.
+    pub drive: DriveModel,
+    /// Simulated plant (sensors in physical coordinates).
+    pub plant: Plant,
+    /// Physical position of the load at start.
+    pub initial_position: f64,
+}
+
+/// A configuration value that is not acceptable: which field, and why.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct ConfigError {
+    /// The key, as in the cell file (e.g. `dynamics.max_velocity`).
+    pub field: &'static str,
+    /// What is wrong with it.
+    pub problem: &'static str,
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}: {}", self.field, self.problem)
+    }
+}
+
+fn positive(field: &'static str, x: f64) -> Result<(), ConfigError> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(ConfigError {
+            field,
+            problem: "must be a positive number",
+        })
+    }
+}
+
+fn non_negative(field: &'static str, x: f64) -> Result<(), ConfigError> {
+    if x.is_finite() && x >= 0.0 {
+        Ok(())
+    } else {
+        Err(ConfigError {
+            field,
+            problem: "must be zero or a positive number",
+        })
+    }
+}
+
+fn finite(field: &'static str, x: f64) -> Result<(), ConfigError> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(ConfigError {
+            field,
+            problem: "must be a finite number",
+        })
+    }
+}
+
+impl AxisConfig {
+    /// A positioning axis with plausible defaults (mm, mm/s ...), for tests and examples.
+    pub fn example(cycle: f64) -> Self {
+        Self {
+            kind: AxisKind::Positioning,
+            motion_type: MotionType::Linear,
+            modulo: None,
+            encoder: EncoderType::Incremental,
+            virtual_axis: false,
+            cycle,
+            limits: DynamicLimits {
+                max_velocity: 500.0,
+                max_acceleration: 5000.0,
+                max_deceleration: 5000.0,
+                max_jerk: 100_000.0,
+            },
+            defaults: DynamicDefaults {
+                velocity: 100.0,
+                acceleration: 1000.0,
+                deceleration: 1000.0,
+                jerk: 20_000.0,
+                emergency_deceleration: 10_000.0,
+            },
+            sw_limits: None,
+            hw_limits_active: false,
+            positioning: PositioningMonitoring {
+                window: 0.01,
+                tolerance_time: 1.0,
+                min_dwell_time: 0.0,
+            },
+            following_error: FollowingErrorMonitoring {
+                enable: true,
+                min_value: 1.0,
+                max_value: 10.0,
+                min_velocity: 10.0,
+                warning_level: 90.0,
+            },
+            standstill: StandstillSignal {
+                velocity_threshold: 0.1,
+                min_dwell_time: 0.01,
+            },
+            homing: HomingConfig::default(),
+            drive: DriveModel::PositionLoop {
+                kv: 100.0,
+                kpc: 1.0,
+                t_vtc: 0.002,
+            },
+            plant: Plant::default(),
+            initial_position: 0.0,
+        }
+    }
+
+    /// Checks every value; the first problem found is returned with the key that has it.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        positive("cycle", self.cycle)?;
+        positive("dynamics.max_velocity", self.limits.max_velocity)?;
+        positive("dynamics.max_acceleration", self.limits.max_acceleration)?;
+        positive("dynamics.max_deceleration", self.limits.max_deceleration)?;
+        positive("dynamics.max_jerk", self.limits.max_jerk)?;
+        positive("dynamics.velocity", self.defaults.velocity)?;
+        positive("dynamics.acceleration", self.defaults.acceleration)?;
+        positive("dynamics.deceleration", self.defaults.deceleration)?;
+        non_negative("dynamics.jerk", self.defaults.jerk)?;
+        positive(
+            "dynamics.emergency_deceleration",
+            self.defaults.emergency_deceleration,
+        )?;
+        if self.defaults.velocity > self.limits.max_velocity {
+            return Err(ConfigError {
+                field: "dynamics.velocity",
+                problem: "exceeds max_velocity",
+            });
+        }
+        if self.defaults.acceleration > self.limits.max_acceleration {
+            return Err(ConfigError {
+                field: "dynamics.acceleration",
+                problem: "exceeds max_acceleration",
+            });
+        }
+        if self.defaults.deceleration > self.limits.max_deceleration {
+            return Err(ConfigError {
+                field: "dynamics.deceleration",
+                problem: "exceeds max_deceleration",
+            });
+        }
+        if self.defaults.jerk > self.limits.max_jerk {
+            return Err(ConfigError {
+                field: "dynamics.jerk",
+                problem: "exceeds max_jerk",
+            });
+        }
+        if let Some(m) = self.modulo {
+            finite("modulo.start", m.start)?;
+            positive("modulo.length", m.length)?;
+            if self.kind == AxisKind::Speed {
+                return Err(ConfigError {
+                    field: "modulo",
+                    problem: "a speed axis has no modulo",
+                });
+            }
+        }
+        if let Some(sw) = self.sw_limits {
+            finite("sw_limits.min", sw.min)?;
+            finite("sw_limits.max", sw.max)?;
+            if sw.max <= sw.min {
+                return Err(ConfigError {
+                    field: "sw_limits.max",
+                    problem: "must be greater than sw_limits.min (alarm 104)",
+                });
+            }
+            if self.modulo.is_some() {
+                return Err(ConfigError {
+                    field: "sw_limits",
+                    problem: "software limit switches on a modulo axis are not supported yet",
+                });
+            }
+        }
+        non_negative("positioning.window", self.positioning.window)?;
+        non_negative(
+            "positioning.tolerance_time",
+            self.positioning.tolerance_time,
+        )?;
+        non_negative(
+            "positioning.min_dwell_time",
+            self.positioning.min_dwell_time,
+        )?;
+        let fe = &self.following_error;
+        if fe.enable {
+            positive("following_error.min_value", fe.min_value)?;
+            positive("following_error.max_value", fe.max_value)?;
+            non_negative("following_error.min_velocity", fe.min_velocity)?;
+            if fe.max_value < fe.min_value {
+                return Err(ConfigError {
+                    field: "following_error.max_value",
+                    problem: "must not be less than following_error.min_value",
+                });
+            }
+            if !(0.0..=100.0).contains(&fe.warning_level) {
+                return Err(ConfigError {
+                    field: "following_error.warning_level",
+                    problem: "must be between 0 and 100 (%)",
+                });
+            }
+        }
+        non_negative(
+            "standstill.velocity_threshold",
+            self.standstill.velocity_threshold,
+        )?;
+        non_negative("standstill.min_dwell_time", self.standstill.min_dwell_time)?;
+        positive("homing.approach_velocity", self.homing.approach_velocity)?;
+        positive(
+            "homing.referencing_velocity",
+            self.homing.referencing_velocity,
+        )?;
+        finite("homing.home_position", self.homing.home_position)?;
+        finite(
+            "homing.home_position_offset",
+            self.homing.home_position_offset,
+        )?;
+        match self.drive {
+            DriveModel::Delay { delay } => non_negative("drive.delay", delay)?,
+            DriveModel::PositionLoop { kv, kpc, t_vtc } => {
+                positive("drive.kv", kv)?;
+                if !(0.0..=1.5).contains(&kpc) {
+                    return Err(ConfigError {
+                        field: "drive.kpc",
+                        problem: "must be between 0 and 150 %",
+                    });
+                }
+                non_negative("drive.t_vtc", t_vtc)?;
+            }
+        }
+        if let Some((lo, hi)) = self.plant.reference_cam {
+            if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+                return Err(ConfigError {
+                    field: "plant.reference_cam",
+                    problem: "must be [low, high] with high > low",
+                });
+            }
+        }
+        if let Some(z) = self.plant.zero_mark {
+            positive("plant.zero_mark_period", z.period)?;
+            finite("plant.zero_mark_offset", z.offset)?;
+        }
+        if let (Some(lo), Some(hi)) = (self.plant.hw_limit_min, self.plant.hw_limit_max) {
+            if hi <= lo {
+                return Err(ConfigError {
+                    field: "plant.hw_limit_max",
+                    problem: "must be greater than plant.hw_limit_min",
+                });
+            }
+        }
+        finite("initial_position", self.initial_position)?;
+        Ok(())
+    }
+}

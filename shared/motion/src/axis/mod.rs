@@ -1,0 +1,1350 @@
+//! The axis technology object: speed axis and positioning axis with the PLCopen state machine,
+//! the jobs of seed 001 §3.2, monitoring (§4) and technology alarms (§5), over a simulated
+//! drive. One call of [`Axis::step`] is one servo/interpolator cycle; commands are applied
+//! between cycles with [`Axis::command`]. Nothing here allocates after [`Axis::new`].
+//!
+//! Positions are kept continuous (unwrapped) inside; modulo positions are what the status shows.
+
+mod command;
+mod config;
+mod step;
+
+pub use command::{Command, Direction, StartMode, StopMode, VelocityDirection};
+pub use config::{
+    AxisConfig, AxisKind, ConfigError, EncoderType, FollowingErrorMonitoring, HomingConfig,
+    HomingMark, MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits,
+    StandstillSignal,
+};
+
+use crate::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
+use crate::drive::SimDrive;
+use crate::dynamics::{Clamped, Dynamics};
+use crate::error_id::ErrorId;
+use crate::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
+use crate::override_table::{table1, NewJob, RunningMotion};
+use crate::profile::{plan_position, plan_velocity, Limits, Profile, State};
+
+/// PLCopen axis states (seed 001 §3.5, seed 000 §2.5).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AxisState {
+    /// Not enabled.
+    Disabled,
+    /// Enabled, no motion job.
+    Standstill,
+    /// Active homing.
+    Homing,
+    /// A positioning or halt job (MoveAbsolute, MoveRelative, Halt, superimposed alone).
+    DiscreteMotion,
+    /// A velocity, jog or MotionIn job.
+    ContinuousMotion,
+    /// Following a leader (synchronous axis).
+    SynchronizedMotion,
+    /// MC_Stop active (the axis is locked).
+    Stopping,
+    /// A technology alarm with a stopping reaction is pending.
+    ErrorStop,
+}
+
+impl AxisState {
+    /// PLCopen name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Disabled => "Disabled",
+            Self::Standstill => "Standstill",
+            Self::Homing => "Homing",
+            Self::DiscreteMotion => "DiscreteMotion",
+            Self::ContinuousMotion => "ContinuousMotion",
+            Self::SynchronizedMotion => "SynchronizedMotion",
+            Self::Stopping => "Stopping",
+            Self::ErrorStop => "ErrorStop",
+        }
+    }
+}
+
+/// A snapshot of everything an axis shows, taken at the end of each cycle.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct AxisStatus {
+    /// Cycle time (ns).
+    pub time_ns: i64,
+    /// PLCopen state.
+    pub state: AxisState,
+    /// `StatusWord` (bits in [`status_bit`]).
+    pub status_word: u32,
+    /// `ErrorWord`.
+    pub error_word: u32,
+    /// `WarningWord`.
+    pub warning_word: u32,
+    /// `ErrorDetail`.
+    pub error_detail: ErrorDetail,
+    /// `Position` setpoint (modulo-reduced).
+    pub position: f64,
+    /// `Velocity` setpoint.
+    pub velocity: f64,
+    /// `Acceleration` setpoint.
+    pub acceleration: f64,
+    /// `ActualPosition` (modulo-reduced).
+    pub actual_position: f64,
+    /// `ActualVelocity`.
+    pub actual_velocity: f64,
+    /// `StatusPositioning.FollowingError`.
+    pub following_error: f64,
+    /// `Override.Velocity` (%).
+    pub override_velocity: f64,
+    /// Setpoint position, continuous (not reduced).
+    pub position_unwrapped: f64,
+    /// The running basic-motion job.
+    pub motion_job: Option<(JobId, Instruction)>,
+    /// The running superimposed job.
+    pub superimposed_job: Option<(JobId, Instruction)>,
+}
+
+impl AxisStatus {
+    /// Tests a [`status_bit`].
+    pub fn has(&self, bit: u32) -> bool {
+        self.status_word & bit != 0
+    }
+}
+
+/// Why the basic setpoint moves.
+#[derive(Copy, Clone, Debug, PartialEq)]
+enum Goal {
+    /// Hold the current position.
+    Hold,
+    /// To rest at `target` (continuous coordinates); velocity scaled by the override.
+    Position { target: f64, lim: Limits },
+    /// To the velocity `v` (scaled by the override).
+    Velocity { v: f64, lim: Limits },
+    /// To standstill, not scaled by the override.
+    Stop { lim: Limits },
+    /// Direct setpoints (MotionIn); `position` is `None` for MotionInVelocity.
+    Direct {
+        position: Option<f64>,
+        v: f64,
+        a: f64,
+    },
+    /// Disabled: the setpoint follows the actual value.
+    Track,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum HomePhase {
+    /// Looking for the reference cam.
+    Search,
+    /// On the cam, moving in the homing direction until it is left.
+    OnCam,
+    /// Armed: the next mark in the homing direction homes the axis.
+    Armed,
+    /// Homed; travelling to the home position.
+    Travel,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct ActiveHoming {
+    /// Axis position given to the mark (end position minus the home position offset).
+    home: f64,
+    /// Where the axis travels after homing (`Position` or `Homing.HomePosition`).
+    end: f64,
+    phase: HomePhase,
+    search_dir: f64,
+    reversals: u8,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct PassiveHoming {
+    job: JobId,
+    home: f64,
+    phase: HomePhase,
+    /// Direction of travel when the cam was left (for the re-arm rule).
+    armed_dir: f64,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct MotionJob {
+    id: JobId,
+    instr: Instruction,
+    in_velocity: bool,
+    /// Positioning monitoring started (the setpoint reached its target or stop).
+    monitoring: Option<PosMon>,
+    homing: Option<ActiveHoming>,
+    /// MoveJog: which inputs are held.
+    jog: (bool, bool),
+    /// Dynamics of the job (for reaction 1 and jog stops).
+    lim: Limits,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct PosMon {
+    target: f64,
+    start_ns: i64,
+    entered_ns: Option<i64>,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct SupJob {
+    id: JobId,
+    prof: Profile,
+    t0: i64,
+}
+
+const MAX_ALARMS: usize = 12;
+
+/// Power sequencing.
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct Power {
+    enable: bool,
+    start_mode: StartMode,
+    stop_mode: StopMode,
+    job: JobId,
+    /// A user disable is braking before the enable is removed.
+    disabling: bool,
+}
+
+/// An axis technology object with its simulated drive.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    cfg: AxisConfig,
+    drive: SimDrive,
+    power: Power,
+    enabled: bool,
+    pos_ctrl: bool,
+    /// Axis position = physical position + offset.
+    offset: f64,
+    abs_encoder_offset: f64,
+    homed: bool,
+    basic: State,
+    sup: State,
+    goal: Goal,
+    prof: Profile,
+    t0: i64,
+    override_pct: f64,
+    main: Option<MotionJob>,
+    sup_job: Option<SupJob>,
+    passive: Option<PassiveHoming>,
+    stop_lock: bool,
+    alarms: [Option<AlarmInstance>; MAX_ALARMS],
+    hw_trigger: Option<(Sense, f64)>,
+    sw_active: Option<Sense>,
+    standstill_since: Option<i64>,
+    fe: f64,
+    actual_p: f64,
+    actual_v: f64,
+    prev_phys: f64,
+    events: EventQueue,
+    next_id: JobId,
+    now: i64,
+    status: AxisStatus,
+}
+
+fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+impl Axis {
+    /// Builds an axis from a validated configuration, disabled, at rest.
+    pub fn new(cfg: AxisConfig) -> Result<Self, ConfigError> {
+        cfg.validate()?;
+        let drive = SimDrive::new(
+            cfg.drive,
+            cfg.cycle,
+            cfg.defaults.emergency_deceleration,
+            cfg.initial_position,
+        );
+        let p0 = cfg.initial_position;
+        let homed = cfg.encoder == EncoderType::Absolute;
+        let mut axis = Self {
+            drive,
+            power: Power {
+                enable: false,
+                start_mode: StartMode::PositionControlled,
+                stop_mode: StopMode::Emergency,
+                job: 0,
+                disabling: false,
+            },
+            enabled: false,
+            pos_ctrl: false,
+            offset: 0.0,
+            abs_encoder_offset: 0.0,
+            homed,
+            basic: State::rest(p0),
+            sup: State::default(),
+            goal: Goal::Track,
+            prof: Profile::hold(State::rest(p0)),
+            t0: 0,
+            override_pct: 100.0,
+            main: None,
+            sup_job: None,
+            passive: None,
+            stop_lock: false,
+            alarms: [None; MAX_ALARMS],
+            hw_trigger: None,
+            sw_active: None,
+            standstill_since: None,
+            fe: 0.0,
+            actual_p: p0,
+            actual_v: 0.0,
+            prev_phys: p0,
+            events: EventQueue::default(),
+            next_id: 1,
+            now: 0,
+            status: AxisStatus {
+                time_ns: 0,
+                state: AxisState::Disabled,
+                status_word: 0,
+                error_word: 0,
+                warning_word: 0,
+                error_detail: ErrorDetail::NONE,
+                position: p0,
+                velocity: 0.0,
+                acceleration: 0.0,
+                actual_position: p0,
+                actual_velocity: 0.0,
+                following_error: 0.0,
+                override_velocity: 100.0,
+                position_unwrapped: p0,
+                motion_job: None,
+                superimposed_job: None,
+            },
+            cfg,
+        };
+        axis.refresh_status();
+        Ok(axis)
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &AxisConfig {
+        &self.cfg
+    }
+
+    /// The status after the last cycle (or command).
+    pub fn status(&self) -> &AxisStatus {
+        &self.status
+    }
+
+    /// Takes the oldest pending job event.
+    pub fn pop_event(&mut self) -> Option<JobEvent> {
+        self.events.pop()
+    }
+
+    /// Pending technology alarms.
+    pub fn alarms(&self) -> impl Iterator<Item = AlarmInstance> + '_ {
+        self.alarms.iter().flatten().copied()
+    }
+
+    /// Whether the alarm `id` is pending.
+    pub fn has_alarm(&self, id: AlarmId) -> bool {
+        self.alarms().any(|a| a.id == id)
+    }
+
+    /// Job events dropped because nobody drained them.
+    pub fn dropped_events(&self) -> u64 {
+        self.events.dropped()
+    }
+
+    // ----------------------------------------------------------------------------------------
+    // helpers
+
+    fn new_id(&mut self) -> JobId {
+        let id = self.next_id;
+        self.next_id = self.next_id.wrapping_add(1).max(1);
+        id
+    }
+
+    fn emit(&mut self, job: JobId, instruction: Instruction, kind: JobEventKind) {
+        self.events.push(JobEvent {
+            job,
+            instruction,
+            kind,
+            time_ns: self.now,
+        });
+    }
+
+    fn wrap(&self, p: f64) -> f64 {
+        match self.cfg.modulo {
+            Some(m) => m.wrap(p),
+            None => p,
+        }
+    }
+
+    fn total(&self) -> State {
+        State {
+            p: self.basic.p + self.sup.p,
+            v: self.basic.v + self.sup.v,
+            a: self.basic.a + self.sup.a,
+        }
+    }
+
+    fn elapsed(&self, t0: i64) -> f64 {
+        (self.now - t0) as f64 * 1e-9
+    }
+
+    fn max_limits(&self) -> Limits {
+        self.cfg.limits.as_limits()
+    }
+
+    fn default_limits(&self) -> Limits {
+        let d = &self.cfg.defaults;
+        Limits {
+            vel: d.velocity,
+            acc: d.acceleration,
+            dec: d.deceleration,
+            jerk: d.jerk,
+        }
+    }
+
+    fn emergency_limits(&self) -> Limits {
+        let d = self.cfg.defaults.emergency_deceleration;
+        Limits {
+            vel: self.cfg.limits.max_velocity.max(1e-9),
+            acc: d,
+            dec: d,
+            jerk: 0.0,
+        }
+    }
+
+    fn stopping_alarm_pending(&self) -> bool {
+        self.alarms().any(|a| a.id.reaction() != Reaction::None)
+    }
+
+    fn warn_clamped(&mut self, c: Clamped) {
+        if c.velocity {
+            self.raise(AlarmId::VelocityLimited, supplement::NONE);
+        }
+        if c.acceleration {
+            self.raise(AlarmId::AccelerationLimited, supplement::NONE);
+        }
+        if c.jerk {
+            self.raise(AlarmId::JerkLimited, supplement::NONE);
+        }
+    }
+
+    /// Plans the current goal from the current basic setpoint at the current time.
+    fn replan(&mut self) {
+        let s = self.basic;
+        let ovr = self.override_pct / 100.0;
+        let planned = match self.goal {
+            Goal::Hold | Goal::Direct { .. } | Goal::Track => {
+                self.basic = State { a: 0.0, ..s };
+                Ok(Profile::hold(self.basic))
+            }
+            Goal::Position { target, lim } => {
+                if ovr > 0.0 {
+                    plan_position(
+                        s,
+                        target,
+                        &Limits {
+                            vel: lim.vel * ovr,
+                            ..lim
+                        },
+                    )
+                } else {
+                    plan_velocity(s, 0.0, &lim)
+                }
+            }
+            Goal::Velocity { v, lim } => plan_velocity(
+                s,
+                v * ovr,
+                &Limits {
+                    vel: lim.vel.max(v.abs()).max(1e-12),
+                    ..lim
+                },
+            ),
+            Goal::Stop { lim } => plan_velocity(
+                s,
+                0.0,
+                &Limits {
+                    vel: lim.vel.max(1e-12),
+                    ..lim
+                },
+            ),
+        };
+        // Inputs were validated when the job was accepted; a planning failure here can only be
+        // a non-finite state, which is a fault, not a panic: stop as hard as allowed.
+        self.prof = match planned {
+            Ok(p) => p,
+            Err(_) => Profile::hold(State {
+                v: 0.0,
+                a: 0.0,
+                ..s
+            }),
+        };
+        self.t0 = self.now;
+    }
+
+    fn set_goal(&mut self, g: Goal) {
+        self.goal = g;
+        self.replan();
+    }
+
+    /// Moves the superimposed motion into the basic setpoint (when it is aborted) so the total
+    /// does not jump.
+    fn fold_superimposed(&mut self) {
+        if self.sup != State::default() {
+            self.basic.p += self.sup.p;
+            self.basic.v += self.sup.v;
+            self.basic.a += self.sup.a;
+            self.sup = State::default();
+        }
+    }
+
+    fn running_classes(&self) -> [(RunningMotion, bool); 3] {
+        let main = self.main.map(|m| match m.instr {
+            Instruction::Home => RunningMotion::HomingActive,
+            Instruction::MotionInPosition | Instruction::MotionInVelocity => {
+                RunningMotion::MotionIn
+            }
+            _ => RunningMotion::Motion,
+        });
+        [
+            (main.unwrap_or(RunningMotion::Motion), main.is_some()),
+            (RunningMotion::Superimposed, self.sup_job.is_some()),
+            (RunningMotion::HomingPassive, self.passive.is_some()),
+        ]
+    }
+
+    /// Aborts the running jobs that `new` overrides (seed 001 §3.3 table 1).
+    fn apply_override_table(&mut self, new: NewJob) {
+        let [main, sup, passive] = self.running_classes();
+        if main.1 && table1(new, main.0).aborts() {
+            self.abort_main(JobEventKind::CommandAborted);
+        }
+        if sup.1 && table1(new, sup.0).aborts() {
+            self.abort_sup(JobEventKind::CommandAborted);
+        }
+        if passive.1 && table1(new, passive.0).aborts() {
+            self.abort_passive(JobEventKind::CommandAborted);
+        }
+    }
+
+    fn abort_main(&mut self, how: JobEventKind) {
+        if let Some(m) = self.main.take() {
+            self.emit(m.id, m.instr, how);
+            if m.instr == Instruction::Stop {
+                self.stop_lock = false;
+            }
+        }
+    }
+
+    fn abort_sup(&mut self, how: JobEventKind) {
+        if let Some(s) = self.sup_job.take() {
+            self.emit(s.id, Instruction::MoveSuperimposed, how);
+        }
+        self.fold_superimposed();
+    }
+
+    fn abort_passive(&mut self, how: JobEventKind) {
+        if let Some(p) = self.passive.take() {
+            self.emit(p.job, Instruction::Home, how);
+        }
+    }
+
+    fn abort_all(&mut self, how: JobEventKind) {
+        self.abort_main(how);
+        self.abort_sup(how);
+        self.abort_passive(how);
+        self.replan();
+    }
+
+    /// Raises a technology alarm and applies its reaction (seed 001 §5.1).
+    pub fn raise(&mut self, id: AlarmId, supp: u16) {
+        if self.alarms().any(|a| a.id == id && a.supplement == supp) {
+            return;
+        }
+        if let Some(slot) = self.alarms.iter_mut().find(|a| a.is_none()) {
+            *slot = Some(AlarmInstance::new(id, supp));
+        }
+        let reaction = id.reaction();
+        if reaction == Reaction::None {
+            return;
+        }
+        let job_lim = self
+            .main
+            .map(|m| m.lim)
+            .unwrap_or_else(|| self.default_limits());
+        self.abort_all(JobEventKind::Error(ErrorId::TechnologyAlarm));
+        self.power.disabling = false;
+        match reaction {
+            Reaction::None => {}
+            Reaction::StopCurrentDynamics => self.set_goal(Goal::Stop { lim: job_lim }),
+            Reaction::StopMaxDynamics => {
+                let lim = self.max_limits();
+                self.set_goal(Goal::Stop { lim })
+            }
+            Reaction::EmergencyStop => {
+                let lim = self.emergency_limits();
+                self.set_goal(Goal::Stop { lim })
+            }
+            Reaction::RemoveEnable | Reaction::TrackSetpoints => self.remove_enable(),
+        }
+    }
+
+    fn remove_enable(&mut self) {
+        if self.enabled {
+            self.enabled = false;
+            self.emit(
+                self.power.job,
+                Instruction::Power,
+                JobEventKind::Status(false),
+            );
+        }
+        self.power.disabling = false;
+        self.goal = Goal::Track;
+        self.standstill_since = None;
+    }
+
+    fn enable_now(&mut self) {
+        self.enabled = true;
+        self.pos_ctrl = self.cfg.kind == AxisKind::Positioning
+            && self.power.start_mode == StartMode::PositionControlled;
+        // The setpoint takes over the actual position (StartMode 1 pulls a moving axis back
+        // to the position it had when the enable came).
+        self.basic = State::rest(self.actual_p);
+        self.sup = State::default();
+        self.set_goal(Goal::Hold);
+        self.emit(
+            self.power.job,
+            Instruction::Power,
+            JobEventKind::Status(true),
+        );
+    }
+
+    fn check_motion_allowed(&self) -> Result<(), ErrorId> {
+        if !self.enabled || self.power.disabling {
+            return Err(ErrorId::NotEnabled);
+        }
+        if self.stopping_alarm_pending() {
+            return Err(ErrorId::JobRejectedInErrorStop);
+        }
+        if self.stop_lock {
+            return Err(ErrorId::AxisLocked);
+        }
+        Ok(())
+    }
+
+    fn require_positioning(&self) -> Result<(), ErrorId> {
+        if self.cfg.kind == AxisKind::Speed {
+            return Err(ErrorId::IllegalObject);
+        }
+        Ok(())
+    }
+
+    fn start_main(&mut self, instr: Instruction, lim: Limits, goal: Goal) -> JobId {
+        let id = self.new_id();
+        self.main = Some(MotionJob {
+            id,
+            instr,
+            in_velocity: false,
+            monitoring: None,
+            homing: None,
+            jog: (false, false),
+            lim,
+        });
+        self.emit(id, instr, JobEventKind::Busy);
+        self.set_goal(goal);
+        id
+    }
+
+    /// Stop distance of the total setpoint with the given limits (signed).
+    fn stop_point(&self, s: State, lim: &Limits) -> f64 {
+        match plan_velocity(
+            s,
+            0.0,
+            &Limits {
+                vel: lim.vel.max(s.v.abs()).max(1e-12),
+                ..*lim
+            },
+        ) {
+            Ok(p) => p.end().p,
+            Err(_) => s.p,
+        }
+    }
+
+    // ----------------------------------------------------------------------------------------
+    // commands
+
+    /// Applies an instruction now (between cycles). Returns the job id, or the ErrorID of a
+    /// rejection; a rejected command changes nothing.
+    ///
+    /// The command takes effect from the setpoint of the last cycle: the next [`Axis::step`]
+    /// continues from there, so nothing jumps.
+    pub fn command(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
+        let r = self.apply(cmd);
+        self.refresh_status();
+        r
+    }
+
+    fn apply(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
+        match *cmd {
+            Command::Power {
+                enable,
+                start_mode,
+                stop_mode,
+            } => Ok(self.cmd_power(enable, start_mode, stop_mode)),
+            Command::Reset { restart } => self.cmd_reset(restart),
+            Command::Home { mode, position } => self.cmd_home(mode, position),
+            Command::Halt {
+                deceleration,
+                jerk,
+                abort_acceleration,
+            } => {
+                self.check_motion_allowed()?;
+                let d = Dynamics {
+                    velocity: -1.0,
+                    acceleration: -1.0,
+                    deceleration,
+                    jerk,
+                };
+                let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+                self.warn_clamped(r.clamped);
+                self.apply_override_table(NewJob::Halt);
+                self.fold_superimposed();
+                if abort_acceleration {
+                    self.basic.a = 0.0;
+                }
+                let lim = Limits {
+                    acc: r.limits.dec,
+                    ..r.limits
+                };
+                Ok(self.start_main(Instruction::Halt, lim, Goal::Stop { lim }))
+            }
+            Command::Stop {
+                execute,
+                deceleration,
+                jerk,
+            } => self.cmd_stop(execute, deceleration, jerk),
+            Command::MoveAbsolute {
+                position,
+                dynamics,
+                direction,
+            } => {
+                self.require_positioning()?;
+                self.check_motion_allowed()?;
+                if !position.is_finite() {
+                    return Err(ErrorId::IllegalPosition);
+                }
+                if !self.homed {
+                    return Err(ErrorId::NotHomed);
+                }
+                let r = self
+                    .cfg
+                    .limits
+                    .resolve(&self.cfg.defaults, &dynamics, false)?;
+                self.warn_clamped(r.clamped);
+                self.apply_override_table(NewJob::Positioning);
+                self.fold_superimposed();
+                self.force_position_control();
+                let target = self.absolute_target(position, direction, &r.limits);
+                Ok(self.start_main(
+                    Instruction::MoveAbsolute,
+                    r.limits,
+                    Goal::Position {
+                        target,
+                        lim: r.limits,
+                    },
+                ))
+            }
+            Command::MoveRelative { distance, dynamics } => {
+                self.require_positioning()?;
+                self.check_motion_allowed()?;
+                if !distance.is_finite() {
+                    return Err(ErrorId::IllegalDistance);
+                }
+                let r = self
+                    .cfg
+                    .limits
+                    .resolve(&self.cfg.defaults, &dynamics, false)?;
+                self.warn_clamped(r.clamped);
+                self.apply_override_table(NewJob::Positioning);
+                self.fold_superimposed();
+                self.force_position_control();
+                let target = self.basic.p + distance;
+                Ok(self.start_main(
+                    Instruction::MoveRelative,
+                    r.limits,
+                    Goal::Position {
+                        target,
+                        lim: r.limits,
+                    },
+                ))
+            }
+            Command::MoveVelocity {
+                dynamics,
+                direction,
+                current,
+                position_controlled,
+            } => {
+                self.check_motion_allowed()?;
+                // MoveVelocity: the sign of Velocity is a direction (Direction 0), not the
+                // "default" sentinel; 0 is allowed (stop and stay busy).
+                let d = Dynamics {
+                    velocity: dynamics.velocity.abs(),
+                    ..dynamics
+                };
+                let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+                let speed = r.limits.vel;
+                let v = if current {
+                    self.total().v
+                } else {
+                    match direction {
+                        VelocityDirection::BySign => speed.copysign(dynamics.velocity),
+                        VelocityDirection::Positive => speed,
+                        VelocityDirection::Negative => -speed,
+                    }
+                };
+                self.warn_clamped(r.clamped);
+                self.apply_override_table(NewJob::Positioning);
+                self.fold_superimposed();
+                self.set_position_control(position_controlled);
+                let lim = Limits {
+                    vel: self.cfg.limits.max_velocity,
+                    ..r.limits
+                };
+                Ok(self.start_main(Instruction::MoveVelocity, lim, Goal::Velocity { v, lim }))
+            }
+            Command::MoveJog {
+                forward,
+                backward,
+                dynamics,
+                position_controlled,
+            } => self.cmd_jog(forward, backward, dynamics, position_controlled),
+            Command::MoveSuperimposed { distance, dynamics } => {
+                self.require_positioning()?;
+                self.check_motion_allowed()?;
+                if !distance.is_finite() {
+                    return Err(ErrorId::IllegalDistance);
+                }
+                let r = self
+                    .cfg
+                    .limits
+                    .resolve(&self.cfg.defaults, &dynamics, false)?;
+                self.warn_clamped(r.clamped);
+                self.apply_override_table(NewJob::Superimposed);
+                self.force_position_control();
+                // A new superimposed job continues from the current superimposed state; its
+                // distance counts from the current superimposed position.
+                let s = self.sup;
+                let prof = plan_position(s, s.p + distance, &r.limits)
+                    .map_err(|_| ErrorId::IllegalDistance)?;
+                let id = self.new_id();
+                self.sup_job = Some(SupJob {
+                    id,
+                    prof,
+                    t0: self.now,
+                });
+                self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Busy);
+                Ok(id)
+            }
+            Command::SetOverride { velocity } => {
+                if !(velocity.is_finite() && (0.0..=200.0).contains(&velocity)) {
+                    return Err(ErrorId::IllegalOverride);
+                }
+                let id = self.new_id();
+                if velocity != self.override_pct {
+                    self.override_pct = velocity;
+                    if matches!(self.goal, Goal::Position { .. } | Goal::Velocity { .. }) {
+                        self.replan();
+                        let mut left = None;
+                        if let Some(m) = self.main.as_mut() {
+                            if m.in_velocity {
+                                m.in_velocity = false;
+                                left = Some((m.id, m.instr));
+                            }
+                            // A positioning job that had stopped at override 0 moves again.
+                            m.monitoring = None;
+                        }
+                        if let Some((mid, instr)) = left {
+                            self.emit(mid, instr, JobEventKind::LeftVelocity);
+                        }
+                    }
+                }
+                self.emit(id, Instruction::SetOverride, JobEventKind::Done);
+                Ok(id)
+            }
+            Command::MotionInPosition {
+                enable,
+                position,
+                velocity,
+                acceleration,
+            } => {
+                self.require_positioning()?;
+                self.cmd_motion_in(
+                    Instruction::MotionInPosition,
+                    enable,
+                    Some(position),
+                    velocity,
+                    acceleration,
+                    true,
+                )
+            }
+            Command::MotionInVelocity {
+                enable,
+                velocity,
+                acceleration,
+                position_controlled,
+            } => self.cmd_motion_in(
+                Instruction::MotionInVelocity,
+                enable,
+                None,
+                velocity,
+                acceleration,
+                position_controlled,
+            ),
+        }
+    }
+
+    fn force_position_control(&mut self) {
+        self.set_position_control(true);
+    }
+
+    fn set_position_control(&mut self, on: bool) {
+        let on = on && self.cfg.kind == AxisKind::Positioning;
+        if on && !self.pos_ctrl {
+            // Closing the loop: the position setpoint takes over the actual position.
+            self.basic.p = self.actual_p - self.sup.p;
+        }
+        self.pos_ctrl = on;
+    }
+
+    /// Continuous target of MoveAbsolute: modulo reduction and Direction (seed 001 §3.2).
+    fn absolute_target(&self, position: f64, direction: Direction, lim: &Limits) -> f64 {
+        let Some(m) = self.cfg.modulo else {
+            return position;
+        };
+        let s = self.total();
+        let here = s.p;
+        match direction {
+            Direction::Shortest => here + m.shortest(here, position),
+            Direction::Positive | Direction::Negative => {
+                let dir = if direction == Direction::Positive {
+                    1.0
+                } else {
+                    -1.0
+                };
+                let mut d = if dir > 0.0 {
+                    m.forward(here, position)
+                } else {
+                    -m.forward(position, here)
+                };
+                // Keep the direction: if the axis cannot stop before the target, go one more
+                // modulo length around.
+                let stop = self.stop_point(s, lim) - here;
+                while dir * stop > dir * d + 1e-12 * m.length {
+                    d += dir * m.length;
+                }
+                here + d
+            }
+        }
+    }
+
+    fn cmd_power(&mut self, enable: bool, start_mode: StartMode, stop_mode: StopMode) -> JobId {
+        if enable && !self.power.enable {
+            self.power = Power {
+                enable,
+                start_mode,
+                stop_mode,
+                job: self.new_id(),
+                disabling: false,
+            };
+            self.emit(self.power.job, Instruction::Power, JobEventKind::Busy);
+            if !self.alarms().any(|a| a.id.reaction().removes_enable()) {
+                self.enable_now();
+            }
+        } else if !enable && self.power.enable {
+            self.power.enable = false;
+            self.power.stop_mode = stop_mode;
+            self.abort_all(JobEventKind::CommandAborted);
+            self.stop_lock = false;
+            if self.enabled {
+                match stop_mode {
+                    StopMode::Immediate => self.remove_enable(),
+                    StopMode::Emergency => {
+                        self.power.disabling = true;
+                        let lim = self.emergency_limits();
+                        self.set_goal(Goal::Stop { lim });
+                    }
+                    StopMode::MaxDynamics => {
+                        self.power.disabling = true;
+                        let lim = self.max_limits();
+                        self.set_goal(Goal::Stop { lim });
+                    }
+                }
+            }
+        } else {
+            self.power.stop_mode = stop_mode;
+        }
+        self.power.job
+    }
+
+    fn cmd_reset(&mut self, restart: bool) -> Result<JobId, ErrorId> {
+        if restart && (self.enabled || self.power.enable) {
+            return Err(ErrorId::RestartWhileEnabled);
+        }
+        let id = self.new_id();
+        self.emit(id, Instruction::Reset, JobEventKind::Busy);
+        if restart {
+            self.alarms = [None; MAX_ALARMS];
+            self.homed = self.cfg.encoder == EncoderType::Absolute;
+            self.offset = if self.homed {
+                self.abs_encoder_offset
+            } else {
+                0.0
+            };
+            self.override_pct = 100.0;
+            self.hw_trigger = None;
+            self.sw_active = None;
+            self.actual_p = self.drive.actual().p + self.offset;
+            self.basic = State::rest(self.actual_p);
+        } else {
+            for a in self.alarms.iter_mut() {
+                if a.map(|x| !x.spec().restart).unwrap_or(false) {
+                    *a = None;
+                }
+            }
+        }
+        // Automatic re-enable after acknowledgement while Enable is still held.
+        if self.power.enable
+            && !self.enabled
+            && !self.alarms().any(|a| a.id.reaction().removes_enable())
+        {
+            self.enable_now();
+        }
+        self.emit(id, Instruction::Reset, JobEventKind::Done);
+        Ok(id)
+    }
+
+    fn cmd_stop(&mut self, execute: bool, deceleration: f64, jerk: f64) -> Result<JobId, ErrorId> {
+        if !execute {
+            // Release the lock; the job is done once the axis stands still.
+            self.stop_lock = false;
+            let id = self
+                .main
+                .filter(|m| m.instr == Instruction::Stop)
+                .map(|m| m.id)
+                .unwrap_or(0);
+            return Ok(id);
+        }
+        if !self.enabled || self.power.disabling {
+            return Err(ErrorId::NotEnabled);
+        }
+        if self.stopping_alarm_pending() {
+            return Err(ErrorId::JobRejectedInErrorStop);
+        }
+        let d = Dynamics {
+            velocity: -1.0,
+            acceleration: -1.0,
+            deceleration,
+            jerk,
+        };
+        let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+        self.warn_clamped(r.clamped);
+        self.apply_override_table(NewJob::Halt);
+        self.fold_superimposed();
+        let lim = Limits {
+            acc: r.limits.dec,
+            ..r.limits
+        };
+        let id = self.start_main(Instruction::Stop, lim, Goal::Stop { lim });
+        self.stop_lock = true;
+        Ok(id)
+    }
+
+    fn cmd_jog(
+        &mut self,
+        forward: bool,
+        backward: bool,
+        dynamics: Dynamics,
+        position_controlled: bool,
+    ) -> Result<JobId, ErrorId> {
+        let running = self.main.filter(|m| m.instr == Instruction::MoveJog);
+        if running.is_none() && !forward && !backward {
+            return Ok(0);
+        }
+        self.check_motion_allowed()?;
+        // Jog uses the absolute value of a negative Velocity (seed 001 §8 item 2).
+        let d = Dynamics {
+            velocity: dynamics.velocity.abs(),
+            ..dynamics
+        };
+        let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+        if forward && backward {
+            // Both inputs: brake with the last valid deceleration and report 16#8007.
+            if let Some(m) = running {
+                self.main = None;
+                self.emit(
+                    m.id,
+                    m.instr,
+                    JobEventKind::Error(ErrorId::IllegalDirection),
+                );
+                self.set_goal(Goal::Stop { lim: m.lim });
+            }
+            return Err(ErrorId::IllegalDirection);
+        }
+        let lim = Limits {
+            vel: self.cfg.limits.max_velocity,
+            ..r.limits
+        };
+        let v = if forward {
+            r.limits.vel
+        } else if backward {
+            -r.limits.vel
+        } else {
+            0.0
+        };
+        match running {
+            Some(m) if m.jog == (forward, backward) => Ok(m.id),
+            Some(m) => {
+                // Same job, inputs changed.
+                if let Some(job) = self.main.as_mut() {
+                    job.jog = (forward, backward);
+                    job.lim = lim;
+                    if job.in_velocity {
+                        job.in_velocity = false;
+                        self.emit(m.id, m.instr, JobEventKind::LeftVelocity);
+                    }
+                }
+                if forward || backward {
+                    self.set_goal(Goal::Velocity { v, lim });
+                } else {
+                    self.set_goal(Goal::Stop { lim });
+                }
+                Ok(m.id)
+            }
+            None => {
+                self.warn_clamped(r.clamped);
+                self.apply_override_table(NewJob::Positioning);
+                self.fold_superimposed();
+                self.set_position_control(position_controlled);
+                let id = self.start_main(Instruction::MoveJog, lim, Goal::Velocity { v, lim });
+                if let Some(job) = self.main.as_mut() {
+                    job.jog = (forward, backward);
+                }
+                Ok(id)
+            }
+        }
+    }
+
+    fn cmd_motion_in(
+        &mut self,
+        instr: Instruction,
+        enable: bool,
+        position: Option<f64>,
+        velocity: f64,
+        acceleration: f64,
+        position_controlled: bool,
+    ) -> Result<JobId, ErrorId> {
+        let running = self.main.filter(|m| m.instr == instr);
+        if !enable {
+            if let Some(m) = running {
+                // Enable FALSE: velocity and acceleration to 0 at once, position holds.
+                self.main = None;
+                self.basic.v = 0.0;
+                self.basic.a = 0.0;
+                self.set_goal(Goal::Hold);
+                self.emit(m.id, instr, JobEventKind::Done);
+                return Ok(m.id);
+            }
+            return Ok(0);
+        }
+        if !(velocity.is_finite() && acceleration.is_finite()) {
+            return Err(ErrorId::IllegalVelocity);
+        }
+        if position.map(|p| !p.is_finite()).unwrap_or(false) {
+            return Err(ErrorId::IllegalPosition);
+        }
+        let goal = Goal::Direct {
+            position,
+            v: velocity,
+            a: acceleration,
+        };
+        if let Some(m) = running {
+            self.goal = goal;
+            return Ok(m.id);
+        }
+        self.check_motion_allowed()?;
+        self.apply_override_table(NewJob::MotionIn);
+        self.fold_superimposed();
+        self.set_position_control(position_controlled);
+        let lim = self.default_limits();
+        let id = self.start_main(instr, lim, goal);
+        self.goal = goal;
+        Ok(id)
+    }
+
+    fn cmd_home(&mut self, mode: u8, position: f64) -> Result<JobId, ErrorId> {
+        self.require_positioning()?;
+        if !position.is_finite() {
+            return Err(ErrorId::IllegalPosition);
+        }
+        let incremental = self.cfg.encoder == EncoderType::Incremental;
+        match mode {
+            0 | 1 | 9 => {}
+            2 | 3 | 5 | 8 | 10 => {
+                if !incremental {
+                    return Err(ErrorId::IllegalHomingModeAbsolute);
+                }
+                if !self.enabled {
+                    return Err(ErrorId::NotEnabled);
+                }
+            }
+            6 | 7 => {
+                if incremental {
+                    return Err(ErrorId::IllegalHomingModeIncremental);
+                }
+                if !self.enabled || !self.pos_ctrl {
+                    return Err(ErrorId::NotPositionControlled);
+                }
+            }
+            _ => return Err(ErrorId::IllegalMode),
+        }
+        if matches!(mode, 3 | 5) {
+            self.check_motion_allowed()?;
+        }
+        let id = self.new_id();
+        self.emit(id, Instruction::Home, JobEventKind::Busy);
+        let modulo = self.cfg.modulo;
+        let reduce = |p: f64| match modulo {
+            Some(m) => m.wrap(p),
+            None => p,
+        };
+        match mode {
+            0 | 7 => {
+                // Direct / absolute-encoder adjustment, absolute: actual := Position.
+                let delta = reduce(position) - self.actual_p;
+                self.shift(delta);
+                if mode == 7 {
+                    self.abs_encoder_offset = self.offset;
+                }
+                self.homed = true;
+                self.emit(id, Instruction::Home, JobEventKind::Done);
+            }
+            1 | 6 => {
+                // Relative: actual := actual + Position (reduced on modulo axes).
+                let delta = reduce(self.actual_p + position) - self.actual_p;
+                self.shift(delta);
+                if mode == 6 {
+                    self.abs_encoder_offset = self.offset;
+                }
+                self.homed = true;
+                self.emit(id, Instruction::Home, JobEventKind::Done);
+            }
+            9 => {
+                self.abort_passive(JobEventKind::CommandAborted);
+                self.emit(id, Instruction::Home, JobEventKind::Done);
+            }
+            2 | 8 | 10 => {
+                self.abort_passive(JobEventKind::CommandAborted);
+                if mode != 2 {
+                    self.homed = false;
+                }
+                let home = reduce(if mode == 10 {
+                    self.cfg.homing.home_position
+                } else {
+                    position
+                });
+                let phase = match self.cfg.homing.passive_mark {
+                    HomingMark::ZeroMark => HomePhase::Armed,
+                    _ => HomePhase::Search,
+                };
+                self.passive = Some(PassiveHoming {
+                    job: id,
+                    home,
+                    phase,
+                    armed_dir: 0.0,
+                });
+            }
+            _ => {
+                // 3 / 5: active homing. Aborts all motion and re-enables position control.
+                self.apply_override_table(NewJob::HomeActive);
+                self.fold_superimposed();
+                self.force_position_control();
+                self.homed = false;
+                let h = &self.cfg.homing;
+                let end = reduce(if mode == 5 { h.home_position } else { position });
+                let lim = self.default_limits();
+                if self.cfg.virtual_axis {
+                    // Simulation: homing completes at once without motion (seed 001 §7).
+                    let delta = end - self.actual_p;
+                    self.shift(delta);
+                    self.homed = true;
+                    self.emit(id, Instruction::Home, JobEventKind::Done);
+                    return Ok(id);
+                }
+                let home = end - h.home_position_offset;
+                let search_dir = h.approach_direction.sign();
+                let on_cam = self.on_cam(self.drive.actual().p);
+                let (phase, v) = match (h.active_mark, on_cam) {
+                    (HomingMark::ZeroMark, _) => (
+                        HomePhase::Armed,
+                        h.homing_direction.sign() * h.referencing_velocity,
+                    ),
+                    (_, true) => (
+                        HomePhase::OnCam,
+                        h.homing_direction.sign() * h.referencing_velocity,
+                    ),
+                    (_, false) => (HomePhase::Search, search_dir * h.approach_velocity),
+                };
+                self.main = Some(MotionJob {
+                    id,
+                    instr: Instruction::Home,
+                    in_velocity: false,
+                    monitoring: None,
+                    homing: Some(ActiveHoming {
+                        home,
+                        end,
+                        phase,
+                        search_dir,
+                        reversals: 0,
+                    }),
+                    jog: (false, false),
+                    lim,
+                });
+                let vlim = Limits {
+                    vel: self.cfg.limits.max_velocity,
+                    ..lim
+                };
+                self.set_goal(Goal::Velocity { v, lim: vlim });
+                // Homing velocities are not scaled by the override: undo the scaling.
+                if self.override_pct != 100.0 {
+                    let ovr = self.override_pct;
+                    self.override_pct = 100.0;
+                    self.replan();
+                    self.override_pct = ovr;
+                }
+            }
+        }
+        Ok(id)
+    }
+
+    /// Shifts the axis coordinate system by `delta` (homing): actual, setpoint and the running
+    /// goal move together, so nothing jumps physically.
+    fn shift(&mut self, delta: f64) {
+        self.offset += delta;
+        self.actual_p += delta;
+        self.basic.p += delta;
+        match &mut self.goal {
+            Goal::Position { target, .. } => *target += delta,
+            Goal::Direct {
+                position: Some(p), ..
+            } => *p += delta,
+            _ => {}
+        }
+        if let Some(m) = self.main.as_mut() {
+            if let Some(pm) = m.monitoring.as_mut() {
+                pm.target += delta;
+            }
+        }
+        self.replan();
+    }
+
+    fn on_cam(&self, phys: f64) -> bool {
+        match self.cfg.plant.reference_cam {
+            Some((lo, hi)) => phys >= lo && phys <= hi,
+            None => false,
+        }
+    }
+}

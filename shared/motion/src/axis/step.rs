@@ -1,0 +1,703 @@
+//! The cyclic part of the axis: sensors, setpoint generation, limit supervision, job
+//! completion, monitoring, drive, status. Allocation-free.
+
+use super::{
+    sign, Axis, AxisKind, AxisState, Goal, HomePhase, HomingMark, PassiveDirection, PosMon, Sense,
+};
+use crate::alarm::{error_bit, status_bit, supplement, AlarmId, ErrorDetail, Reaction};
+use crate::job::{Instruction, JobEventKind};
+use crate::profile::{plan_position, Limits, State};
+
+impl Axis {
+    /// Runs one cycle for time `now_ns` (cell clock, ns): the setpoint computed here is the
+    /// setpoint for `now_ns`; the simulated drive then moves the plant to the next cycle.
+    pub fn step(&mut self, now_ns: i64) {
+        self.now = now_ns;
+        let act = self.drive.actual();
+        let phys = act.p;
+        let prev = self.prev_phys;
+        self.prev_phys = phys;
+        self.actual_p = phys + self.offset;
+        self.actual_v = act.v;
+
+        self.check_hw_limits(phys);
+        self.active_homing(prev, phys);
+        self.passive_homing(prev, phys);
+        self.generate();
+        self.check_sw_limits();
+        self.update_jobs();
+        self.monitor(act.balanced + self.offset);
+
+        let tot = self.total();
+        self.drive
+            .step(tot.p - self.offset, tot.v, self.enabled, self.pos_ctrl);
+        self.refresh_status();
+    }
+
+    /// The total setpoint predicted one cycle ahead (for the software-limit look-ahead).
+    fn predict(&self) -> State {
+        let dt = self.cfg.cycle;
+        let basic = match self.goal {
+            Goal::Direct {
+                position: Some(p),
+                v,
+                a,
+            } => State {
+                p: p + v * dt,
+                v,
+                a,
+            },
+            Goal::Direct {
+                position: None,
+                v,
+                a,
+            } => State {
+                p: self.basic.p + v * dt,
+                v,
+                a,
+            },
+            Goal::Track => self.basic,
+            _ => self.prof.at(self.elapsed(self.t0) + dt),
+        };
+        let sup = match self.sup_job {
+            Some(j) => j.prof.at(self.elapsed(j.t0) + dt),
+            None => self.sup,
+        };
+        State {
+            p: basic.p + sup.p,
+            v: basic.v + sup.v,
+            a: basic.a + sup.a,
+        }
+    }
+
+    fn generate(&mut self) {
+        let dt = self.cfg.cycle;
+        match self.goal {
+            Goal::Direct {
+                position: Some(p),
+                v,
+                a,
+            } => self.basic = State { p, v, a },
+            Goal::Direct {
+                position: None,
+                v,
+                a,
+            } => {
+                self.basic = State {
+                    p: self.basic.p + v * dt,
+                    v,
+                    a,
+                };
+            }
+            Goal::Track => {
+                self.basic = State {
+                    p: self.actual_p,
+                    v: self.actual_v,
+                    a: 0.0,
+                };
+                self.sup = State::default();
+            }
+            _ => self.basic = self.prof.at(self.elapsed(self.t0)),
+        }
+        if let Some(j) = self.sup_job {
+            self.sup = j.prof.at(self.elapsed(j.t0));
+        }
+    }
+
+    fn check_sw_limits(&mut self) {
+        let Some(sw) = self.cfg.sw_limits else {
+            return;
+        };
+        if !self.homed || !self.enabled || self.cfg.kind == AxisKind::Speed {
+            self.sw_active = None;
+            return;
+        }
+        let tot = self.total();
+        let eps = 1e-9 * (1.0 + sw.max.abs().max(sw.min.abs()));
+        if tot.p > sw.max + eps {
+            self.sw_active = Some(Sense::Positive);
+            self.raise(AlarmId::SwLimitCrossed, supplement::POSITIVE);
+            return;
+        }
+        if tot.p < sw.min - eps {
+            self.sw_active = Some(Sense::Negative);
+            self.raise(AlarmId::SwLimitCrossed, supplement::NEGATIVE);
+            return;
+        }
+        // The status stays while the alarm is pending or the setpoint is at the limit.
+        let pending =
+            self.has_alarm(AlarmId::SwLimitReached) || self.has_alarm(AlarmId::SwLimitCrossed);
+        match self.sw_active {
+            Some(Sense::Positive) if !pending && tot.p < sw.max - eps => self.sw_active = None,
+            Some(Sense::Negative) if !pending && tot.p > sw.min + eps => self.sw_active = None,
+            _ => {}
+        }
+        let next = self.predict();
+        let (limit, sense) = if next.v > 0.0 || (next.v == 0.0 && next.a > 0.0) {
+            (sw.max, Sense::Positive)
+        } else if next.v < 0.0 || next.a < 0.0 {
+            (sw.min, Sense::Negative)
+        } else {
+            return;
+        };
+        let max = self.max_limits();
+        let stop = self.stop_point(next, &max);
+        let beyond = match sense {
+            Sense::Positive => stop > limit + eps,
+            Sense::Negative => stop < limit - eps,
+        };
+        if !beyond {
+            return;
+        }
+        // Reaching the limit: stop exactly at it with maximum dynamics (alarm 533, the axis
+        // stays enabled). If even that is impossible the setpoint will cross: alarm 534.
+        self.sw_active = Some(sense);
+        let supp = if sense == Sense::Positive {
+            supplement::POSITIVE
+        } else {
+            supplement::NEGATIVE
+        };
+        self.raise(AlarmId::SwLimitReached, supp);
+        self.fold_superimposed();
+        let here = self.stop_point(self.basic, &max);
+        let reachable = match sense {
+            Sense::Positive => here <= limit + eps,
+            Sense::Negative => here >= limit - eps,
+        };
+        if reachable {
+            if let Ok(p) = plan_position(
+                self.basic,
+                limit,
+                &Limits {
+                    vel: max.vel.max(self.basic.v.abs()),
+                    ..max
+                },
+            ) {
+                self.goal = Goal::Stop { lim: max };
+                self.prof = p;
+                self.t0 = self.now;
+            }
+        }
+    }
+
+    fn check_hw_limits(&mut self, phys: f64) {
+        if !self.cfg.hw_limits_active || self.cfg.virtual_axis {
+            return;
+        }
+        let plant = self.cfg.plant;
+        let max_on = plant.hw_limit_max.map(|x| phys >= x).unwrap_or(false);
+        let min_on = plant.hw_limit_min.map(|x| phys <= x).unwrap_or(false);
+        if let Some((sense, at)) = self.hw_trigger {
+            // Cleared once the switch is left and the axis is back beyond the stored position.
+            let cleared = match sense {
+                Sense::Positive => !max_on && phys < at,
+                Sense::Negative => !min_on && phys > at,
+            };
+            if cleared {
+                self.hw_trigger = None;
+            }
+        }
+        if !self.enabled {
+            return;
+        }
+        let homing_reverses = self.cfg.homing.auto_reversal
+            && self
+                .main
+                .and_then(|m| m.homing)
+                .map(|h| h.phase != HomePhase::Travel)
+                .unwrap_or(false);
+        if homing_reverses {
+            return;
+        }
+        let v = self.total().v;
+        for (sense, on) in [(Sense::Positive, max_on), (Sense::Negative, min_on)] {
+            if !on {
+                continue;
+            }
+            match self.hw_trigger {
+                None => {
+                    self.hw_trigger = Some((sense, phys));
+                    let supp = if sense == Sense::Positive {
+                        supplement::HW_LIMIT_POSITIVE
+                    } else {
+                        supplement::HW_LIMIT_NEGATIVE
+                    };
+                    self.raise(AlarmId::HwLimit, supp);
+                }
+                Some((s, _)) if s == sense && sign(v) == sense.sign() => {
+                    self.raise(AlarmId::HwLimit, supplement::HW_LIMIT_ILLEGAL_DIRECTION);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn hw_switch_hit(&self, phys: f64, dir: f64) -> bool {
+        let p = self.cfg.plant;
+        (dir > 0.0 && p.hw_limit_max.map(|x| phys >= x).unwrap_or(false))
+            || (dir < 0.0 && p.hw_limit_min.map(|x| phys <= x).unwrap_or(false))
+    }
+
+    /// Sets the axis position so that the physical mark `m` has the axis value `home`.
+    fn home_at_mark(&mut self, m: f64, home: f64) {
+        let delta = home - (m + self.offset);
+        self.shift(delta);
+        self.homed = true;
+    }
+
+    fn active_homing(&mut self, prev: f64, phys: f64) {
+        let Some(job) = self.main else {
+            return;
+        };
+        let Some(mut h) = job.homing else {
+            return;
+        };
+        let hc = self.cfg.homing;
+        let hd = hc.homing_direction.sign();
+        let moved = sign(phys - prev);
+        let vlim = Limits {
+            vel: self.cfg.limits.max_velocity,
+            ..job.lim
+        };
+        let mut new_goal = None;
+        match h.phase {
+            HomePhase::Search | HomePhase::OnCam | HomePhase::Armed
+                if hc.auto_reversal && self.hw_switch_hit(phys, moved) =>
+            {
+                // Reversing cam: brake with the maximum deceleration, continue the other way at
+                // approach velocity. The second reversal means nothing was found.
+                h.reversals += 1;
+                if h.reversals >= 2 {
+                    self.raise(AlarmId::HomingNotFound, supplement::NONE);
+                    return;
+                }
+                h.search_dir = -moved;
+                h.phase = HomePhase::Search;
+                let lim = Limits {
+                    dec: self.cfg.limits.max_deceleration,
+                    ..vlim
+                };
+                new_goal = Some(Goal::Velocity {
+                    v: h.search_dir * hc.approach_velocity,
+                    lim,
+                });
+            }
+            HomePhase::Search => {
+                if self.on_cam(phys) {
+                    h.phase = HomePhase::OnCam;
+                    new_goal = Some(Goal::Velocity {
+                        v: hd * hc.referencing_velocity,
+                        lim: vlim,
+                    });
+                }
+            }
+            HomePhase::OnCam => {
+                if !self.on_cam(phys) && moved == hd {
+                    if hc.active_mark == HomingMark::DigitalInput {
+                        if let Some((lo, hi)) = self.cfg.plant.reference_cam {
+                            let m = if hd > 0.0 { hi } else { lo };
+                            self.home_at_mark(m, h.home);
+                            h.phase = HomePhase::Travel;
+                        }
+                    } else {
+                        h.phase = HomePhase::Armed;
+                    }
+                }
+            }
+            HomePhase::Armed => {
+                if moved == hd {
+                    if let Some(m) = self.cfg.plant.zero_mark.and_then(|z| z.crossed(prev, phys)) {
+                        self.home_at_mark(m, h.home);
+                        h.phase = HomePhase::Travel;
+                    }
+                }
+            }
+            HomePhase::Travel => {}
+        }
+        if h.phase == HomePhase::Travel && job.homing.map(|o| o.phase) != Some(HomePhase::Travel) {
+            // Travel to the end position at approach velocity (shortest way on modulo axes).
+            let here = self.basic.p;
+            let target = match self.cfg.modulo {
+                Some(m) => here + m.shortest(here, h.end),
+                None => h.end,
+            };
+            let lim = Limits {
+                vel: hc.approach_velocity,
+                ..job.lim
+            };
+            new_goal = Some(Goal::Position { target, lim });
+        }
+        if let Some(m) = self.main.as_mut() {
+            m.homing = Some(h);
+        }
+        if let Some(g) = new_goal {
+            // Homing motions ignore the override.
+            let ovr = self.override_pct;
+            self.override_pct = 100.0;
+            self.set_goal(g);
+            self.override_pct = ovr;
+        }
+    }
+
+    fn passive_homing(&mut self, prev: f64, phys: f64) {
+        let Some(mut ph) = self.passive else {
+            return;
+        };
+        let moved = sign(phys - prev);
+        let dir_ok = match self.cfg.homing.passive_direction {
+            PassiveDirection::Positive => moved > 0.0,
+            PassiveDirection::Negative => moved < 0.0,
+            PassiveDirection::Current => moved != 0.0,
+        };
+        let mark = self.cfg.homing.passive_mark;
+        let mut hit = None;
+        match ph.phase {
+            HomePhase::Search => {
+                if dir_ok && self.on_cam(phys) {
+                    ph.phase = HomePhase::OnCam;
+                }
+            }
+            HomePhase::OnCam => {
+                if !self.on_cam(phys) {
+                    if dir_ok {
+                        if mark == HomingMark::DigitalInput {
+                            if let Some((lo, hi)) = self.cfg.plant.reference_cam {
+                                hit = Some(if moved > 0.0 { hi } else { lo });
+                            }
+                        } else {
+                            ph.phase = HomePhase::Armed;
+                            ph.armed_dir = moved;
+                        }
+                    } else {
+                        ph.phase = HomePhase::Search;
+                    }
+                }
+            }
+            HomePhase::Armed => {
+                if ph.armed_dir != 0.0 && moved != 0.0 && moved != ph.armed_dir {
+                    // A reversal after leaving the cam: the cam must be detected again.
+                    ph.phase = HomePhase::Search;
+                } else if dir_ok {
+                    hit = self.cfg.plant.zero_mark.and_then(|z| z.crossed(prev, phys));
+                }
+            }
+            HomePhase::Travel => {}
+        }
+        if let Some(m) = hit {
+            // Passive homing applies no home position offset.
+            self.home_at_mark(m, ph.home);
+            self.passive = None;
+            self.emit(ph.job, Instruction::Home, JobEventKind::Done);
+        } else {
+            self.passive = Some(ph);
+        }
+    }
+
+    fn update_jobs(&mut self) {
+        let finished = self.elapsed(self.t0) >= self.prof.duration();
+        if let Some(j) = self.sup_job {
+            if self.elapsed(j.t0) >= j.prof.duration() {
+                self.sup = j.prof.end();
+                self.sup_job = None;
+                self.emit(j.id, Instruction::MoveSuperimposed, JobEventKind::Done);
+            }
+        }
+        if self.power.disabling && finished {
+            self.remove_enable();
+            return;
+        }
+        let Some(mut m) = self.main else {
+            return;
+        };
+        let ovr_stopped = self.override_pct == 0.0 && matches!(self.goal, Goal::Position { .. });
+        match (m.instr, self.goal) {
+            (Instruction::MoveVelocity | Instruction::MoveJog, Goal::Velocity { .. })
+                if finished && !m.in_velocity =>
+            {
+                m.in_velocity = true;
+                self.emit(m.id, m.instr, JobEventKind::InVelocity);
+            }
+            (Instruction::MoveJog, Goal::Stop { .. }) if finished => {
+                self.finish_main(m.id, m.instr);
+                return;
+            }
+            (Instruction::Stop, _) if finished && !self.stop_lock => {
+                self.finish_main(m.id, m.instr);
+                return;
+            }
+            (
+                Instruction::MoveAbsolute
+                | Instruction::MoveRelative
+                | Instruction::Halt
+                | Instruction::Home,
+                Goal::Position { target: _, .. } | Goal::Stop { .. },
+            ) if finished && !ovr_stopped => {
+                if (m.instr == Instruction::Home
+                    && m.homing
+                        .map(|h| h.phase != HomePhase::Travel)
+                        .unwrap_or(false))
+                    || self.sup_job.is_some()
+                {
+                    // Still searching (a stop in between is not the end), or a superimposed
+                    // motion is still running: positioning monitoring waits for the total.
+                } else {
+                    let target = self.total().p;
+                    let pm = *m.monitoring.get_or_insert(PosMon {
+                        target,
+                        start_ns: self.now,
+                        entered_ns: None,
+                    });
+                    match self.positioning_monitor(pm) {
+                        Some(true) => {
+                            self.finish_main(m.id, m.instr);
+                            return;
+                        }
+                        Some(false) => return,
+                        None => {
+                            if let Some(pm2) = m.monitoring.as_mut() {
+                                if pm2.entered_ns.is_none() && self.pm_inside(pm2.target) {
+                                    pm2.entered_ns = Some(self.now);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+        if let Some(slot) = self.main.as_mut() {
+            if slot.id == m.id {
+                *slot = m;
+            }
+        }
+    }
+
+    fn finish_main(&mut self, id: crate::job::JobId, instr: Instruction) {
+        self.main = None;
+        self.emit(id, instr, JobEventKind::Done);
+        self.set_goal(Goal::Hold);
+    }
+
+    fn pm_inside(&self, target: f64) -> bool {
+        (self.actual_p - target).abs() <= self.cfg.positioning.window
+    }
+
+    /// Positioning monitoring (seed 001 §4.6): `Some(true)` done, `Some(false)` failed (alarm
+    /// 541 raised), `None` still waiting.
+    fn positioning_monitor(&mut self, pm: PosMon) -> Option<bool> {
+        if !self.pos_ctrl {
+            return Some(true);
+        }
+        let pmc = self.cfg.positioning;
+        let inside = self.pm_inside(pm.target);
+        let ns = |s: f64| (s * 1e9).round() as i64;
+        match pm.entered_ns {
+            None => {
+                if inside {
+                    if pmc.min_dwell_time <= 0.0 {
+                        return Some(true);
+                    }
+                    None
+                } else if self.now - pm.start_ns > ns(pmc.tolerance_time) {
+                    self.raise(
+                        AlarmId::PositioningMonitoring,
+                        supplement::TARGET_NOT_REACHED,
+                    );
+                    Some(false)
+                } else {
+                    None
+                }
+            }
+            Some(t) => {
+                if !inside {
+                    self.raise(AlarmId::PositioningMonitoring, supplement::TARGET_LEFT);
+                    Some(false)
+                } else if self.now - t >= ns(pmc.min_dwell_time) {
+                    Some(true)
+                } else {
+                    None
+                }
+            }
+        }
+    }
+
+    fn monitor(&mut self, balanced: f64) {
+        let ss = self.cfg.standstill;
+        if self.actual_v.abs() <= ss.velocity_threshold {
+            self.standstill_since.get_or_insert(self.now);
+        } else {
+            self.standstill_since = None;
+        }
+        let fe_cfg = self.cfg.following_error;
+        self.fe = if self.enabled && self.pos_ctrl {
+            balanced - self.actual_p
+        } else {
+            0.0
+        };
+        if !(fe_cfg.enable && self.enabled && self.pos_ctrl) {
+            return;
+        }
+        let v = self.total().v.abs();
+        let vmax = self.cfg.limits.max_velocity;
+        let allowed = if v <= fe_cfg.min_velocity || vmax <= fe_cfg.min_velocity {
+            fe_cfg.min_value
+        } else {
+            let f = ((v - fe_cfg.min_velocity) / (vmax - fe_cfg.min_velocity)).min(1.0);
+            fe_cfg.min_value + (fe_cfg.max_value - fe_cfg.min_value) * f
+        };
+        let err = self.fe.abs();
+        if err > allowed {
+            self.raise(AlarmId::FollowingError, supplement::NONE);
+        } else if err > allowed * fe_cfg.warning_level / 100.0 {
+            self.raise(AlarmId::FollowingErrorWarning, supplement::NONE);
+        }
+    }
+
+    pub(super) fn refresh_status(&mut self) {
+        let tot = self.total();
+        let mut sw = 0u32;
+        let mut ew = 0u32;
+        let mut ww = 0u32;
+        for a in self.alarms() {
+            let spec = a.spec();
+            ew |= spec.error_mask();
+            ww |= spec.warning_mask();
+        }
+        let detail = ErrorDetail::from_pending(self.alarms());
+        let main = self.main.map(|m| m.instr);
+        let set = |sw: &mut u32, bit: u32, on: bool| {
+            if on {
+                *sw |= bit;
+            }
+        };
+        set(&mut sw, status_bit::ENABLE, self.enabled);
+        set(&mut sw, status_bit::ERROR, detail.number != 0);
+        set(&mut sw, status_bit::HOMING_DONE, self.homed);
+        set(
+            &mut sw,
+            status_bit::DONE,
+            self.main.is_none() && self.sup_job.is_none(),
+        );
+        let standstill = self
+            .standstill_since
+            .map(|t| self.now - t >= (self.cfg.standstill.min_dwell_time * 1e9).round() as i64)
+            .unwrap_or(false);
+        set(
+            &mut sw,
+            status_bit::STANDSTILL,
+            standstill && self.cfg.kind == AxisKind::Positioning,
+        );
+        set(
+            &mut sw,
+            status_bit::POSITIONING_COMMAND,
+            matches!(
+                main,
+                Some(Instruction::MoveAbsolute | Instruction::MoveRelative)
+            ),
+        );
+        set(
+            &mut sw,
+            status_bit::JOG_COMMAND,
+            main == Some(Instruction::MoveJog),
+        );
+        set(
+            &mut sw,
+            status_bit::VELOCITY_COMMAND,
+            main == Some(Instruction::MoveVelocity),
+        );
+        set(
+            &mut sw,
+            status_bit::HOMING_COMMAND,
+            main == Some(Instruction::Home) || self.passive.is_some(),
+        );
+        set(&mut sw, status_bit::CONSTANT_VELOCITY, tot.a == 0.0);
+        set(
+            &mut sw,
+            status_bit::ACCELERATING,
+            tot.a != 0.0 && tot.a * tot.v >= 0.0,
+        );
+        set(&mut sw, status_bit::DECELERATING, tot.a * tot.v < 0.0);
+        set(
+            &mut sw,
+            status_bit::SW_LIMIT_MIN_ACTIVE,
+            self.sw_active == Some(Sense::Negative),
+        );
+        set(
+            &mut sw,
+            status_bit::SW_LIMIT_MAX_ACTIVE,
+            self.sw_active == Some(Sense::Positive),
+        );
+        let hw = self.hw_trigger.map(|(s, _)| s);
+        set(
+            &mut sw,
+            status_bit::HW_LIMIT_MIN_ACTIVE,
+            hw == Some(Sense::Negative),
+        );
+        set(
+            &mut sw,
+            status_bit::HW_LIMIT_MAX_ACTIVE,
+            hw == Some(Sense::Positive),
+        );
+        set(
+            &mut sw,
+            status_bit::SUPERIMPOSED_MOTION_COMMAND,
+            self.sup_job.is_some(),
+        );
+        set(&mut sw, status_bit::AXIS_SIMULATION, self.cfg.virtual_axis);
+        set(
+            &mut sw,
+            status_bit::NON_POSITION_CONTROLLED,
+            self.enabled && !self.pos_ctrl,
+        );
+        set(
+            &mut sw,
+            status_bit::MOTION_IN_COMMAND,
+            matches!(
+                main,
+                Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
+            ),
+        );
+        if self.cfg.kind == AxisKind::Speed {
+            sw &= status_bit::SPEED_AXIS_MASK;
+        }
+        let _ = error_bit::SW_LIMIT;
+        let state = if detail.reaction != Reaction::None {
+            AxisState::ErrorStop
+        } else if !self.enabled {
+            AxisState::Disabled
+        } else if self.stop_lock || main == Some(Instruction::Stop) || self.power.disabling {
+            AxisState::Stopping
+        } else {
+            match main {
+                Some(Instruction::Home) => AxisState::Homing,
+                Some(
+                    Instruction::MoveVelocity
+                    | Instruction::MoveJog
+                    | Instruction::MotionInPosition
+                    | Instruction::MotionInVelocity,
+                ) => AxisState::ContinuousMotion,
+                Some(_) => AxisState::DiscreteMotion,
+                None if self.sup_job.is_some() => AxisState::DiscreteMotion,
+                None => AxisState::Standstill,
+            }
+        };
+        self.status = super::AxisStatus {
+            time_ns: self.now,
+            state,
+            status_word: sw,
+            error_word: ew,
+            warning_word: ww,
+            error_detail: detail,
+            position: self.wrap(tot.p),
+            velocity: tot.v,
+            acceleration: tot.a,
+            actual_position: self.wrap(self.actual_p),
+            actual_velocity: self.actual_v,
+            following_error: self.fe,
+            override_velocity: self.override_pct,
+            position_unwrapped: tot.p,
+            motion_job: self.main.map(|m| (m.id, m.instr)),
+            superimposed_job: self.sup_job.map(|s| (s.id, Instruction::MoveSuperimposed)),
+        };
+    }
+}

@@ -1,0 +1,178 @@
+//! Jobs: identifiers, the instructions they run, and the events they report (seed 001 §3.1).
+//!
+//! An Execute-type instruction starts a job and is answered at once with a [`JobId`] or a
+//! rejection ([`crate::error_id::ErrorId`]); the job then reports its progress as [`JobEvent`]s
+//! (Busy at start, then InVelocity / Done / CommandAborted / Error). Enable-type instructions
+//! (MC_Power, MC_MoveJog, MC_MotionIn*) keep one job while their enable is held.
+
+use crate::error_id::ErrorId;
+
+/// Identifier of a job, unique per technology object (never 0).
+pub type JobId = u32;
+
+/// The PLCopen / S7-1500T instruction a job runs.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Instruction {
+    /// `MC_Power`.
+    Power,
+    /// `MC_Reset`.
+    Reset,
+    /// `MC_Home`.
+    Home,
+    /// `MC_Halt`.
+    Halt,
+    /// `MC_Stop`.
+    Stop,
+    /// `MC_MoveAbsolute`.
+    MoveAbsolute,
+    /// `MC_MoveRelative`.
+    MoveRelative,
+    /// `MC_MoveVelocity`.
+    MoveVelocity,
+    /// `MC_MoveJog`.
+    MoveJog,
+    /// `MC_MoveSuperimposed`.
+    MoveSuperimposed,
+    /// `MC_SetOverride` (tandem: writes `Override.Velocity`).
+    SetOverride,
+    /// `MC_MotionInPosition`.
+    MotionInPosition,
+    /// `MC_MotionInVelocity`.
+    MotionInVelocity,
+}
+
+impl Instruction {
+    /// The PLCopen name, e.g. `MC_MoveAbsolute`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Power => "MC_Power",
+            Self::Reset => "MC_Reset",
+            Self::Home => "MC_Home",
+            Self::Halt => "MC_Halt",
+            Self::Stop => "MC_Stop",
+            Self::MoveAbsolute => "MC_MoveAbsolute",
+            Self::MoveRelative => "MC_MoveRelative",
+            Self::MoveVelocity => "MC_MoveVelocity",
+            Self::MoveJog => "MC_MoveJog",
+            Self::MoveSuperimposed => "MC_MoveSuperimposed",
+            Self::SetOverride => "MC_SetOverride",
+            Self::MotionInPosition => "MC_MotionInPosition",
+            Self::MotionInVelocity => "MC_MotionInVelocity",
+        }
+    }
+}
+
+/// What happened to a job.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum JobEventKind {
+    /// Accepted and running (`Busy`).
+    Busy,
+    /// The target velocity is reached (`InVelocity`, velocity and jog jobs).
+    InVelocity,
+    /// The target velocity is left again (override change, stop of a jog).
+    LeftVelocity,
+    /// Finished (`Done`).
+    Done,
+    /// `MC_Power.Status` changed (TRUE: enabled, FALSE: disabled).
+    Status(bool),
+    /// Aborted by another job or by an alarm reaction (`CommandAborted`).
+    CommandAborted,
+    /// Ended with an error (`Error`, `ErrorID`), e.g. 16#8001 when an alarm ended it.
+    Error(ErrorId),
+}
+
+/// One job event, with the time (ns, cell clock) of the cycle it happened in.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct JobEvent {
+    /// The job.
+    pub job: JobId,
+    /// Its instruction.
+    pub instruction: Instruction,
+    /// What happened.
+    pub kind: JobEventKind,
+    /// Cycle time (ns).
+    pub time_ns: i64,
+}
+
+/// Capacity of an event queue.
+pub const EVENT_CAPACITY: usize = 64;
+
+/// Fixed-capacity FIFO of job events; when full the oldest event is dropped and counted.
+#[derive(Clone, Debug)]
+pub struct EventQueue {
+    buf: [Option<JobEvent>; EVENT_CAPACITY],
+    head: usize,
+    len: usize,
+    dropped: u64,
+}
+
+impl Default for EventQueue {
+    fn default() -> Self {
+        Self {
+            buf: [None; EVENT_CAPACITY],
+            head: 0,
+            len: 0,
+            dropped: 0,
+        }
+    }
+}
+
+impl EventQueue {
+    /// Appends an event (dropping the oldest when full).
+    pub fn push(&mut self, e: JobEvent) {
+        if self.len == EVENT_CAPACITY {
+            self.head = (self.head + 1) % EVENT_CAPACITY;
+            self.len -= 1;
+            self.dropped += 1;
+        }
+        self.buf[(self.head + self.len) % EVENT_CAPACITY] = Some(e);
+        self.len += 1;
+    }
+
+    /// Removes and returns the oldest event.
+    pub fn pop(&mut self) -> Option<JobEvent> {
+        if self.len == 0 {
+            return None;
+        }
+        let e = self.buf[self.head].take();
+        self.head = (self.head + 1) % EVENT_CAPACITY;
+        self.len -= 1;
+        e
+    }
+
+    /// Number of queued events.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// No queued events.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Events dropped because the queue was full.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn queue_drops_oldest_and_counts() {
+        let mut q = EventQueue::default();
+        for i in 0..(EVENT_CAPACITY as u32 + 3) {
+            q.push(JobEvent {
+                job: i + 1,
+                instruction: Instruction::Halt,
+                kind: JobEventKind::Done,
+                time_ns: 0,
+            });
+        }
+        assert_eq!(q.len(), EVENT_CAPACITY);
+        assert_eq!(q.dropped(), 3);
+        assert_eq!(q.pop().map(|e| e.job), Some(4));
+    }
+}
