@@ -83,6 +83,9 @@ INF = float("inf")
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 OUT = os.path.join(REPO, "shared", "motion", "tests", "fixtures", "ruckig_1dof.csv")
+# `--out PATH` writes elsewhere (tests/run.sh regenerates into a temp file and compares).
+if len(sys.argv) == 3 and sys.argv[1] == "--out":
+    OUT = os.path.abspath(sys.argv[2])
 COLUMNS = ["id", "kind", "p0", "v0", "a0", "target", "vmax", "acc", "dec", "jerk", "duration"]
 
 N_SAMPLES = 2001

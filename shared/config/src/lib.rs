@@ -1,1 +1,399 @@
+//! tandem-config: the cell file (TOML) to a validated, typed configuration.
+//!
+//! Every error names the file, the line and the key, and says what is wrong. The same module
+//! parses instruction names and parameters (`command`) for the simulator script and the CLI.
 
+pub mod command;
+mod schema;
+pub mod script;
+
+use schema::{AxisSection, CellFile};
+use std::path::Path;
+use tandem_motion::axis::{
+    AxisConfig, AxisKind, EncoderType, FollowingErrorMonitoring, HomingConfig, HomingMark,
+    MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
+};
+use tandem_motion::drive::{DriveModel, Plant, ZeroMark};
+use tandem_motion::dynamics::{DynamicDefaults, DynamicLimits};
+use tandem_motion::modulo::Modulo;
+
+/// A problem in a configuration file, located.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ConfigError {
+    /// File (as given).
+    pub file: String,
+    /// 1-based line, when known.
+    pub line: Option<usize>,
+    /// Dotted key path, when known.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: ", self.file, l)?,
+            None => write!(f, "{}: ", self.file)?,
+        }
+        if self.key.is_empty() {
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "{}: {}", self.key, self.message)
+        }
+    }
+}
+
+impl std::error::Error for ConfigError {}
+
+/// A node of the cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    /// Name.
+    pub name: String,
+    /// Servo cycle (ns).
+    pub cycle_ns: i64,
+}
+
+/// An axis of the cell, with the node that hosts it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisEntry {
+    /// Name (unique in the cell).
+    pub name: String,
+    /// Index into [`Cell::nodes`].
+    pub node: usize,
+    /// Engine configuration.
+    pub config: AxisConfig,
+}
+
+/// A validated cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cell {
+    /// Cell name.
+    pub name: String,
+    /// Base tick (ns).
+    pub base_tick_ns: i64,
+    /// Nodes.
+    pub nodes: Vec<Node>,
+    /// Axes, in name order.
+    pub axes: Vec<AxisEntry>,
+}
+
+/// Finds the 1-based line of a dotted key path in TOML source (best effort).
+pub fn locate(src: &str, path: &[&str]) -> Option<usize> {
+    let doc = toml_edit::ImDocument::parse(src).ok()?;
+    let mut item: &toml_edit::Item = doc.as_item();
+    let mut span = None;
+    for k in path {
+        let table = item.as_table_like()?;
+        let (key, next) = table.get_key_value(k)?;
+        span = key.span().or(span);
+        item = next;
+    }
+    let offset = span?.start;
+    Some(src[..offset.min(src.len())].matches('\n').count() + 1)
+}
+
+fn line_of_toml_error(e: &toml::de::Error, src: &str) -> Option<usize> {
+    e.span()
+        .map(|s| src[..s.start.min(src.len())].matches('\n').count() + 1)
+}
+
+/// Loads and validates a cell file.
+pub fn load(path: &Path) -> Result<Cell, ConfigError> {
+    let file = path.display().to_string();
+    let src = std::fs::read_to_string(path).map_err(|e| ConfigError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read: {e}"),
+    })?;
+    parse(&file, &src)
+}
+
+/// Parses and validates cell source text; `file` is used in error messages.
+pub fn parse(file: &str, src: &str) -> Result<Cell, ConfigError> {
+    let raw: CellFile = toml::from_str(src).map_err(|e| ConfigError {
+        file: file.into(),
+        line: line_of_toml_error(&e, src),
+        key: String::new(),
+        message: e.message().to_string(),
+    })?;
+    let err = |path: &[&str], message: String| ConfigError {
+        file: file.into(),
+        line: locate(src, path),
+        key: path.join("."),
+        message,
+    };
+    if raw.cell.base_tick_us == 0 {
+        return Err(err(
+            &["cell", "base_tick_us"],
+            "must be at least 1 µs".into(),
+        ));
+    }
+    let base = raw.cell.base_tick_us;
+    let mut nodes = Vec::new();
+    for n in &raw.nodes {
+        if n.cycle_us == 0 || n.cycle_us % base != 0 {
+            return Err(err(
+                &["nodes"],
+                format!(
+                    "node `{}`: cycle_us = {} is not a positive multiple of the base tick ({base} µs)",
+                    n.name, n.cycle_us
+                ),
+            ));
+        }
+        if nodes.iter().any(|x: &Node| x.name == n.name) {
+            return Err(err(
+                &["nodes"],
+                format!("node `{}` is defined twice", n.name),
+            ));
+        }
+        nodes.push(Node {
+            name: n.name.clone(),
+            cycle_ns: n.cycle_us as i64 * 1000,
+        });
+    }
+    let mut axes = Vec::new();
+    for (name, a) in &raw.axes {
+        let node = nodes.iter().position(|n| n.name == a.node).ok_or_else(|| {
+            err(
+                &["axes", name, "node"],
+                format!("unknown node `{}` (define it in [[nodes]])", a.node),
+            )
+        })?;
+        let cycle = nodes[node].cycle_ns as f64 * 1e-9;
+        let config = axis_config(a, cycle).map_err(|(k, m)| err(&["axes", name, k], m))?;
+        config.validate().map_err(|e| {
+            let parts: Vec<&str> = e.field.split('.').collect();
+            let mut path = vec!["axes", name.as_str()];
+            path.extend(parts.iter().copied());
+            let mut located = err(&path, e.problem.to_string());
+            if located.line.is_none() {
+                // The key is absent (a default); point at the axis table.
+                located.line = locate(src, &["axes", name]);
+            }
+            located
+        })?;
+        axes.push(AxisEntry {
+            name: name.clone(),
+            node,
+            config,
+        });
+    }
+    Ok(Cell {
+        name: raw.cell.name,
+        base_tick_ns: base as i64 * 1000,
+        nodes,
+        axes,
+    })
+}
+
+type FieldError = (&'static str, String);
+
+fn pick<T: Copy>(key: &'static str, value: &str, options: &[(&str, T)]) -> Result<T, FieldError> {
+    options
+        .iter()
+        .find(|(n, _)| *n == value)
+        .map(|(_, v)| *v)
+        .ok_or_else(|| {
+            let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
+            (key, format!("`{value}` is not one of {}", names.join(", ")))
+        })
+}
+
+fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, FieldError> {
+    let kind = pick(
+        "kind",
+        &a.kind,
+        &[
+            ("speed", AxisKind::Speed),
+            ("positioning", AxisKind::Positioning),
+        ],
+    )?;
+    let motion_type = pick(
+        "motion_type",
+        &a.motion_type,
+        &[
+            ("linear", MotionType::Linear),
+            ("rotary", MotionType::Rotary),
+        ],
+    )?;
+    let encoder = pick(
+        "encoder",
+        &a.encoder,
+        &[
+            ("incremental", EncoderType::Incremental),
+            ("absolute", EncoderType::Absolute),
+        ],
+    )?;
+    let marks = [
+        ("zero_mark", HomingMark::ZeroMark),
+        ("cam_and_zero_mark", HomingMark::CamAndZeroMark),
+        ("digital_input", HomingMark::DigitalInput),
+    ];
+    let senses = [("positive", Sense::Positive), ("negative", Sense::Negative)];
+    let h = &a.homing;
+    let homing = HomingConfig {
+        active_mark: pick("homing.active_mark", &h.active_mark, &marks)?,
+        passive_mark: pick("homing.passive_mark", &h.passive_mark, &marks)?,
+        approach_direction: pick("homing.approach_direction", &h.approach_direction, &senses)?,
+        homing_direction: pick("homing.homing_direction", &h.homing_direction, &senses)?,
+        passive_direction: pick(
+            "homing.passive_direction",
+            &h.passive_direction,
+            &[
+                ("positive", PassiveDirection::Positive),
+                ("negative", PassiveDirection::Negative),
+                ("current", PassiveDirection::Current),
+            ],
+        )?,
+        approach_velocity: h.approach_velocity,
+        referencing_velocity: h.referencing_velocity,
+        home_position: h.home_position,
+        home_position_offset: h.home_position_offset,
+        auto_reversal: h.auto_reversal,
+    };
+    let d = &a.drive;
+    let drive = match d.model.as_str() {
+        "position_loop" => DriveModel::PositionLoop {
+            kv: d.kv,
+            kpc: d.kpc / 100.0,
+            t_vtc: d.t_vtc,
+        },
+        "delay" => DriveModel::Delay { delay: d.delay },
+        other => {
+            return Err((
+                "drive.model",
+                format!("`{other}` is not one of position_loop, delay"),
+            ));
+        }
+    };
+    let dy = &a.dynamics;
+    let hw = a.hw_limits.as_ref();
+    Ok(AxisConfig {
+        kind,
+        motion_type,
+        modulo: a.modulo.as_ref().map(|m| Modulo {
+            start: m.start,
+            length: m.length,
+        }),
+        encoder,
+        virtual_axis: a.virtual_axis,
+        cycle,
+        limits: DynamicLimits {
+            max_velocity: dy.max_velocity,
+            max_acceleration: dy.max_acceleration,
+            max_deceleration: dy.max_deceleration,
+            max_jerk: dy.max_jerk,
+        },
+        defaults: DynamicDefaults {
+            velocity: dy.velocity,
+            acceleration: dy.acceleration,
+            deceleration: dy.deceleration,
+            jerk: dy.jerk,
+            emergency_deceleration: dy.emergency_deceleration,
+        },
+        sw_limits: a.sw_limits.as_ref().map(|s| SoftwareLimits {
+            min: s.min,
+            max: s.max,
+        }),
+        hw_limits_active: hw.map(|h| h.active).unwrap_or(false),
+        positioning: PositioningMonitoring {
+            window: a.positioning.window,
+            tolerance_time: a.positioning.tolerance_time,
+            min_dwell_time: a.positioning.min_dwell_time,
+        },
+        following_error: FollowingErrorMonitoring {
+            enable: a.following_error.enable,
+            min_value: a.following_error.min_value,
+            max_value: a.following_error.max_value,
+            min_velocity: a.following_error.min_velocity,
+            warning_level: a.following_error.warning_level,
+        },
+        standstill: StandstillSignal {
+            velocity_threshold: a.standstill.velocity_threshold,
+            min_dwell_time: a.standstill.min_dwell_time,
+        },
+        homing,
+        drive,
+        plant: Plant {
+            reference_cam: a.plant.reference_cam.map(|[lo, hi]| (lo, hi)),
+            zero_mark: a.plant.zero_mark_period.map(|period| ZeroMark {
+                period,
+                offset: a.plant.zero_mark_offset,
+            }),
+            hw_limit_min: hw.and_then(|h| h.min),
+            hw_limit_max: hw.and_then(|h| h.max),
+        },
+        initial_position: a.initial_position,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+[cell]
+name = "t"
+
+[[nodes]]
+name = "n"
+cycle_us = 1000
+
+[axes.x]
+node = "n"
+
+[axes.x.dynamics]
+max_velocity = 100.0
+max_acceleration = 1000.0
+max_deceleration = 1000.0
+max_jerk = 10000.0
+velocity = 50.0
+acceleration = 500.0
+deceleration = 500.0
+jerk = 5000.0
+emergency_deceleration = 2000.0
+"#;
+
+    #[test]
+    fn parses_a_minimal_cell() {
+        let c = parse("cell.toml", GOOD).unwrap();
+        assert_eq!(c.axes.len(), 1);
+        assert_eq!(c.nodes[0].cycle_ns, 1_000_000);
+        assert_eq!(c.axes[0].config.cycle, 0.001);
+    }
+
+    #[test]
+    fn errors_name_file_line_and_key() {
+        let bad = GOOD.replace("max_velocity = 100.0", "max_velocity = 0.0");
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert_eq!(e.key, "axes.x.dynamics.max_velocity");
+        assert_eq!(e.line, Some(13));
+        assert!(e
+            .to_string()
+            .starts_with("cell.toml:13: axes.x.dynamics.max_velocity: must be"));
+        let bad = GOOD.replace("node = \"n\"", "node = \"m\"");
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert_eq!((e.key.as_str(), e.line), ("axes.x.node", Some(10)));
+        assert!(e.message.contains("unknown node `m`"));
+        let bad = GOOD.replace("cycle_us = 1000", "cycle_us = 1100");
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert!(
+            e.message
+                .contains("not a positive multiple of the base tick"),
+            "{e}"
+        );
+        let bad = GOOD.replace("max_jerk = 10000.0", "max_jerk = 10000.0\nmax_jrk = 1.0");
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert_eq!(e.line, Some(17));
+        assert!(e.message.contains("unknown field `max_jrk`"), "{e}");
+        let bad = GOOD.replace("node = \"n\"", "node = \"n\"\nkind = \"servo\"");
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert_eq!(e.key, "axes.x.kind");
+        assert!(e
+            .message
+            .contains("`servo` is not one of speed, positioning"));
+    }
+}

@@ -849,3 +849,37 @@ fn motion_in_velocity_sets_setpoints_directly() {
         2
     );
 }
+
+#[test]
+fn homing_needs_the_sensors_of_its_mark() {
+    // The example config has no reference cam and no zero marks.
+    let mut r = Rig::enabled(AxisConfig::example(0.001));
+    assert_eq!(
+        r.cmd(Command::Home {
+            mode: 3,
+            position: 0.0
+        }),
+        Err(ErrorId::IllegalMode)
+    );
+    assert_eq!(
+        r.cmd(Command::Home {
+            mode: 8,
+            position: 0.0
+        }),
+        Err(ErrorId::IllegalMode)
+    );
+    assert_eq!(r.axis.status().state, AxisState::Standstill);
+    // A virtual axis homes at once without motion.
+    let mut cfg = AxisConfig::example(0.001);
+    cfg.virtual_axis = true;
+    let mut r = Rig::enabled(cfg);
+    let id = r
+        .cmd(Command::Home {
+            mode: 3,
+            position: 12.5,
+        })
+        .unwrap();
+    assert!(r.has(id, JobEventKind::Done));
+    r.step(1);
+    assert!((r.axis.status().position - 12.5).abs() < 1e-12);
+}

@@ -1204,6 +1204,21 @@ impl Axis {
         if matches!(mode, 3 | 5) {
             self.check_motion_allowed()?;
         }
+        // The plant must have the sensors the configured homing mark needs (S7: alarm 343
+        // "homing not supported by the device"; here the job is rejected and nothing changes).
+        let mark = match mode {
+            3 | 5 if !self.cfg.virtual_axis => Some(self.cfg.homing.active_mark),
+            2 | 8 | 10 => Some(self.cfg.homing.passive_mark),
+            _ => None,
+        };
+        if let Some(mark) = mark {
+            let plant = &self.cfg.plant;
+            let cam_ok = plant.reference_cam.is_some() || mark == HomingMark::ZeroMark;
+            let zero_ok = plant.zero_mark.is_some() || mark == HomingMark::DigitalInput;
+            if !(cam_ok && zero_ok) {
+                return Err(ErrorId::IllegalMode);
+            }
+        }
         let id = self.new_id();
         self.emit(id, Instruction::Home, JobEventKind::Busy);
         let modulo = self.cfg.modulo;

@@ -1,0 +1,106 @@
+//! The `tandem` CLI end to end: the README's main command on the bundled example, determinism,
+//! and errors that name file, line and key.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn run(args: &[&str]) -> (u8, String, String) {
+    let mut out = Vec::new();
+    let mut err = Vec::new();
+    let mut argv = vec!["tandem".into()];
+    argv.extend(args.iter().map(|s| std::ffi::OsString::from(*s)));
+    let code = tandem_cli::run(argv, &mut out, &mut err);
+    let code = if code == std::process::ExitCode::SUCCESS {
+        0
+    } else {
+        1
+    };
+    (
+        code,
+        String::from_utf8(out).unwrap(),
+        String::from_utf8(err).unwrap(),
+    )
+}
+
+#[test]
+fn example_runs_and_is_byte_identical_twice() {
+    let dir = std::env::temp_dir().join(format!("tandem-sim-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cell = root().join("config/example-cell.toml");
+    let script = root().join("config/example-script.toml");
+    let mut traces = Vec::new();
+    let mut logs = Vec::new();
+    for i in 0..2 {
+        let trace = dir.join(format!("trace{i}.csv"));
+        let (code, out, err) = run(&[
+            "sim",
+            cell.to_str().unwrap(),
+            "--script",
+            script.to_str().unwrap(),
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        traces.push(std::fs::read(&trace).unwrap());
+        logs.push(out);
+    }
+    assert_eq!(
+        traces[0], traces[1],
+        "two runs must give byte-identical traces"
+    );
+    assert_eq!(logs[0], logs[1]);
+    let text = String::from_utf8(traces[0].clone()).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("time_s,conveyor.state,conveyor.position"));
+    assert_eq!(header.split(',').count(), 1 + 3 * 13);
+    // 6 s at 1 ms: 6001 rows, every row complete.
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 6001);
+    assert!(rows.iter().all(|r| r.split(',').count() == 1 + 3 * 13));
+    // The story of the script, as logged.
+    let log = &logs[0];
+    assert!(log.contains("slide MC_MoveAbsolute rejected: 16#80F2 NotHomed"));
+    assert!(log.contains("slide MC_Home job 2: Done"));
+    assert!(log.contains("slide MC_MoveAbsolute job 3: Done"));
+    assert!(log.contains("conveyor MC_Stop job 3: Done"));
+    // The slide ends at 300 + 5 (superimposed), the table halted somewhere in its move.
+    let last: Vec<&str> = rows[rows.len() - 1].split(',').collect();
+    let slide_pos: f64 = last[1 + 13 + 1].parse().unwrap();
+    assert!((slide_pos - 305.0).abs() < 1e-9, "{slide_pos}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn check_reports_file_line_and_key() {
+    let dir = std::env::temp_dir().join(format!("tandem-check-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let src = std::fs::read_to_string(root().join("config/example-cell.toml")).unwrap();
+    let bad = src.replacen("max_velocity = 500.0", "max_velocity = -5.0", 1);
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, bad).unwrap();
+    let (code, _, err) = run(&["check", path.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    let line = src
+        .lines()
+        .position(|l| l.starts_with("max_velocity = 500.0"))
+        .unwrap()
+        + 1;
+    assert!(
+        err.contains(&format!(
+            "bad.toml:{line}: axes.slide.dynamics.max_velocity: must be a positive number"
+        )),
+        "{err}"
+    );
+    let (code, out, _) = run(&[
+        "check",
+        root().join("config/example-cell.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    assert!(out.contains("is valid"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,375 @@
+//! Instruction names and parameters as people write them (script files, the CLI) to engine
+//! commands. Names are the PLCopen ones, with or without `MC_`, in any case, with or without
+//! underscores: `MC_MoveAbsolute`, `MoveAbsolute`, `move_absolute`. Parameters are the
+//! references' input names in snake case (`position`, `velocity`, `abort_acceleration`...).
+//! Defaults are the references' defaults (dynamics -1.0 = the axis defaults).
+
+use tandem_motion::axis::{Command, Direction, StartMode, StopMode, VelocityDirection};
+use tandem_motion::dynamics::Dynamics;
+
+/// A parameter value.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Value {
+    /// A number.
+    Num(f64),
+    /// A boolean.
+    Bool(bool),
+}
+
+/// One instruction with its parameters: name, and (parameter, default or `None` if required).
+#[derive(Debug)]
+pub struct InstructionSpec {
+    /// PLCopen name.
+    pub name: &'static str,
+    /// Parameters: name and default (`None` = required).
+    pub params: &'static [(&'static str, Option<Value>)],
+}
+
+const DYN: [(&str, Option<Value>); 4] = [
+    ("velocity", Some(Value::Num(-1.0))),
+    ("acceleration", Some(Value::Num(-1.0))),
+    ("deceleration", Some(Value::Num(-1.0))),
+    ("jerk", Some(Value::Num(-1.0))),
+];
+
+/// Every instruction the axis accepts, with its parameters.
+pub const INSTRUCTIONS: &[InstructionSpec] = &[
+    InstructionSpec {
+        name: "MC_Power",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("start_mode", Some(Value::Num(1.0))),
+            ("stop_mode", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_Reset",
+        params: &[("restart", Some(Value::Bool(false)))],
+    },
+    InstructionSpec {
+        name: "MC_Home",
+        params: &[
+            ("mode", Some(Value::Num(0.0))),
+            ("position", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_Halt",
+        params: &[
+            ("deceleration", Some(Value::Num(-1.0))),
+            ("jerk", Some(Value::Num(-1.0))),
+            ("abort_acceleration", Some(Value::Bool(false))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_Stop",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("deceleration", Some(Value::Num(-1.0))),
+            ("jerk", Some(Value::Num(-1.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_MoveAbsolute",
+        params: &[
+            ("position", None),
+            DYN[0],
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            ("direction", Some(Value::Num(1.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_MoveRelative",
+        params: &[("distance", None), DYN[0], DYN[1], DYN[2], DYN[3]],
+    },
+    InstructionSpec {
+        name: "MC_MoveVelocity",
+        params: &[
+            ("velocity", Some(Value::Num(100.0))),
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            ("direction", Some(Value::Num(0.0))),
+            ("current", Some(Value::Bool(false))),
+            ("position_controlled", Some(Value::Bool(true))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_MoveJog",
+        params: &[
+            ("jog_forward", Some(Value::Bool(false))),
+            ("jog_backward", Some(Value::Bool(false))),
+            ("velocity", Some(Value::Num(100.0))),
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            ("position_controlled", Some(Value::Bool(true))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_MoveSuperimposed",
+        params: &[
+            ("distance", None),
+            ("velocity_diff", Some(Value::Num(-1.0))),
+            DYN[1],
+            DYN[2],
+            DYN[3],
+        ],
+    },
+    InstructionSpec {
+        name: "MC_SetOverride",
+        params: &[("velocity", None)],
+    },
+    InstructionSpec {
+        name: "MC_MotionInPosition",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("position", None),
+            ("velocity", Some(Value::Num(0.0))),
+            ("acceleration", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_MotionInVelocity",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("velocity", Some(Value::Num(0.0))),
+            ("acceleration", Some(Value::Num(0.0))),
+            ("position_controlled", Some(Value::Bool(true))),
+        ],
+    },
+];
+
+fn normalize(s: &str) -> String {
+    let s = s.to_ascii_lowercase().replace(['_', '-'], "");
+    s.strip_prefix("mc").map(str::to_string).unwrap_or(s)
+}
+
+/// Finds an instruction by any accepted spelling.
+pub fn find(name: &str) -> Option<&'static InstructionSpec> {
+    let n = normalize(name);
+    INSTRUCTIONS.iter().find(|i| normalize(i.name) == n)
+}
+
+struct Args<'a> {
+    spec: &'static InstructionSpec,
+    given: &'a [(String, Value)],
+}
+
+impl Args<'_> {
+    fn get(&self, key: &str) -> Result<Value, String> {
+        if let Some((_, v)) = self.given.iter().rev().find(|(k, _)| k == key) {
+            return Ok(*v);
+        }
+        match self.spec.params.iter().find(|(k, _)| *k == key) {
+            Some((_, Some(d))) => Ok(*d),
+            _ => Err(format!("{}: parameter `{key}` is required", self.spec.name)),
+        }
+    }
+
+    fn num(&self, key: &str) -> Result<f64, String> {
+        match self.get(key)? {
+            Value::Num(x) => Ok(x),
+            Value::Bool(_) => Err(format!("{}: `{key}` must be a number", self.spec.name)),
+        }
+    }
+
+    fn flag(&self, key: &str) -> Result<bool, String> {
+        match self.get(key)? {
+            Value::Bool(b) => Ok(b),
+            Value::Num(_) => Err(format!("{}: `{key}` must be true or false", self.spec.name)),
+        }
+    }
+
+    fn code(&self, key: &str) -> Result<i32, String> {
+        let x = self.num(key)?;
+        if x.fract() != 0.0 || !(-1e6..=1e6).contains(&x) {
+            return Err(format!("{}: `{key}` must be an integer", self.spec.name));
+        }
+        Ok(x as i32)
+    }
+
+    fn dynamics(&self, vel_key: &str) -> Result<Dynamics, String> {
+        Ok(Dynamics {
+            velocity: self.num(vel_key)?,
+            acceleration: self.num("acceleration")?,
+            deceleration: self.num("deceleration")?,
+            jerk: self.num("jerk")?,
+        })
+    }
+}
+
+/// Builds a command. Unknown instructions and parameters, missing required parameters and
+/// values of the wrong type are errors naming what was wrong.
+pub fn parse(instruction: &str, params: &[(String, Value)]) -> Result<Command, String> {
+    let spec = find(instruction).ok_or_else(|| {
+        let names: Vec<&str> = INSTRUCTIONS.iter().map(|i| i.name).collect();
+        format!(
+            "unknown instruction `{instruction}`; known: {}",
+            names.join(", ")
+        )
+    })?;
+    for (k, _) in params {
+        if !spec.params.iter().any(|(p, _)| p == k) {
+            let names: Vec<&str> = spec.params.iter().map(|(p, _)| *p).collect();
+            return Err(format!(
+                "{}: unknown parameter `{k}`; parameters: {}",
+                spec.name,
+                names.join(", ")
+            ));
+        }
+    }
+    let a = Args {
+        spec,
+        given: params,
+    };
+    let cmd = match spec.name {
+        "MC_Power" => Command::Power {
+            enable: a.flag("enable")?,
+            start_mode: match a.code("start_mode")? {
+                0 => StartMode::NonPositionControlled,
+                1 => StartMode::PositionControlled,
+                _ => return Err("MC_Power: start_mode must be 0 or 1".into()),
+            },
+            stop_mode: match a.code("stop_mode")? {
+                0 => StopMode::Emergency,
+                1 => StopMode::Immediate,
+                2 => StopMode::MaxDynamics,
+                _ => return Err("MC_Power: stop_mode must be 0, 1 or 2".into()),
+            },
+        },
+        "MC_Reset" => Command::Reset {
+            restart: a.flag("restart")?,
+        },
+        "MC_Home" => {
+            let mode = a.code("mode")?;
+            Command::Home {
+                mode: u8::try_from(mode).map_err(|_| "MC_Home: mode must be 0..10".to_string())?,
+                position: a.num("position")?,
+            }
+        }
+        "MC_Halt" => Command::Halt {
+            deceleration: a.num("deceleration")?,
+            jerk: a.num("jerk")?,
+            abort_acceleration: a.flag("abort_acceleration")?,
+        },
+        "MC_Stop" => Command::Stop {
+            execute: a.flag("execute")?,
+            deceleration: a.num("deceleration")?,
+            jerk: a.num("jerk")?,
+        },
+        "MC_MoveAbsolute" => Command::MoveAbsolute {
+            position: a.num("position")?,
+            dynamics: a.dynamics("velocity")?,
+            direction: Direction::from_code(a.code("direction")?)
+                .ok_or("MC_MoveAbsolute: direction must be 1, 2 or 3")?,
+        },
+        "MC_MoveRelative" => Command::MoveRelative {
+            distance: a.num("distance")?,
+            dynamics: a.dynamics("velocity")?,
+        },
+        "MC_MoveVelocity" => Command::MoveVelocity {
+            dynamics: a.dynamics("velocity")?,
+            direction: VelocityDirection::from_code(a.code("direction")?)
+                .ok_or("MC_MoveVelocity: direction must be 0, 1 or 2")?,
+            current: a.flag("current")?,
+            position_controlled: a.flag("position_controlled")?,
+        },
+        "MC_MoveJog" => Command::MoveJog {
+            forward: a.flag("jog_forward")?,
+            backward: a.flag("jog_backward")?,
+            dynamics: a.dynamics("velocity")?,
+            position_controlled: a.flag("position_controlled")?,
+        },
+        "MC_MoveSuperimposed" => Command::MoveSuperimposed {
+            distance: a.num("distance")?,
+            dynamics: a.dynamics("velocity_diff")?,
+        },
+        "MC_SetOverride" => Command::SetOverride {
+            velocity: a.num("velocity")?,
+        },
+        "MC_MotionInPosition" => Command::MotionInPosition {
+            enable: a.flag("enable")?,
+            position: a.num("position")?,
+            velocity: a.num("velocity")?,
+            acceleration: a.num("acceleration")?,
+        },
+        "MC_MotionInVelocity" => Command::MotionInVelocity {
+            enable: a.flag("enable")?,
+            velocity: a.num("velocity")?,
+            acceleration: a.num("acceleration")?,
+            position_controlled: a.flag("position_controlled")?,
+        },
+        other => return Err(format!("instruction `{other}` has no parser")),
+    };
+    Ok(cmd)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(k: &str, v: Value) -> (String, Value) {
+        (k.to_string(), v)
+    }
+
+    #[test]
+    fn names_in_any_spelling() {
+        for n in [
+            "MC_MoveAbsolute",
+            "moveabsolute",
+            "move_absolute",
+            "MOVE-ABSOLUTE",
+        ] {
+            assert_eq!(find(n).map(|s| s.name), Some("MC_MoveAbsolute"));
+        }
+        assert!(find("MC_Fly").is_none());
+    }
+
+    #[test]
+    fn builds_commands_with_defaults() {
+        let c = parse(
+            "MoveAbsolute",
+            &[
+                p("position", Value::Num(40.0)),
+                p("direction", Value::Num(3.0)),
+            ],
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::MoveAbsolute {
+                position: 40.0,
+                dynamics: Dynamics::DEFAULT,
+                direction: Direction::Shortest
+            }
+        );
+        assert!(parse("MoveAbsolute", &[])
+            .unwrap_err()
+            .contains("`position` is required"));
+        assert!(parse("MoveAbsolute", &[p("postion", Value::Num(1.0))])
+            .unwrap_err()
+            .contains("unknown parameter `postion`"));
+        assert!(parse("MC_Power", &[p("enable", Value::Num(1.0))])
+            .unwrap_err()
+            .contains("true or false"));
+        assert!(parse("MC_Home", &[p("mode", Value::Num(2.5))])
+            .unwrap_err()
+            .contains("integer"));
+    }
+
+    #[test]
+    fn every_instruction_parses_with_its_required_parameters() {
+        for spec in INSTRUCTIONS {
+            let given: Vec<(String, Value)> = spec
+                .params
+                .iter()
+                .filter(|(_, d)| d.is_none())
+                .map(|(k, _)| p(k, Value::Num(1.0)))
+                .collect();
+            assert!(parse(spec.name, &given).is_ok(), "{}", spec.name);
+        }
+    }
+}

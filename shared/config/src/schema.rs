@@ -1,0 +1,402 @@
+//! The serde schema of the cell file, as written by people. Every key is documented in
+//! `config/example-cell.toml`; defaults follow the references' typical values.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellFile {
+    /// `[cell]`.
+    pub cell: CellSection,
+    /// `[[nodes]]`.
+    #[serde(default)]
+    pub nodes: Vec<NodeSection>,
+    /// `[axes.<name>]`.
+    #[serde(default)]
+    pub axes: BTreeMap<String, AxisSection>,
+}
+
+/// `[cell]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellSection {
+    /// Cell name (used in key expressions later).
+    pub name: String,
+    /// Base tick of the cell clock in µs: every node cycle is a multiple of it.
+    #[serde(default = "default_base_tick_us")]
+    pub base_tick_us: u64,
+}
+
+fn default_base_tick_us() -> u64 {
+    250
+}
+
+/// `[[nodes]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSection {
+    /// Node name.
+    pub name: String,
+    /// Servo cycle in µs.
+    pub cycle_us: u64,
+}
+
+/// `[axes.<name>]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisSection {
+    /// The node that hosts the axis.
+    pub node: String,
+    /// `speed` or `positioning`.
+    #[serde(default = "default_kind")]
+    pub kind: String,
+    /// `linear` or `rotary`.
+    #[serde(default = "default_motion_type")]
+    pub motion_type: String,
+    /// `incremental` or `absolute`.
+    #[serde(default = "default_encoder")]
+    pub encoder: String,
+    /// Virtual axis / simulation mode.
+    #[serde(default, rename = "virtual")]
+    pub virtual_axis: bool,
+    /// Physical position at start.
+    #[serde(default)]
+    pub initial_position: f64,
+    /// `[axes.<name>.modulo]`.
+    pub modulo: Option<ModuloSection>,
+    /// `[axes.<name>.dynamics]`.
+    pub dynamics: DynamicsSection,
+    /// `[axes.<name>.sw_limits]`.
+    pub sw_limits: Option<SwLimitsSection>,
+    /// `[axes.<name>.hw_limits]`.
+    pub hw_limits: Option<HwLimitsSection>,
+    /// `[axes.<name>.positioning]`.
+    #[serde(default)]
+    pub positioning: PositioningSection,
+    /// `[axes.<name>.following_error]`.
+    #[serde(default)]
+    pub following_error: FollowingErrorSection,
+    /// `[axes.<name>.standstill]`.
+    #[serde(default)]
+    pub standstill: StandstillSection,
+    /// `[axes.<name>.homing]`.
+    #[serde(default)]
+    pub homing: HomingSection,
+    /// `[axes.<name>.drive]`.
+    #[serde(default)]
+    pub drive: DriveSection,
+    /// `[axes.<name>.plant]`.
+    #[serde(default)]
+    pub plant: PlantSection,
+}
+
+fn default_kind() -> String {
+    "positioning".into()
+}
+fn default_motion_type() -> String {
+    "linear".into()
+}
+fn default_encoder() -> String {
+    "incremental".into()
+}
+
+/// Modulo.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModuloSection {
+    /// `Modulo.StartValue`.
+    #[serde(default)]
+    pub start: f64,
+    /// `Modulo.Length`.
+    pub length: f64,
+}
+
+/// Dynamic limits and defaults.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSection {
+    /// `DynamicLimits.MaxVelocity`.
+    pub max_velocity: f64,
+    /// `DynamicLimits.MaxAcceleration`.
+    pub max_acceleration: f64,
+    /// `DynamicLimits.MaxDeceleration`.
+    pub max_deceleration: f64,
+    /// `DynamicLimits.MaxJerk`.
+    pub max_jerk: f64,
+    /// `DynamicDefaults.Velocity`.
+    pub velocity: f64,
+    /// `DynamicDefaults.Acceleration`.
+    pub acceleration: f64,
+    /// `DynamicDefaults.Deceleration`.
+    pub deceleration: f64,
+    /// `DynamicDefaults.Jerk`.
+    pub jerk: f64,
+    /// `DynamicDefaults.EmergencyDeceleration`.
+    pub emergency_deceleration: f64,
+}
+
+/// Software limit switches.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SwLimitsSection {
+    /// `PositionLimits_SW.MinPosition`.
+    pub min: f64,
+    /// `PositionLimits_SW.MaxPosition`.
+    pub max: f64,
+}
+
+/// Hardware limit switches (positions of the simulated switches, physical coordinates).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HwLimitsSection {
+    /// `PositionLimits_HW.Active`.
+    #[serde(default = "yes")]
+    pub active: bool,
+    /// Negative switch position.
+    pub min: Option<f64>,
+    /// Positive switch position.
+    pub max: Option<f64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Positioning monitoring.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PositioningSection {
+    /// `PositioningMonitoring.Window`.
+    #[serde(default = "d_window")]
+    pub window: f64,
+    /// `PositioningMonitoring.ToleranceTime` (s).
+    #[serde(default = "d_tol")]
+    pub tolerance_time: f64,
+    /// `PositioningMonitoring.MinDwellTime` (s).
+    #[serde(default)]
+    pub min_dwell_time: f64,
+}
+
+fn d_window() -> f64 {
+    0.01
+}
+fn d_tol() -> f64 {
+    1.0
+}
+
+impl Default for PositioningSection {
+    fn default() -> Self {
+        Self {
+            window: d_window(),
+            tolerance_time: d_tol(),
+            min_dwell_time: 0.0,
+        }
+    }
+}
+
+/// Following-error monitoring.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FollowingErrorSection {
+    /// `FollowingError.EnableMonitoring`.
+    #[serde(default = "yes")]
+    pub enable: bool,
+    /// `FollowingError.MinValue`.
+    #[serde(default = "d_fe_min")]
+    pub min_value: f64,
+    /// `FollowingError.MaxValue`.
+    #[serde(default = "d_fe_max")]
+    pub max_value: f64,
+    /// `FollowingError.MinVelocity`.
+    #[serde(default = "d_fe_minv")]
+    pub min_velocity: f64,
+    /// `FollowingError.WarningLevel` (%).
+    #[serde(default = "d_fe_warn")]
+    pub warning_level: f64,
+}
+
+fn d_fe_min() -> f64 {
+    1.0
+}
+fn d_fe_max() -> f64 {
+    10.0
+}
+fn d_fe_minv() -> f64 {
+    10.0
+}
+fn d_fe_warn() -> f64 {
+    90.0
+}
+
+impl Default for FollowingErrorSection {
+    fn default() -> Self {
+        Self {
+            enable: true,
+            min_value: d_fe_min(),
+            max_value: d_fe_max(),
+            min_velocity: d_fe_minv(),
+            warning_level: d_fe_warn(),
+        }
+    }
+}
+
+/// Standstill signal.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StandstillSection {
+    /// `StandstillSignal.VelocityThreshold`.
+    #[serde(default = "d_ss_v")]
+    pub velocity_threshold: f64,
+    /// `StandstillSignal.MinDwellTime` (s).
+    #[serde(default = "d_ss_t")]
+    pub min_dwell_time: f64,
+}
+
+fn d_ss_v() -> f64 {
+    0.1
+}
+fn d_ss_t() -> f64 {
+    0.01
+}
+
+impl Default for StandstillSection {
+    fn default() -> Self {
+        Self {
+            velocity_threshold: d_ss_v(),
+            min_dwell_time: d_ss_t(),
+        }
+    }
+}
+
+/// Homing.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HomingSection {
+    /// `zero_mark`, `cam_and_zero_mark` or `digital_input`.
+    #[serde(default = "d_mark")]
+    pub active_mark: String,
+    /// Same, for passive homing.
+    #[serde(default = "d_mark")]
+    pub passive_mark: String,
+    /// `positive` or `negative`.
+    #[serde(default = "d_pos")]
+    pub approach_direction: String,
+    /// `positive` or `negative`.
+    #[serde(default = "d_pos")]
+    pub homing_direction: String,
+    /// `positive`, `negative` or `current`.
+    #[serde(default = "d_current")]
+    pub passive_direction: String,
+    /// `Homing.ApproachVelocity`.
+    #[serde(default = "d_app_v")]
+    pub approach_velocity: f64,
+    /// `Homing.ReferencingVelocity`.
+    #[serde(default = "d_ref_v")]
+    pub referencing_velocity: f64,
+    /// `Homing.HomePosition`.
+    #[serde(default)]
+    pub home_position: f64,
+    /// `HomePositionOffset`.
+    #[serde(default)]
+    pub home_position_offset: f64,
+    /// `Homing.AutoReversal`.
+    #[serde(default = "yes")]
+    pub auto_reversal: bool,
+}
+
+fn d_mark() -> String {
+    "cam_and_zero_mark".into()
+}
+fn d_pos() -> String {
+    "positive".into()
+}
+fn d_current() -> String {
+    "current".into()
+}
+fn d_app_v() -> f64 {
+    10.0
+}
+fn d_ref_v() -> f64 {
+    2.0
+}
+
+impl Default for HomingSection {
+    fn default() -> Self {
+        Self {
+            active_mark: d_mark(),
+            passive_mark: d_mark(),
+            approach_direction: d_pos(),
+            homing_direction: d_pos(),
+            passive_direction: d_current(),
+            approach_velocity: d_app_v(),
+            referencing_velocity: d_ref_v(),
+            home_position: 0.0,
+            home_position_offset: 0.0,
+            auto_reversal: true,
+        }
+    }
+}
+
+/// Simulated drive.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSection {
+    /// `position_loop` or `delay`.
+    #[serde(default = "d_model")]
+    pub model: String,
+    /// `PositionControl.Kv` (1/s).
+    #[serde(default = "d_kv")]
+    pub kv: f64,
+    /// `PositionControl.Kpc` (%).
+    #[serde(default = "d_kpc")]
+    pub kpc: f64,
+    /// `DynamicAxisModel.VelocityTimeConstant` (s).
+    #[serde(default = "d_tvtc")]
+    pub t_vtc: f64,
+    /// `T_t` of the delay model (s).
+    #[serde(default = "d_delay")]
+    pub delay: f64,
+}
+
+fn d_model() -> String {
+    "position_loop".into()
+}
+fn d_kv() -> f64 {
+    100.0
+}
+fn d_kpc() -> f64 {
+    100.0
+}
+fn d_tvtc() -> f64 {
+    0.002
+}
+fn d_delay() -> f64 {
+    0.003
+}
+
+impl Default for DriveSection {
+    fn default() -> Self {
+        Self {
+            model: d_model(),
+            kv: d_kv(),
+            kpc: d_kpc(),
+            t_vtc: d_tvtc(),
+            delay: d_delay(),
+        }
+    }
+}
+
+/// Simulated plant sensors (physical coordinates).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlantSection {
+    /// Reference cam `[low, high]`.
+    pub reference_cam: Option<[f64; 2]>,
+    /// Distance between encoder zero marks.
+    pub zero_mark_period: Option<f64>,
+    /// Position of one zero mark.
+    #[serde(default)]
+    pub zero_mark_offset: f64,
+}

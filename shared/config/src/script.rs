@@ -1,0 +1,183 @@
+//! Simulator scripts: timed instructions for the axes of a cell.
+//!
+//! ```toml
+//! [sim]
+//! duration = 5.0          # virtual seconds to run
+//!
+//! [[at]]
+//! t = 0.0                 # seconds
+//! axis = "x"
+//! instruction = "MC_Power"
+//! enable = true           # the instruction's parameters follow
+//! ```
+
+use crate::command::{self, Value};
+use crate::ConfigError;
+use tandem_motion::axis::Command;
+
+/// One timed command.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScriptEntry {
+    /// When (ns of virtual time).
+    pub t_ns: i64,
+    /// Target axis name.
+    pub axis: String,
+    /// The instruction as written (for the log).
+    pub instruction: &'static str,
+    /// The command.
+    pub command: Command,
+    /// Line in the script file.
+    pub line: usize,
+}
+
+/// A parsed script, entries sorted by time (stable: file order within one time).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Script {
+    /// Virtual duration (ns).
+    pub duration_ns: i64,
+    /// Entries.
+    pub entries: Vec<ScriptEntry>,
+}
+
+fn line_at(src: &str, offset: usize) -> usize {
+    src[..offset.min(src.len())].matches('\n').count() + 1
+}
+
+fn seconds_to_ns(x: f64) -> Option<i64> {
+    (x.is_finite() && (0.0..=1e9).contains(&x)).then(|| (x * 1e9).round() as i64)
+}
+
+fn num(item: &toml_edit::Item) -> Option<f64> {
+    item.as_float()
+        .or_else(|| item.as_integer().map(|i| i as f64))
+}
+
+/// Parses a script; `file` names it in errors. `axes` are the names that exist in the cell.
+pub fn parse(file: &str, src: &str, axes: &[&str]) -> Result<Script, ConfigError> {
+    let e = |line: Option<usize>, key: &str, message: String| ConfigError {
+        file: file.into(),
+        line,
+        key: key.into(),
+        message,
+    };
+    let doc = toml_edit::ImDocument::parse(src).map_err(|x| {
+        e(
+            x.span().map(|s| line_at(src, s.start)),
+            "",
+            x.message().to_string(),
+        )
+    })?;
+    for (k, _) in doc.iter() {
+        if k != "sim" && k != "at" {
+            return Err(e(
+                crate::locate(src, &[k]),
+                k,
+                "unknown section (expected [sim] and [[at]])".into(),
+            ));
+        }
+    }
+    let duration = doc
+        .get("sim")
+        .and_then(|s| s.get("duration"))
+        .ok_or_else(|| {
+            e(
+                None,
+                "sim.duration",
+                "is required (virtual seconds to run)".into(),
+            )
+        })?;
+    let duration_ns = num(duration).and_then(seconds_to_ns).ok_or_else(|| {
+        e(
+            crate::locate(src, &["sim", "duration"]),
+            "sim.duration",
+            "must be a number of seconds >= 0".into(),
+        )
+    })?;
+    let mut entries = Vec::new();
+    if let Some(at) = doc.get("at") {
+        let tables = at.as_array_of_tables().ok_or_else(|| {
+            e(
+                crate::locate(src, &["at"]),
+                "at",
+                "must be written as [[at]] tables".into(),
+            )
+        })?;
+        for (i, t) in tables.iter().enumerate() {
+            let line = t.span().map(|s| line_at(src, s.start));
+            let key = format!("at[{i}]");
+            let time = t
+                .get("t")
+                .and_then(num)
+                .and_then(seconds_to_ns)
+                .ok_or_else(|| e(line, &key, "`t` (seconds >= 0) is required".into()))?;
+            let axis = t
+                .get("axis")
+                .and_then(|x| x.as_str())
+                .ok_or_else(|| e(line, &key, "`axis` (a name) is required".into()))?;
+            if !axes.contains(&axis) {
+                return Err(e(
+                    line,
+                    &key,
+                    format!("unknown axis `{axis}`; the cell has: {}", axes.join(", ")),
+                ));
+            }
+            let instr = t
+                .get("instruction")
+                .and_then(|x| x.as_str())
+                .ok_or_else(|| e(line, &key, "`instruction` is required".into()))?;
+            let mut params = Vec::new();
+            for (k, v) in t.iter() {
+                if matches!(k, "t" | "axis" | "instruction") {
+                    continue;
+                }
+                let value = if let Some(b) = v.as_bool() {
+                    Value::Bool(b)
+                } else if let Some(x) = num(v) {
+                    Value::Num(x)
+                } else {
+                    return Err(e(
+                        line,
+                        &key,
+                        format!("`{k}` must be a number or true/false"),
+                    ));
+                };
+                params.push((k.to_string(), value));
+            }
+            let command = command::parse(instr, &params).map_err(|m| e(line, &key, m))?;
+            let name = command::find(instr).map(|s| s.name).unwrap_or("?");
+            entries.push(ScriptEntry {
+                t_ns: time,
+                axis: axis.to_string(),
+                instruction: name,
+                command,
+                line: line.unwrap_or(0),
+            });
+        }
+    }
+    entries.sort_by_key(|x| x.t_ns);
+    Ok(Script {
+        duration_ns,
+        entries,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_reports_lines() {
+        let src = "[sim]\nduration = 1.5\n\n[[at]]\nt = 0.5\naxis = \"x\"\ninstruction = \"MoveRelative\"\ndistance = 10\n\n[[at]]\nt = 0\naxis = \"x\"\ninstruction = \"MC_Power\"\n";
+        let s = parse("s.toml", src, &["x"]).unwrap();
+        assert_eq!(s.duration_ns, 1_500_000_000);
+        assert_eq!(s.entries.len(), 2);
+        assert_eq!(s.entries[0].instruction, "MC_Power");
+        assert_eq!(s.entries[1].line, 4);
+        let bad = src.replace("distance = 10", "distanc = 10");
+        let e = parse("s.toml", &bad, &["x"]).unwrap_err();
+        assert_eq!(e.line, Some(4));
+        assert!(e.message.contains("unknown parameter `distanc`"), "{e}");
+        let e = parse("s.toml", src, &["y"]).unwrap_err();
+        assert!(e.message.contains("unknown axis `x`"));
+    }
+}

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The test command of README: sets up what the tests need on a fresh machine, then runs them.
+#  1. Python oracle: installs the pinned `ruckig` package and regenerates the committed
+#     fixtures into a temp file; they must match byte for byte (the oracle is real and current).
+#  2. All Rust tests of the workspace, in release (proptest and the simulator run faster).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+python3 -m pip install --quiet --disable-pip-version-check -r tests/oracle/requirements.txt
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+python3 tests/oracle/gen_ruckig_fixtures.py --out "$tmp/ruckig_1dof.csv" >/dev/null
+if ! cmp -s "$tmp/ruckig_1dof.csv" shared/motion/tests/fixtures/ruckig_1dof.csv; then
+    echo "error: the ruckig fixtures do not match tests/oracle/gen_ruckig_fixtures.py output" >&2
+    exit 1
+fi
+echo "ruckig oracle fixtures: reproduced exactly"
+
+cargo test --workspace --release --locked "$@"
