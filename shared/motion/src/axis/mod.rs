@@ -823,6 +823,15 @@ impl Axis {
                     .limits
                     .resolve(&self.cfg.defaults, &dynamics, false)?;
                 self.warn_clamped(r.clamped);
+                // A running superimposed job is aborted (table 1) without folding its motion
+                // into the basic motion: the new one continues from its state.
+                if let Some(old) = self.sup_job.take() {
+                    self.emit(
+                        old.id,
+                        Instruction::MoveSuperimposed,
+                        JobEventKind::CommandAborted,
+                    );
+                }
                 self.apply_override_table(NewJob::Superimposed);
                 self.force_position_control();
                 // A new superimposed job continues from the current superimposed state; its
