@@ -360,6 +360,31 @@ fn stop_locks_the_axis_until_released() {
         }),
         Err(ErrorId::AxisLocked)
     );
+    // The lock survives a disable / re-enable while Execute is held.
+    let power = |enable| Command::Power {
+        enable,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Immediate,
+    };
+    r.cmd(power(false)).unwrap();
+    assert!(r.has(s, JobEventKind::CommandAborted));
+    r.cmd(power(true)).unwrap();
+    r.step(5);
+    assert_eq!(
+        r.cmd(Command::MoveRelative {
+            distance: 1.0,
+            dynamics: Dynamics::DEFAULT
+        }),
+        Err(ErrorId::AxisLocked)
+    );
+    assert_eq!(r.axis.status().state, AxisState::Stopping);
+    let s = r
+        .cmd(Command::Stop {
+            execute: true,
+            deceleration: -1.0,
+            jerk: -1.0,
+        })
+        .unwrap();
     r.cmd(Command::Stop {
         execute: false,
         deceleration: -1.0,

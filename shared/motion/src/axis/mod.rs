@@ -523,10 +523,9 @@ impl Axis {
 
     fn abort_main(&mut self, how: JobEventKind) {
         if let Some(m) = self.main.take() {
+            // An aborted MC_Stop keeps its lock while its Execute is held (seed 000 §2.3: "even
+            // across disable/re-enable"); only releasing it unlocks the axis.
             self.emit(m.id, m.instr, how);
-            if m.instr == Instruction::Stop {
-                self.stop_lock = false;
-            }
         }
     }
 
@@ -967,7 +966,6 @@ impl Axis {
             self.power.enable = false;
             self.power.stop_mode = stop_mode;
             self.abort_all(JobEventKind::CommandAborted);
-            self.stop_lock = false;
             if self.enabled {
                 match stop_mode {
                     StopMode::Immediate => self.remove_enable(),
