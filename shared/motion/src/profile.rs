@@ -28,7 +28,7 @@
 //! from there.
 
 /// Maximum number of constant-jerk segments in one profile.
-pub const MAX_SEGMENTS: usize = 12;
+pub const MAX_SEGMENTS: usize = 16;
 
 /// Kinematic state of one degree of freedom.
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
@@ -120,7 +120,7 @@ impl Segment {
         let s = self.start;
         let j = self.jerk;
         State {
-            p: s.p + dt * (s.v + dt * (0.5 * s.a + dt * j / 6.0)),
+            p: s.p + dt * (s.v + dt * (0.5 * s.a + dt * j * (1.0 / 6.0))),
             v: s.v + dt * (s.a + 0.5 * dt * j),
             a: s.a + dt * j,
         }
@@ -184,25 +184,34 @@ impl Profile {
     }
 }
 
-/// Accumulates segments (when `REC`) and integrates the state exactly.
-struct Builder<const REC: bool> {
-    segs: [Segment; MAX_SEGMENTS],
+/// Integrates the state exactly and records the first `N` segments (`N = 0` for the distance
+/// evaluations of the solver, which need only the end state).
+#[derive(Copy, Clone)]
+struct Builder<const N: usize> {
+    segs: [Segment; N],
     n: usize,
     t: f64,
     s: State,
     jerk: f64,
+    /// `1 / jerk` and `0.5 / jerk` (0 for trapezoidal profiles).
+    ij: f64,
+    h_ij: f64,
     acc: f64,
     dec: f64,
 }
 
-impl<const REC: bool> Builder<REC> {
+impl<const N: usize> Builder<N> {
+    #[inline(always)]
     fn new(s: State, lim: &Limits) -> Self {
+        let jerk = effective_jerk(lim.jerk);
         Self {
-            segs: [Segment::default(); MAX_SEGMENTS],
+            segs: [Segment::default(); N],
             n: 0,
             t: 0.0,
             s,
-            jerk: effective_jerk(lim.jerk),
+            jerk,
+            ij: 1.0 / jerk,
+            h_ij: 0.5 / jerk,
             acc: lim.acc,
             dec: lim.dec,
         }
@@ -213,7 +222,7 @@ impl<const REC: bool> Builder<REC> {
     }
 
     /// Constant jerk `j` for `dt` seconds, from the current state (with acceleration `a`).
-    #[inline]
+    #[inline(always)]
     fn push(&mut self, j: f64, dt: f64) {
         if dt <= 0.0 {
             return;
@@ -223,7 +232,7 @@ impl<const REC: bool> Builder<REC> {
             start: self.s,
             jerk: j,
         };
-        if REC && self.n < MAX_SEGMENTS {
+        if self.n < N {
             self.segs[self.n] = seg;
         }
         self.n += 1;
@@ -239,92 +248,163 @@ impl<const REC: bool> Builder<REC> {
         self.s.a = 0.0;
     }
 
-    /// Acceleration bound for a plateau of sign `s` over the velocity interval `[lo, hi]`.
-    #[inline]
-    fn bound(&self, s: f64, lo: f64, hi: f64) -> f64 {
-        if lo >= 0.0 {
-            if s > 0.0 {
-                self.acc
-            } else {
-                self.dec
-            }
-        } else if hi <= 0.0 {
-            if s > 0.0 {
-                self.dec
-            } else {
-                self.acc
-            }
-        } else {
-            self.acc.min(self.dec)
-        }
-    }
-
     /// Velocity reached if the acceleration is released to zero at full jerk now.
     #[inline]
     fn v_nat(&self) -> f64 {
         if self.trapezoidal() {
             self.s.v
         } else {
-            self.s.v + self.s.a * self.s.a.abs() / (2.0 * self.jerk)
+            self.s.v + self.s.a * self.s.a.abs() * self.h_ij
         }
     }
 
     /// Time-optimal change of velocity to `v1`, ending with `a = 0`.
+    ///
+    /// The acceleration bound depends on what the velocity does: `acc` while `|v|` grows,
+    /// `dec` while it shrinks. A ramp that crosses zero velocity switches from one to the other
+    /// at `v = 0` (see [`Builder::crossing`]).
+    #[inline(always)]
     fn vel_ramp(&mut self, v1: f64) {
         let v0 = self.s.v;
         if self.trapezoidal() {
             let dv = v1 - v0;
             let s = if dv >= 0.0 { 1.0 } else { -1.0 };
-            let bound = self.bound(s, v0.min(v1), v0.max(v1));
-            self.push_acc(s * bound, dv.abs() / bound);
+            if s * v0 < 0.0 && s * v1 > 0.0 {
+                // Brake to zero with the deceleration, then speed up with the acceleration.
+                self.push_acc(s * self.dec, v0.abs() / self.dec);
+                self.push_acc(s * self.acc, v1.abs() / self.acc);
+            } else {
+                let bound = if s * v0 >= 0.0 { self.acc } else { self.dec };
+                self.push_acc(s * bound, dv.abs() / bound);
+            }
             self.s.v = v1;
             self.s.a = 0.0;
             return;
         }
-        let j = self.jerk;
         let a0 = self.s.a;
         let vn = self.v_nat();
         let dvn = v1 - vn;
         if dvn == 0.0 {
             let s = if a0 > 0.0 { -1.0 } else { 1.0 };
-            self.push(s * j, a0.abs() / j);
+            self.push(s * self.jerk, a0.abs() * self.ij);
         } else {
             let s = if dvn > 0.0 { 1.0 } else { -1.0 };
-            let lo = v0.min(vn).min(v1);
-            let hi = v0.max(vn).max(v1);
-            let bound = self.bound(s, lo, hi);
-            let a0s = s * a0;
-            let dv = s * (v1 - v0);
-            if a0s > bound {
-                // Already beyond the bound in the ramp's direction: back to the bound first.
-                let t1 = (a0s - bound) / j;
-                let dv1 = (a0s * a0s - bound * bound) / (2.0 * j);
-                let t3 = bound / j;
-                let t2 = ((dv - dv1 - bound * bound / (2.0 * j)) / bound).max(0.0);
-                self.push(-s * j, t1);
-                self.push(0.0, t2);
-                self.push(-s * j, t3);
+            // In the ramp's direction: the lowest velocity on the way and the target.
+            let vmin = (s * v0).min(s * vn);
+            let v1s = s * v1;
+            if v1s > 0.0 && vmin < 0.0 && self.acc != self.dec && self.crossing(s, v1s) {
+                // Now at v = 0 with the crossing acceleration; speeding up from here.
+                self.ramp_plain(s, v1, self.acc);
             } else {
-                let peak_sq = (2.0 * j * dv + a0s * a0s) * 0.5;
-                let peak = peak_sq.max(0.0).sqrt();
-                if peak <= bound {
-                    self.push(s * j, ((peak - a0s) / j).max(0.0));
-                    self.push(-s * j, peak / j);
+                // The plateau lies where the velocity (in the ramp's direction) is negative:
+                // braking (dec); or positive: speeding up (acc). Equal bounds need no switch.
+                let bound = if v1s <= 0.0 {
+                    self.dec
+                } else if vmin >= 0.0 {
+                    self.acc
                 } else {
-                    let t1 = (bound - a0s) / j;
-                    let dvj = (bound * bound - a0s * a0s) / (2.0 * j) + bound * bound / (2.0 * j);
-                    let t2 = ((dv - dvj) / bound).max(0.0);
-                    self.push(s * j, t1);
-                    self.push(0.0, t2);
-                    self.push(-s * j, bound / j);
-                }
+                    self.acc.min(self.dec)
+                };
+                self.ramp_plain(s, v1, bound);
             }
         }
         self.s.v = v1;
         self.s.a = 0.0;
     }
 
+    /// The part of a ramp in direction `s` that reaches zero velocity, when the bound switches
+    /// there from `dec` (braking) to `acc` (speeding up). The acceleration when crossing zero is
+    /// the largest that both bounds, the rest of the ramp (`v1s`, in direction `s`) and the
+    /// start state allow; before it the ramp rises to at most `dec` and comes down to it.
+    /// Returns false (and changes nothing) when the start state cannot meet that (it already
+    /// carries more acceleration than the crossing allows); the caller then uses one bound.
+    #[inline(always)]
+    fn crossing(&mut self, s: f64, v1s: f64) -> bool {
+        let (j, ij, hij) = (self.jerk, self.ij, self.h_ij);
+        let vs0 = s * self.s.v;
+        let as0 = s * self.s.a;
+        let b1 = self.dec;
+        if as0 > b1 {
+            return false;
+        }
+        // Velocity to gain (in direction s) up to zero, and the highest acceleration with which
+        // zero can be reached after rising from as0 at full jerk.
+        let g = -vs0;
+        let reach_sq = (2.0 * j * g + as0 * as0).max(0.0);
+        let a_star = b1
+            .min(self.acc)
+            .min((2.0 * j * v1s).sqrt())
+            .min(reach_sq.sqrt());
+        if as0 * as0 - 2.0 * j * g > a_star * a_star {
+            return false;
+        }
+        let peak_sq = (reach_sq + a_star * a_star) * 0.5;
+        if peak_sq <= b1 * b1 {
+            let peak = peak_sq.sqrt();
+            self.push(s * j, ((peak - as0) * ij).max(0.0));
+            self.push(-s * j, ((peak - a_star) * ij).max(0.0));
+        } else {
+            let t2 = ((g - (2.0 * b1 * b1 - as0 * as0 - a_star * a_star) * hij) / b1).max(0.0);
+            self.push(s * j, (b1 - as0) * ij);
+            self.push(0.0, t2);
+            self.push(-s * j, (b1 - a_star) * ij);
+        }
+        self.s.v = 0.0;
+        self.s.a = s * a_star;
+        true
+    }
+
+    /// The peak velocity (in direction `s`, signed result) beyond which the ramp from the current
+    /// state to it holds the acceleration bound `acc`, so that its distance is quadratic in the
+    /// peak velocity. `vn` is the released velocity of the current state.
+    fn saturation(&self, s: f64, vn: f64) -> f64 {
+        let vs0 = s * self.s.v;
+        let as0 = s * self.s.a;
+        let crossing = vs0.min(s * vn) < 0.0 && self.acc != self.dec;
+        let from_zero = if crossing {
+            let reach_sq = (as0 * as0 - 2.0 * self.jerk * vs0).max(0.0);
+            let a_star = self.dec.min(self.acc).min(reach_sq.sqrt());
+            (2.0 * self.acc * self.acc - a_star * a_star) * self.h_ij
+        } else {
+            vs0 + (2.0 * self.acc * self.acc - as0 * as0) * self.h_ij
+        };
+        s * from_zero
+    }
+
+    /// A ramp in direction `s` to `v1` with one acceleration bound, from the current state.
+    #[inline(always)]
+    fn ramp_plain(&mut self, s: f64, v1: f64, bound: f64) {
+        let (j, ij, hij) = (self.jerk, self.ij, self.h_ij);
+        let a0s = s * self.s.a;
+        let dv = s * (v1 - self.s.v);
+        if a0s > bound {
+            // Already beyond the bound in the ramp's direction: back to the bound first.
+            let t1 = (a0s - bound) * ij;
+            let dv1 = (a0s * a0s - bound * bound) * hij;
+            let t3 = bound * ij;
+            let t2 = ((dv - dv1 - bound * bound * hij) / bound).max(0.0);
+            self.push(-s * j, t1);
+            self.push(0.0, t2);
+            self.push(-s * j, t3);
+        } else {
+            let peak_sq = ((2.0 * j * dv + a0s * a0s) * 0.5).max(0.0);
+            if peak_sq <= bound * bound {
+                let peak = peak_sq.sqrt();
+                self.push(s * j, ((peak - a0s) * ij).max(0.0));
+                self.push(-s * j, peak * ij);
+            } else {
+                let t1 = (bound - a0s) * ij;
+                let dvj = (2.0 * bound * bound - a0s * a0s) * hij;
+                let t2 = ((dv - dvj) / bound).max(0.0);
+                self.push(s * j, t1);
+                self.push(0.0, t2);
+                self.push(-s * j, bound * ij);
+            }
+        }
+    }
+
     /// Appends the profile of `fam` with parameter `x` (peak velocity or relaxation time).
+    #[inline(always)]
     fn apply(&mut self, fam: Family, x: f64, cruise: f64) {
         match fam {
             Family::Peak => {
@@ -337,6 +417,7 @@ impl<const REC: bool> Builder<REC> {
     }
 
     /// Cruise at the current velocity for `dt`.
+    #[inline(always)]
     fn cruise(&mut self, dt: f64) {
         self.s.a = 0.0;
         self.push(0.0, dt);
@@ -374,7 +455,7 @@ fn finite_state(s: &State) -> bool {
 
 /// Brings a state that violates the acceleration bound or whose released velocity exceeds
 /// `vmax` back within the limits, as fast as the limits allow (mirrored frame, `v_nat >= 0`).
-fn recover<const REC: bool>(b: &mut Builder<REC>, vmax: f64) {
+fn recover<const N: usize>(b: &mut Builder<N>, vmax: f64) {
     if b.v_nat() > vmax {
         b.vel_ramp(vmax);
         return;
@@ -388,7 +469,7 @@ fn recover<const REC: bool>(b: &mut Builder<REC>, vmax: f64) {
     let bound = if a * v > 0.0 { b.acc } else { b.dec };
     if a.abs() > bound {
         let s = if a > 0.0 { -1.0 } else { 1.0 };
-        b.push(s * b.jerk, (a.abs() - bound) / b.jerk);
+        b.push(s * b.jerk, (a.abs() - bound) * b.ij);
     }
 }
 
@@ -403,15 +484,71 @@ enum Family {
 
 #[inline]
 fn dist(start: State, lim: &Limits, fam: Family, x: f64) -> f64 {
-    let mut b = Builder::<false>::new(start, lim);
+    let mut b = Builder::<0>::new(start, lim);
     b.apply(fam, x, 0.0);
     b.s.p - start.p
 }
 
-/// Brent's method for an increasing `f` on `[a, b]` with `f(a) <= 0 <= f(b)`.
-fn brent(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64, tol_f: f64) -> Option<f64> {
-    let mut fa = f(a);
-    let mut fb = f(b);
+/// Solves `dpk(x) = d` for the peak velocity on `[a, b]` (`fa <= 0 <= fb` are the residuals
+/// at the ends). `sat` are the peak velocities where the up-ramp and the down-ramp start to
+/// saturate their acceleration bound; beyond both (away from zero velocity) the distance is
+/// exactly quadratic in the peak velocity with second derivative `c2`, so the root there has a
+/// closed form (the caller checks where the profile lands and otherwise asks again without it).
+/// Elsewhere Brent's method runs on the narrowed bracket.
+fn solve_peak(
+    dpk: impl Fn(f64) -> f64,
+    d: f64,
+    (mut a, mut b): (f64, f64),
+    (mut fa, mut fb): (f64, f64),
+    sat: (f64, f64),
+    c2: f64,
+    tol: f64,
+    closed_form: bool,
+) -> Option<f64> {
+    let (x0, x1) = if sat.0 <= sat.1 {
+        (sat.0, sat.1)
+    } else {
+        (sat.1, sat.0)
+    };
+    for x in [x0, x1] {
+        if x > a && x < b {
+            let fx = dpk(x) - d;
+            if fx <= 0.0 {
+                a = x;
+                fa = fx;
+            } else {
+                b = x;
+                fb = fx;
+            }
+        }
+    }
+    let quadratic = if c2 > 0.0 { a >= x1 } else { b <= x0 };
+    if closed_form && quadratic && b > a {
+        return Some(quad_root((a, b), (fa, fb), c2));
+    }
+    brent(|x| dpk(x) - d, (a, b), (fa, fb), tol)
+}
+
+/// Root in `[a, b]` of the quadratic with second derivative `c2` through `(a, fa)`, `(b, fb)`.
+fn quad_root((a, b): (f64, f64), (fa, fb): (f64, f64), c2: f64) -> f64 {
+    let w = b - a;
+    let m = (fb - fa) / w - 0.5 * c2 * w;
+    // 0.5 c2 h^2 + m h + fa = 0, the numerically stable pair of roots.
+    let disc = (m * m - 2.0 * c2 * fa).max(0.0);
+    let q = -0.5 * (m + disc.sqrt().copysign(m));
+    let h1 = if q != 0.0 { fa / q } else { 0.0 };
+    let h2 = if c2 != 0.0 { q / (0.5 * c2) } else { h1 };
+    let h = if (0.0..=w).contains(&h1) { h1 } else { h2 };
+    a + h.clamp(0.0, w)
+}
+
+/// Brent's method for an increasing `f` on `[a, b]` with `fa = f(a) <= 0 <= f(b) = fb`.
+fn brent(
+    mut f: impl FnMut(f64) -> f64,
+    (mut a, mut b): (f64, f64),
+    (mut fa, mut fb): (f64, f64),
+    tol_f: f64,
+) -> Option<f64> {
     if fa.abs() <= tol_f {
         return Some(a);
     }
@@ -485,22 +622,18 @@ fn brent(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64, tol_f: f64) -> O
     Some(b)
 }
 
-fn finish<const REC: bool>(b: Builder<REC>, origin: f64, sigma: f64, end: State) -> Profile {
-    let mut segs = [Segment::default(); MAX_SEGMENTS];
+fn finish(mut b: Builder<MAX_SEGMENTS>, origin: f64, sigma: f64, end: State) -> Profile {
     let n = b.n.min(MAX_SEGMENTS);
-    for (dst, src) in segs.iter_mut().zip(b.segs.iter()).take(n) {
-        *dst = Segment {
-            t0: src.t0,
-            start: State {
-                p: origin + sigma * src.start.p,
-                v: sigma * src.start.v,
-                a: sigma * src.start.a,
-            },
-            jerk: sigma * src.jerk,
+    for seg in b.segs.iter_mut().take(n) {
+        seg.start = State {
+            p: origin + sigma * seg.start.p,
+            v: sigma * seg.start.v,
+            a: sigma * seg.start.a,
         };
+        seg.jerk *= sigma;
     }
     Profile {
-        segs,
+        segs: b.segs,
         n,
         duration: b.t,
         end,
@@ -517,11 +650,11 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
     let vmax = lim.vel;
     // Work relative to the start position, mirrored so that the released velocity is >= 0.
     let rel = State { p: 0.0, ..start };
-    let probe = Builder::<false>::new(rel, lim);
+    let probe = Builder::<0>::new(rel, lim);
     let sigma = if probe.v_nat() < 0.0 { -1.0 } else { 1.0 };
     let goal = sigma * (target - start.p);
 
-    let mut pre = Builder::<true>::new(rel.mirrored(sigma), lim);
+    let mut pre = Builder::<MAX_SEGMENTS>::new(rel.mirrored(sigma), lim);
     recover(&mut pre, vmax);
     let s0 = pre.s;
     let d = goal - s0.p;
@@ -533,43 +666,93 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
         0.0
     };
 
-    let scale = goal.abs().max(s0.p.abs()).max(1e-9);
-    let tol = 1e-13 * scale;
-
     let sub = State { p: 0.0, ..s0 };
-    let d_neg = dist(sub, lim, Family::Peak, -vmax);
-    let d_zero = dist(sub, lim, Family::Peak, 0.0);
-    let d_vn = dist(sub, lim, Family::Peak, vn);
-    let d_pos = dist(sub, lim, Family::Peak, vmax);
-
-    let (fam, x, cruise) = if d >= d_pos {
-        (Family::Peak, vmax, (d - d_pos) / vmax)
-    } else if d <= d_neg {
-        (Family::Peak, -vmax, (d_neg - d) / vmax)
-    } else if d <= d_zero {
-        let x = brent(|x| dist(sub, lim, Family::Peak, x) - d, -vmax, 0.0, tol)
-            .ok_or(ProfileError::NoSolution)?;
-        (Family::Peak, x, 0.0)
-    } else if d < d_vn && tau_max > 0.0 {
-        let x = brent(
-            |x| dist(sub, lim, Family::Relaxed, x) - d,
-            0.0,
-            tau_max,
-            tol,
-        )
-        .ok_or(ProfileError::NoSolution)?;
-        (Family::Relaxed, x, 0.0)
-    } else if d <= d_vn {
-        (Family::Peak, vn, 0.0)
-    } else {
-        let x = brent(|x| dist(sub, lim, Family::Peak, x) - d, vn, vmax, tol)
-            .ok_or(ProfileError::NoSolution)?;
-        (Family::Peak, x, 0.0)
+    let dpk = |x: f64| dist(sub, lim, Family::Peak, x);
+    // The distance grows along the families: Peak(-vmax) <= Peak(0) = Relaxed(0) <=
+    // Relaxed(tau_max) = Peak(vn) <= Peak(vmax). Evaluate only the brackets needed.
+    let d_vn = dpk(vn);
+    // Length scale of the motion (the net travel may be much shorter than the way there).
+    let scale = goal.abs().max(s0.p.abs()).max(d_vn.abs()).max(1e-9);
+    let tol = 1e-13 * scale;
+    let select = |closed_form: bool| -> Result<(Family, f64, f64), ProfileError> {
+        Ok(if d > d_vn {
+            let d_pos = dpk(vmax);
+            if d >= d_pos {
+                (Family::Peak, vmax, (d - d_pos) / vmax)
+            } else {
+                // Where the up-ramp and the down-ramp start to saturate their bounds.
+                let (x_up, x_dn) = if trap {
+                    (vn, 0.0)
+                } else {
+                    (pre.saturation(1.0, vn), pre.dec * pre.dec * pre.ij)
+                };
+                let c2 = 1.0 / pre.acc + 1.0 / pre.dec;
+                let x = solve_peak(
+                    dpk,
+                    d,
+                    (vn, vmax),
+                    (d_vn - d, d_pos - d),
+                    (x_up, x_dn),
+                    c2,
+                    tol,
+                    closed_form,
+                )
+                .ok_or(ProfileError::NoSolution)?;
+                (Family::Peak, x, 0.0)
+            }
+        } else {
+            let d_zero = dpk(0.0);
+            if d > d_zero {
+                if tau_max > 0.0 && d < d_vn {
+                    let x = brent(
+                        |x| dist(sub, lim, Family::Relaxed, x) - d,
+                        (0.0, tau_max),
+                        (d_zero - d, d_vn - d),
+                        tol,
+                    )
+                    .ok_or(ProfileError::NoSolution)?;
+                    (Family::Relaxed, x, 0.0)
+                } else {
+                    (Family::Peak, vn, 0.0)
+                }
+            } else {
+                let d_neg = dpk(-vmax);
+                if d <= d_neg {
+                    (Family::Peak, -vmax, (d_neg - d) / vmax)
+                } else {
+                    let (x_up, x_dn) = if trap {
+                        (0.0, 0.0)
+                    } else {
+                        (pre.saturation(-1.0, vn), -pre.dec * pre.dec * pre.ij)
+                    };
+                    let c2 = -(1.0 / pre.acc + 1.0 / pre.dec);
+                    let x = solve_peak(
+                        dpk,
+                        d,
+                        (-vmax, 0.0),
+                        (d_neg - d, d_zero - d),
+                        (x_up, x_dn),
+                        c2,
+                        tol,
+                        closed_form,
+                    )
+                    .ok_or(ProfileError::NoSolution)?;
+                    (Family::Peak, x, 0.0)
+                }
+            }
+        })
     };
 
-    // Replay: recovery prefix, then the chosen family, all in one recorded builder.
+    // Replay: recovery prefix, then the chosen family, all in one recorded builder. A closed-form
+    // root that does not land (a breakpoint formula did not hold) is solved again iteratively.
+    let (fam, x, cruise) = select(true)?;
     let mut b = pre;
     b.apply(fam, x, cruise);
+    if (b.s.p - goal).abs() > 1e-10 * scale {
+        let (fam, x, cruise) = select(false)?;
+        b = pre;
+        b.apply(fam, x, cruise);
+    }
     if b.n > MAX_SEGMENTS {
         return Err(ProfileError::NoSolution);
     }
@@ -586,7 +769,7 @@ pub fn plan_velocity(start: State, target_v: f64, lim: &Limits) -> Result<Profil
     }
     let vt = target_v.clamp(-lim.vel, lim.vel);
     let rel = State { p: 0.0, ..start };
-    let mut b = Builder::<true>::new(rel, lim);
+    let mut b = Builder::<MAX_SEGMENTS>::new(rel, lim);
     b.vel_ramp(vt);
     let end_p = b.s.p;
     if b.n > MAX_SEGMENTS {

@@ -38,6 +38,23 @@ fn check_profile(p: &Profile, start: State, lim: &Limits, end_pos: Option<f64>) 
             "a {} at {t}",
             s.a
         );
+        // Siemens semantics: `acc` while |v| grows, `dec` while it shrinks (the generated start
+        // states are within both).
+        if !trap {
+            let bound = if s.v * s.a > 0.0 {
+                lim.acc
+            } else if s.v * s.a < 0.0 {
+                lim.dec
+            } else {
+                amax
+            };
+            assert!(
+                s.a.abs() <= bound * (1.0 + 1e-9) + 1e-9,
+                "a {} at v {} exceeds its bound {bound} at {t} ({lim:?})",
+                s.a,
+                s.v
+            );
+        }
         let dt = d / n as f64;
         // Continuity: the position can move at most by |v|max*dt, velocity by |a|max*dt.
         assert!((s.p - prev.p).abs() <= lim.vel.max(start.v.abs()) * dt * (1.0 + 1e-6) + 1e-9);

@@ -117,3 +117,78 @@ fn durations_match_rsruckig_symmetric() {
         worst.1
     );
 }
+
+/// Asymmetric limits with reversals: ruckig with both bounds equal to the larger one can only be
+/// faster than any profile under our (acc while speeding up, dec while braking) limits, and
+/// ruckig with both equal to the smaller one can only be slower. Ours lies in between, and is
+/// strictly faster than the smaller-bound one whenever a reversal can use the larger bound.
+#[test]
+fn asymmetric_durations_lie_between_the_symmetric_bounds() {
+    let mut rng = Rng(0xa5a5_1234_0f0f_7777);
+    let mut compared = 0;
+    let mut improved = 0;
+    for case in 0..20_000 {
+        let vel = rng.log_uniform(1.0, 2000.0);
+        let acc = rng.log_uniform(10.0, 20000.0);
+        let dec = acc * rng.log_uniform(0.25, 4.0);
+        let jerk = acc.max(dec) * rng.log_uniform(1.0, 200.0);
+        let lo = Limits {
+            vel,
+            acc: acc.min(dec),
+            dec: acc.min(dec),
+            jerk,
+        };
+        let hi = Limits {
+            vel,
+            acc: acc.max(dec),
+            dec: acc.max(dec),
+            jerk,
+        };
+        let lim = Limits {
+            vel,
+            acc,
+            dec,
+            jerk,
+        };
+        let (v, a) = feasible_start(rng.next(), rng.next(), &lo);
+        let start = State { p: 0.0, v, a };
+        let velocity_mode = case % 3 == 2;
+        let target = if velocity_mode {
+            (2.0 * rng.next() - 1.0) * vel
+        } else {
+            let d = rng.log_uniform(0.01, 5000.0);
+            if rng.next() < 0.5 {
+                -d
+            } else {
+                d
+            }
+        };
+        let (Some(t_hi), Some(t_lo)) = (
+            ruckig_duration(start, target, velocity_mode, &hi),
+            ruckig_duration(start, target, velocity_mode, &lo),
+        ) else {
+            continue;
+        };
+        let ours = if velocity_mode {
+            plan_velocity(start, target, &lim)
+        } else {
+            plan_position(start, target, &lim)
+        }
+        .unwrap()
+        .duration();
+        let tol = (1e-6f64).max(1e-4 * t_lo);
+        assert!(
+            ours >= t_hi - tol && ours <= t_lo + tol,
+            "case {case}: {start:?} -> {target} {lim:?}: ours {ours} not in [{t_hi}, {t_lo}]"
+        );
+        compared += 1;
+        if ours < t_lo - tol {
+            improved += 1;
+        }
+    }
+    assert!(compared > 19_000, "only {compared} cases compared");
+    assert!(
+        improved > 1000,
+        "only {improved} cases used the larger bound"
+    );
+}
