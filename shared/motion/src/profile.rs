@@ -500,11 +500,14 @@ fn solve_peak(
     d: f64,
     (mut a, mut b): (f64, f64),
     (mut fa, mut fb): (f64, f64),
-    sat: (f64, f64),
-    c2: f64,
+    shape: Shape,
     tol: f64,
-    closed_form: bool,
 ) -> Option<f64> {
+    let Shape {
+        sat,
+        c2,
+        closed_form,
+    } = shape;
     let (x0, x1) = if sat.0 <= sat.1 {
         (sat.0, sat.1)
     } else {
@@ -527,6 +530,17 @@ fn solve_peak(
         return Some(quad_root((a, b), (fa, fb), c2));
     }
     brent(|x| dpk(x) - d, (a, b), (fa, fb), tol)
+}
+
+/// Where the distance becomes quadratic in the peak velocity (see [`solve_peak`]).
+#[derive(Copy, Clone)]
+struct Shape {
+    /// Saturation points of the up-ramp and the down-ramp.
+    sat: (f64, f64),
+    /// Second derivative of the distance beyond both.
+    c2: f64,
+    /// Whether the closed form may be used.
+    closed_form: bool,
 }
 
 /// Root in `[a, b]` of the quadratic with second derivative `c2` through `(a, fa)`, `(b, fb)`.
@@ -692,10 +706,12 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
                     d,
                     (vn, vmax),
                     (d_vn - d, d_pos - d),
-                    (x_up, x_dn),
-                    c2,
+                    Shape {
+                        sat: (x_up, x_dn),
+                        c2,
+                        closed_form,
+                    },
                     tol,
-                    closed_form,
                 )
                 .ok_or(ProfileError::NoSolution)?;
                 (Family::Peak, x, 0.0)
@@ -731,10 +747,12 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
                         d,
                         (-vmax, 0.0),
                         (d_neg - d, d_zero - d),
-                        (x_up, x_dn),
-                        c2,
+                        Shape {
+                            sat: (x_up, x_dn),
+                            c2,
+                            closed_form,
+                        },
                         tol,
-                        closed_form,
                     )
                     .ok_or(ProfileError::NoSolution)?;
                     (Family::Peak, x, 0.0)
