@@ -4,102 +4,17 @@
 
 use tandem_motion::alarm::{status_bit, AlarmId};
 use tandem_motion::axis::{
-    Axis, AxisConfig, AxisState, Command, Direction, HomingMark, Sense, SoftwareLimits, StartMode,
+    AxisConfig, AxisState, Command, Direction, HomingMark, Sense, SoftwareLimits, StartMode,
     StopMode, VelocityDirection,
 };
 use tandem_motion::drive::{DriveModel, ZeroMark};
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{Instruction, JobEvent, JobEventKind, JobId};
+use tandem_motion::job::{Instruction, JobEventKind};
 use tandem_motion::modulo::Modulo;
 
-const MS: i64 = 1_000_000;
-
-struct Rig {
-    axis: Axis,
-    k: i64,
-    events: Vec<JobEvent>,
-}
-
-impl Rig {
-    fn new(cfg: AxisConfig) -> Self {
-        let mut r = Self {
-            axis: Axis::new(cfg).unwrap(),
-            k: 0,
-            events: Vec::new(),
-        };
-        r.step(1);
-        r
-    }
-
-    fn enabled(cfg: AxisConfig) -> Self {
-        let mut r = Self::new(cfg);
-        r.cmd(Command::Power {
-            enable: true,
-            start_mode: StartMode::PositionControlled,
-            stop_mode: StopMode::Emergency,
-        })
-        .unwrap();
-        r.step(1);
-        r
-    }
-
-    fn now(&self) -> i64 {
-        self.k * MS
-    }
-
-    /// Time of the last computed setpoint: a command takes effect from there.
-    fn t_last(&self) -> f64 {
-        (self.k - 1) as f64 * 1e-3
-    }
-
-    fn cmd(&mut self, c: Command) -> Result<JobId, ErrorId> {
-        let r = self.axis.command(&c);
-        self.drain();
-        r
-    }
-
-    fn drain(&mut self) {
-        while let Some(e) = self.axis.pop_event() {
-            self.events.push(e);
-        }
-    }
-
-    fn step(&mut self, n: usize) {
-        for _ in 0..n {
-            self.axis.step(self.now());
-            self.drain();
-            self.k += 1;
-        }
-    }
-
-    /// Steps until `job` reports `kind` or `max` cycles pass; returns the cycle time in s.
-    fn until(&mut self, job: JobId, kind: JobEventKind, max: usize) -> f64 {
-        for _ in 0..max {
-            if let Some(e) = self.events.iter().find(|e| e.job == job && e.kind == kind) {
-                return e.time_ns as f64 * 1e-9;
-            }
-            self.step(1);
-        }
-        panic!(
-            "job {job} did not report {kind:?} within {max} cycles; events {:?}",
-            self.events
-        );
-    }
-
-    fn has(&self, job: JobId, kind: JobEventKind) -> bool {
-        self.events.iter().any(|e| e.job == job && e.kind == kind)
-    }
-}
-
-fn dyn_(v: f64, a: f64, d: f64, j: f64) -> Dynamics {
-    Dynamics {
-        velocity: v,
-        acceleration: a,
-        deceleration: d,
-        jerk: j,
-    }
-}
+mod common;
+use common::{dyn_, Rig};
 
 fn homed(cfg: AxisConfig) -> Rig {
     let mut r = Rig::enabled(cfg);

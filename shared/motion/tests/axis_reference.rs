@@ -4,81 +4,16 @@
 
 use tandem_motion::alarm::AlarmId;
 use tandem_motion::axis::{
-    Axis, AxisConfig, AxisState, Command, HomingMark, StartMode, StopMode, VelocityDirection,
+    AxisConfig, AxisState, Command, HomingMark, StartMode, StopMode, VelocityDirection,
 };
 use tandem_motion::drive::{DriveModel, ZeroMark};
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{JobEvent, JobEventKind, JobId};
+use tandem_motion::job::JobEventKind;
 use tandem_motion::profile::{plan_velocity, Limits, State};
 
-const MS: i64 = 1_000_000;
-
-struct Rig {
-    axis: Axis,
-    k: i64,
-    events: Vec<JobEvent>,
-}
-
-impl Rig {
-    fn enabled(cfg: AxisConfig) -> Self {
-        let mut r = Self {
-            axis: Axis::new(cfg).unwrap(),
-            k: 0,
-            events: Vec::new(),
-        };
-        r.step(1);
-        r.cmd(Command::Power {
-            enable: true,
-            start_mode: StartMode::PositionControlled,
-            stop_mode: StopMode::Emergency,
-        })
-        .unwrap();
-        r.step(1);
-        r
-    }
-    fn cmd(&mut self, c: Command) -> Result<JobId, ErrorId> {
-        let r = self.axis.command(&c);
-        self.drain();
-        r
-    }
-    fn drain(&mut self) {
-        while let Some(e) = self.axis.pop_event() {
-            self.events.push(e);
-        }
-    }
-    fn step(&mut self, n: usize) {
-        for _ in 0..n {
-            self.axis.step(self.k * MS);
-            self.drain();
-            self.k += 1;
-        }
-    }
-    fn t_last(&self) -> f64 {
-        (self.k - 1) as f64 * 1e-3
-    }
-    fn until(&mut self, job: JobId, kind: JobEventKind, max: usize) -> f64 {
-        for _ in 0..max {
-            if let Some(e) = self.events.iter().find(|e| e.job == job && e.kind == kind) {
-                return e.time_ns as f64 * 1e-9;
-            }
-            self.step(1);
-        }
-        panic!("job {job}: no {kind:?} in {max} cycles: {:?}", self.events);
-    }
-    fn has(&self, job: JobId, kind: JobEventKind) -> bool {
-        self.events.iter().any(|e| e.job == job && e.kind == kind)
-    }
-}
-
-fn dynamics(v: f64, a: f64, d: f64, j: f64) -> Dynamics {
-    Dynamics {
-        velocity: v,
-        acceleration: a,
-        deceleration: d,
-        jerk: j,
-    }
-}
+mod common;
+use common::{dyn_ as dynamics, Rig};
 
 #[test]
 fn ramp_and_smoothing_times_of_seed_001_4_1() {

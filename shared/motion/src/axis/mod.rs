@@ -720,56 +720,13 @@ impl Axis {
                 position,
                 dynamics,
                 direction,
-            } => {
-                self.require_positioning()?;
-                self.check_motion_allowed()?;
-                if !position.is_finite() {
-                    return Err(ErrorId::IllegalPosition);
-                }
-                if !self.homed {
-                    return Err(ErrorId::NotHomed);
-                }
-                let r = self
-                    .cfg
-                    .limits
-                    .resolve(&self.cfg.defaults, &dynamics, false)?;
-                self.warn_clamped(r.clamped);
-                self.apply_override_table(NewJob::Positioning);
-                self.fold_superimposed();
-                self.force_position_control();
-                let target = self.absolute_target(position, direction, &r.limits);
-                Ok(self.start_main(
-                    Instruction::MoveAbsolute,
-                    r.limits,
-                    Goal::Position {
-                        target,
-                        lim: r.limits,
-                    },
-                ))
-            }
+            } => self.cmd_positioning(Instruction::MoveAbsolute, position, &dynamics, |ax, lim| {
+                ax.absolute_target(position, direction, lim)
+            }),
             Command::MoveRelative { distance, dynamics } => {
-                self.require_positioning()?;
-                self.check_motion_allowed()?;
-                if !distance.is_finite() {
-                    return Err(ErrorId::IllegalDistance);
-                }
-                let r = self
-                    .cfg
-                    .limits
-                    .resolve(&self.cfg.defaults, &dynamics, false)?;
-                self.warn_clamped(r.clamped);
-                self.apply_override_table(NewJob::Positioning);
-                self.fold_superimposed();
-                self.force_position_control();
-                let target = self.basic.p + distance;
-                Ok(self.start_main(
-                    Instruction::MoveRelative,
-                    r.limits,
-                    Goal::Position {
-                        target,
-                        lim: r.limits,
-                    },
-                ))
+                self.cmd_positioning(Instruction::MoveRelative, distance, &dynamics, |ax, _| {
+                    ax.basic.p + distance
+                })
             }
             Command::MoveVelocity {
                 dynamics,
@@ -903,6 +860,42 @@ impl Axis {
                 position_controlled,
             ),
         }
+    }
+
+    /// MC_MoveAbsolute (`value` = Position) and MC_MoveRelative (`value` = Distance): checks,
+    /// override table, then a position goal at `target` (computed after any superimposed
+    /// motion has been folded into the basic motion, from the position at job start).
+    fn cmd_positioning(
+        &mut self,
+        instr: Instruction,
+        value: f64,
+        dynamics: &Dynamics,
+        target: impl FnOnce(&Self, &Limits) -> f64,
+    ) -> Result<JobId, ErrorId> {
+        self.require_positioning()?;
+        self.check_motion_allowed()?;
+        let absolute = instr == Instruction::MoveAbsolute;
+        if !value.is_finite() {
+            return Err(if absolute {
+                ErrorId::IllegalPosition
+            } else {
+                ErrorId::IllegalDistance
+            });
+        }
+        if absolute && !self.homed {
+            return Err(ErrorId::NotHomed);
+        }
+        let r = self
+            .cfg
+            .limits
+            .resolve(&self.cfg.defaults, dynamics, false)?;
+        self.warn_clamped(r.clamped);
+        self.apply_override_table(NewJob::Positioning);
+        self.fold_superimposed();
+        self.force_position_control();
+        let target = target(self, &r.limits);
+        let lim = r.limits;
+        Ok(self.start_main(instr, lim, Goal::Position { target, lim }))
     }
 
     fn force_position_control(&mut self) {
