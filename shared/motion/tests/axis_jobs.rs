@@ -823,3 +823,223 @@ fn homing_needs_the_sensors_of_its_mark() {
     r.step(1);
     assert!((r.axis.status().position - 12.5).abs() < 1e-12);
 }
+
+fn homing_cfg() -> AxisConfig {
+    let mut cfg = AxisConfig::example(0.001);
+    cfg.plant.reference_cam = Some((20.0, 30.0));
+    cfg.plant.zero_mark = Some(ZeroMark {
+        period: 10.0,
+        offset: 5.0,
+    });
+    cfg.homing.approach_velocity = 20.0;
+    cfg.homing.referencing_velocity = 5.0;
+    cfg
+}
+
+#[test]
+fn active_homing_zero_mark_only_mode_5_ends_at_home_position() {
+    // Mode 5: the mark gets HomePosition - HomePositionOffset, the axis ends at HomePosition;
+    // zero mark only: the first mark in the homing direction (negative from 3: the mark at -5).
+    let mut cfg = homing_cfg();
+    cfg.initial_position = 3.0;
+    cfg.homing.active_mark = HomingMark::ZeroMark;
+    cfg.homing.homing_direction = Sense::Negative;
+    cfg.homing.home_position = 50.0;
+    cfg.homing.home_position_offset = -1.5;
+    let mut r = Rig::enabled(cfg);
+    let id = r
+        .cmd(Command::Home {
+            mode: 5,
+            position: 999.0,
+        })
+        .unwrap();
+    r.until(id, JobEventKind::Done, 20_000);
+    let s = r.axis.status();
+    assert!((s.position - 50.0).abs() < 1e-9);
+    // The mark at physical -5 is 51.5, so the axis at 50 is physically at -6.5.
+    let phys = s.actual_position - 51.5 + (-5.0);
+    assert!((phys + 6.5).abs() < 0.011, "{phys}");
+}
+
+#[test]
+fn active_homing_on_a_digital_input_edge() {
+    // Digital input (the cam signal) mode: the edge on the homing-direction side is the mark.
+    // Negative side: the lower edge (20) gets Position - offset = 10 - 0 = 10.
+    let mut cfg = homing_cfg();
+    cfg.initial_position = 40.0;
+    cfg.homing.active_mark = HomingMark::DigitalInput;
+    cfg.homing.approach_direction = Sense::Negative;
+    cfg.homing.homing_direction = Sense::Negative;
+    let mut r = Rig::enabled(cfg);
+    let id = r
+        .cmd(Command::Home {
+            mode: 3,
+            position: 10.0,
+        })
+        .unwrap();
+    r.until(id, JobEventKind::Done, 20_000);
+    let s = r.axis.status();
+    assert!((s.position - 10.0).abs() < 1e-9);
+    // Physically the axis stands at the edge (20): actual 10 <-> physical 20.
+    let id = r
+        .cmd(Command::MoveRelative {
+            distance: 5.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    r.until(id, JobEventKind::Done, 3000);
+    assert!((r.axis.status().actual_position - 15.0).abs() < 0.011);
+}
+
+#[test]
+fn active_homing_reverses_at_a_hardware_limit_switch() {
+    // The cam lies in the positive direction but the search starts negative: the axis reaches
+    // the negative limit switch, brakes, reverses at approach velocity and homes normally,
+    // without alarm 531 (AutoReversal).
+    let mut cfg = homing_cfg();
+    cfg.initial_position = 0.0;
+    cfg.hw_limits_active = true;
+    cfg.plant.hw_limit_min = Some(-30.0);
+    cfg.homing.approach_direction = Sense::Negative;
+    cfg.homing.homing_direction = Sense::Positive;
+    cfg.following_error.enable = false;
+    let mut r = Rig::enabled(cfg);
+    let id = r
+        .cmd(Command::Home {
+            mode: 3,
+            position: 0.0,
+        })
+        .unwrap();
+    let mut min_pos = f64::MAX;
+    for _ in 0..30_000 {
+        r.step(1);
+        min_pos = min_pos.min(r.axis.status().actual_position);
+        if r.has(id, JobEventKind::Done) {
+            break;
+        }
+    }
+    assert!(r.has(id, JobEventKind::Done), "{:?}", r.events);
+    assert!(min_pos < -30.0, "it reached the switch");
+    assert!(!r.axis.has_alarm(AlarmId::HwLimit));
+    // Without AutoReversal the same search ends with 531.
+    let mut cfg = homing_cfg();
+    cfg.hw_limits_active = true;
+    cfg.plant.hw_limit_min = Some(-30.0);
+    cfg.homing.approach_direction = Sense::Negative;
+    cfg.homing.auto_reversal = false;
+    let mut r = Rig::enabled(cfg);
+    let id = r
+        .cmd(Command::Home {
+            mode: 3,
+            position: 0.0,
+        })
+        .unwrap();
+    r.until(id, JobEventKind::Error(ErrorId::TechnologyAlarm), 30_000);
+    assert!(r.axis.has_alarm(AlarmId::HwLimit));
+}
+
+#[test]
+fn active_homing_finds_nothing_between_two_switches() {
+    let mut cfg = homing_cfg();
+    cfg.plant.reference_cam = Some((200.0, 210.0));
+    cfg.hw_limits_active = true;
+    cfg.plant.hw_limit_min = Some(-30.0);
+    cfg.plant.hw_limit_max = Some(60.0);
+    cfg.following_error.enable = false;
+    let mut r = Rig::enabled(cfg);
+    let id = r
+        .cmd(Command::Home {
+            mode: 3,
+            position: 0.0,
+        })
+        .unwrap();
+    r.until(id, JobEventKind::Error(ErrorId::TechnologyAlarm), 60_000);
+    assert!(r.axis.has_alarm(AlarmId::HomingNotFound));
+    assert!(!r.axis.status().has(status_bit::HOMING_DONE));
+}
+
+#[test]
+fn absolute_encoder_adjustment_and_passive_mode_10() {
+    let mut cfg = homing_cfg();
+    cfg.encoder = tandem_motion::axis::EncoderType::Absolute;
+    let mut r = Rig::enabled(cfg);
+    assert!(
+        r.axis.status().has(status_bit::HOMING_DONE),
+        "absolute: homed from the start"
+    );
+    assert_eq!(
+        r.cmd(Command::Home {
+            mode: 3,
+            position: 0.0
+        }),
+        Err(ErrorId::IllegalHomingModeAbsolute)
+    );
+    // Mode 7: actual := Position; mode 6: shift by Position.
+    r.cmd(Command::Home {
+        mode: 7,
+        position: 100.0,
+    })
+    .unwrap();
+    r.step(1);
+    assert!((r.axis.status().actual_position - 100.0).abs() < 1e-9);
+    r.cmd(Command::Home {
+        mode: 6,
+        position: -30.0,
+    })
+    .unwrap();
+    r.step(1);
+    assert!((r.axis.status().actual_position - 70.0).abs() < 1e-9);
+    // The adjustment survives a restart (the offset is retentive).
+    r.cmd(Command::Power {
+        enable: false,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Immediate,
+    })
+    .unwrap();
+    r.cmd(Command::Reset { restart: true }).unwrap();
+    r.step(1);
+    assert!((r.axis.status().actual_position - 70.0).abs() < 1e-9);
+    assert!(r.axis.status().has(status_bit::HOMING_DONE));
+
+    // Passive mode 10: the mark gets Homing.HomePosition (Position ignored), no offset.
+    let mut cfg = homing_cfg();
+    cfg.homing.home_position = 500.0;
+    cfg.homing.home_position_offset = 7.0;
+    cfg.homing.passive_mark = HomingMark::ZeroMark;
+    cfg.homing.passive_direction = tandem_motion::axis::PassiveDirection::Negative;
+    let mut r = Rig::enabled(cfg);
+    let h = r
+        .cmd(Command::Home {
+            mode: 10,
+            position: 1.0,
+        })
+        .unwrap();
+    // Moving positive: not armed (direction negative).
+    let m = r
+        .cmd(Command::MoveRelative {
+            distance: 12.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    r.until(m, JobEventKind::Done, 3000);
+    assert!(!r.has(h, JobEventKind::Done));
+    assert!(
+        !r.axis.status().has(status_bit::HOMING_DONE),
+        "mode 10 clears HomingDone at start"
+    );
+    // Back from 12: the mark at 5 is crossed going negative: it becomes 500.
+    let m = r
+        .cmd(Command::MoveRelative {
+            distance: -12.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    r.until(h, JobEventKind::Done, 3000);
+    r.until(m, JobEventKind::Done, 3000);
+    // The move continued in the new coordinates: it ends 5 below the mark.
+    assert!(
+        (r.axis.status().actual_position - 495.0).abs() < 0.011,
+        "{}",
+        r.axis.status().actual_position
+    );
+}

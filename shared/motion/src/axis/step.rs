@@ -260,9 +260,16 @@ impl Axis {
             ..job.lim
         };
         let mut new_goal = None;
+        // The direction the homing motion is commanded in (a reversal is counted once, when
+        // the switch lies ahead of it, not again while braking on the switch).
+        let heading = if h.phase == HomePhase::Search {
+            h.search_dir
+        } else {
+            hd
+        };
         match h.phase {
             HomePhase::Search | HomePhase::OnCam | HomePhase::Armed
-                if hc.auto_reversal && self.hw_switch_hit(phys, moved) =>
+                if hc.auto_reversal && self.hw_switch_hit(phys, heading) =>
             {
                 // Reversing cam: brake with the maximum deceleration, continue the other way at
                 // approach velocity. The second reversal means nothing was found.
@@ -271,7 +278,7 @@ impl Axis {
                     self.raise(AlarmId::HomingNotFound, supplement::NONE);
                     return;
                 }
-                h.search_dir = -moved;
+                h.search_dir = -heading;
                 h.phase = HomePhase::Search;
                 let lim = Limits {
                     dec: self.cfg.limits.max_deceleration,
