@@ -343,3 +343,135 @@ fn alarm_with_stop_reaction_keeps_the_axis_enabled_and_reset_returns_to_standsti
     assert_eq!(r.axis.status().state, AxisState::Standstill);
     assert_eq!(r.axis.status().error_detail.number, 0);
 }
+
+#[test]
+fn non_position_controlled_mode_is_sticky_until_a_positioning_job() {
+    // StartMode 0 enables without position control (StatusWord.X28); MoveVelocity with
+    // PositionControlled FALSE keeps it after the job; Halt keeps the mode; MoveRelative forces
+    // position control (seed 001 §3.6).
+    let mut r = Rig::enabled(AxisConfig::example(0.001));
+    r.cmd(Command::Power {
+        enable: false,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Immediate,
+    })
+    .unwrap();
+    r.cmd(Command::Power {
+        enable: true,
+        start_mode: StartMode::NonPositionControlled,
+        stop_mode: StopMode::Emergency,
+    })
+    .unwrap();
+    r.step(1);
+    let npc = tandem_motion::alarm::status_bit::NON_POSITION_CONTROLLED;
+    assert!(r.axis.status().has(npc));
+    let v = r
+        .cmd(Command::MoveVelocity {
+            dynamics: dynamics(50.0, -1.0, -1.0, -1.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: false,
+        })
+        .unwrap();
+    r.until(v, JobEventKind::InVelocity, 1000);
+    assert!(r.axis.status().has(npc));
+    assert_eq!(r.axis.status().following_error, 0.0);
+    let h = r
+        .cmd(Command::Halt {
+            deceleration: -1.0,
+            jerk: -1.0,
+            abort_acceleration: false,
+        })
+        .unwrap();
+    r.until(h, JobEventKind::Done, 1000);
+    assert!(r.axis.status().has(npc), "Halt keeps the mode");
+    let m = r
+        .cmd(Command::MoveRelative {
+            distance: 10.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    r.step(1);
+    assert!(
+        !r.axis.status().has(npc),
+        "MoveRelative forces position control"
+    );
+    r.until(m, JobEventKind::Done, 3000);
+}
+
+#[test]
+fn a_state_beyond_new_limits_is_brought_back_as_fast_as_they_allow() {
+    // Running at 400; a MoveAbsolute with Velocity 100 and Deceleration 2000 brakes at once
+    // with 2000 (jerk 0 here) down to 100: 300/2000 = 0.15 s, then cruises.
+    let mut r = Rig::enabled(AxisConfig::example(0.001));
+    r.cmd(Command::Home {
+        mode: 0,
+        position: 0.0,
+    })
+    .unwrap();
+    let v = r
+        .cmd(Command::MoveVelocity {
+            dynamics: dynamics(400.0, 5000.0, 5000.0, 0.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    r.until(v, JobEventKind::InVelocity, 1000);
+    r.cmd(Command::MoveAbsolute {
+        position: 10_000.0,
+        dynamics: dynamics(100.0, 1000.0, 2000.0, 0.0),
+        direction: tandem_motion::axis::Direction::Shortest,
+    })
+    .unwrap();
+    r.step(1);
+    assert!((r.axis.status().velocity - (400.0 - 2000.0 * 0.001)).abs() < 1e-9);
+    r.step(148);
+    assert!(
+        (r.axis.status().velocity - 102.0).abs() < 1e-9,
+        "{}",
+        r.axis.status().velocity
+    );
+    r.step(2);
+    assert!((r.axis.status().velocity - 100.0).abs() < 1e-9);
+    // The same with an override drop from 100 % to 25 % on a velocity job.
+    r.cmd(Command::SetOverride { velocity: 25.0 }).unwrap();
+    r.step(1);
+    assert!((r.axis.status().velocity - (100.0 - 2000.0 * 0.001)).abs() < 1e-9);
+}
+
+#[test]
+fn speed_axis_has_velocity_jobs_only() {
+    let mut cfg = AxisConfig::example(0.001);
+    cfg.kind = tandem_motion::axis::AxisKind::Speed;
+    let mut r = Rig::enabled(cfg);
+    assert_eq!(
+        r.cmd(Command::MoveRelative {
+            distance: 1.0,
+            dynamics: Dynamics::DEFAULT
+        }),
+        Err(ErrorId::IllegalObject)
+    );
+    assert_eq!(
+        r.cmd(Command::Home {
+            mode: 0,
+            position: 0.0
+        }),
+        Err(ErrorId::IllegalObject)
+    );
+    let v = r
+        .cmd(Command::MoveVelocity {
+            dynamics: dynamics(120.0, -1.0, -1.0, -1.0),
+            direction: VelocityDirection::BySign,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    r.until(v, JobEventKind::InVelocity, 1000);
+    let s = r.axis.status();
+    assert_eq!(s.velocity, 120.0);
+    assert_eq!(
+        s.status_word & !tandem_motion::alarm::status_bit::SPEED_AXIS_MASK,
+        0
+    );
+}
