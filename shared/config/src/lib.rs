@@ -209,6 +209,7 @@ fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, FieldError> {
         &[
             ("speed", AxisKind::Speed),
             ("positioning", AxisKind::Positioning),
+            ("synchronous", AxisKind::Synchronous),
         ],
     )?;
     let motion_type = pick(

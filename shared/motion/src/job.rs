@@ -39,6 +39,16 @@ pub enum Instruction {
     MotionInPosition,
     /// `MC_MotionInVelocity`.
     MotionInVelocity,
+    /// `MC_GearIn`.
+    GearIn,
+    /// `MC_GearInPos`.
+    GearInPos,
+    /// `MC_GearOut`.
+    GearOut,
+    /// `MC_PhasingAbsolute`.
+    PhasingAbsolute,
+    /// `MC_PhasingRelative`.
+    PhasingRelative,
 }
 
 impl Instruction {
@@ -58,6 +68,11 @@ impl Instruction {
             Self::SetOverride => "MC_SetOverride",
             Self::MotionInPosition => "MC_MotionInPosition",
             Self::MotionInVelocity => "MC_MotionInVelocity",
+            Self::GearIn => "MC_GearIn",
+            Self::GearInPos => "MC_GearInPos",
+            Self::GearOut => "MC_GearOut",
+            Self::PhasingAbsolute => "MC_PhasingAbsolute",
+            Self::PhasingRelative => "MC_PhasingRelative",
         }
     }
 }
@@ -75,6 +90,12 @@ pub enum JobEventKind {
     Done,
     /// `MC_Power.Status` changed (TRUE: enabled, FALSE: disabled).
     Status(bool),
+    /// `InGear` (MC_GearIn): velocity and acceleration match the leader's times the ratio.
+    InGear,
+    /// `StartSync` (MC_GearInPos, MC_CamIn): synchronization has started.
+    StartSync,
+    /// `InSync` (MC_GearInPos, MC_CamIn): synchronous at the sync positions.
+    InSync,
     /// Aborted by another job or by an alarm reaction (`CommandAborted`).
     CommandAborted,
     /// Ended with an error (`Error`, `ErrorID`), e.g. 16#8001 when an alarm ended it.

@@ -12,6 +12,7 @@ pub mod drive;
 pub mod dynamics;
 pub mod error_id;
 pub mod job;
+pub mod leading;
 pub mod modulo;
 pub mod override_table;
 pub mod profile;

@@ -147,6 +147,16 @@ impl Profile {
         }
     }
 
+    /// The same profile moved by `delta` in position.
+    pub fn shifted(mut self, delta: f64) -> Self {
+        let n = self.n.min(MAX_SEGMENTS);
+        for seg in self.segs.iter_mut().take(n) {
+            seg.start.p += delta;
+        }
+        self.end.p += delta;
+        self
+    }
+
     /// Total duration (s).
     pub fn duration(&self) -> f64 {
         self.duration

@@ -1,6 +1,7 @@
 //! The instructions an axis accepts, with their inputs as in the references (seed 001 §3.2).
 
 use crate::dynamics::Dynamics;
+use crate::leading::LeaderId;
 
 /// `MC_Power.StartMode`.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -66,6 +67,26 @@ impl VelocityDirection {
             _ => None,
         }
     }
+}
+
+/// `SyncProfileReference` of MC_GearInPos.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum SyncProfileReference {
+    /// 0: synchronize using the dynamics; the synchronization length follows from them.
+    Dynamics,
+    /// 1: synchronize over the leading value distance `MasterStartDistance`.
+    MasterStartDistance,
+}
+
+/// `SyncDirection` of a modulo follower (MC_GearInPos, MC_CamIn).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum SyncDirection {
+    /// 1: the follower moves only in the positive direction while synchronizing.
+    Positive,
+    /// 2: only in the negative direction.
+    Negative,
+    /// 3: the shortest way (default).
+    Shortest,
 }
 
 /// An instruction for an axis. Execute-type instructions start a job per command;
@@ -197,5 +218,53 @@ pub enum Command {
         acceleration: f64,
         /// `PositionControlled`.
         position_controlled: bool,
+    },
+    /// `MC_GearIn`: relative gearing; synchronizes with the given dynamics, then `InGear`.
+    #[doc(alias = "MC_GearIn")]
+    GearIn {
+        /// The leader (the runtime resolves names to ids).
+        master: LeaderId,
+        /// `RatioNumerator` (DINT, not 0; negative reverses).
+        ratio_numerator: i32,
+        /// `RatioDenominator` (DINT, >= 1).
+        ratio_denominator: i32,
+        /// `Acceleration`, `Deceleration`, `Jerk` (velocity unused).
+        dynamics: Dynamics,
+    },
+    /// `MC_GearInPos`: absolute gearing, synchronous exactly at the sync positions.
+    #[doc(alias = "MC_GearInPos")]
+    GearInPos {
+        /// The leader.
+        master: LeaderId,
+        /// `RatioNumerator`.
+        ratio_numerator: i32,
+        /// `RatioDenominator`.
+        ratio_denominator: i32,
+        /// `MasterSyncPosition`.
+        master_sync_position: f64,
+        /// `SlaveSyncPosition`.
+        slave_sync_position: f64,
+        /// `SyncProfileReference`.
+        sync_profile_reference: SyncProfileReference,
+        /// `MasterStartDistance` (> 0; used with reference 1).
+        master_start_distance: f64,
+        /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` (used with reference 0).
+        dynamics: Dynamics,
+        /// `SyncDirection` (modulo followers).
+        sync_direction: SyncDirection,
+    },
+    /// `MC_GearOut`: ends gearing; the follower continues with its current velocity.
+    #[doc(alias = "MC_GearOut")]
+    GearOut,
+    /// `MC_PhasingAbsolute` / `MC_PhasingRelative`: shifts the leading value the follower sees.
+    #[doc(alias = "MC_PhasingAbsolute")]
+    #[doc(alias = "MC_PhasingRelative")]
+    Phasing {
+        /// `PhaseShift` (leading value units).
+        phase_shift: f64,
+        /// Absolute (the total shift becomes `phase_shift`) or relative (added).
+        absolute: bool,
+        /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` of the shift.
+        dynamics: Dynamics,
     },
 }

@@ -4,14 +4,15 @@ use crate::drive::{DriveModel, Plant};
 use crate::dynamics::{DynamicDefaults, DynamicLimits};
 use crate::modulo::Modulo;
 
-/// Speed axis or positioning axis (seed 001 §1.4, §1.5). The synchronous axis comes with
-/// synchronous operation.
+/// Speed, positioning or synchronous axis (seed 001 §1.4 to §1.6).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum AxisKind {
     /// `TO_SpeedAxis`: velocity setpoints only, no position control, no homing.
     Speed,
     /// `TO_PositioningAxis`.
     Positioning,
+    /// `TO_SynchronousAxis`: a positioning axis that can also follow a leading value.
+    Synchronous,
 }
 
 /// `Properties.MotionType`.

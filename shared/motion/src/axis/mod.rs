@@ -8,8 +8,11 @@
 mod command;
 mod config;
 mod step;
+mod sync;
 
-pub use command::{Command, Direction, StartMode, StopMode, VelocityDirection};
+pub use command::{
+    Command, Direction, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+};
 pub use config::{
     AxisConfig, AxisKind, ConfigError, EncoderType, FollowingErrorMonitoring, HomingConfig,
     HomingMark, MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits,
@@ -96,6 +99,15 @@ pub struct AxisStatus {
     pub motion_job: Option<(JobId, Instruction)>,
     /// The running superimposed job.
     pub superimposed_job: Option<(JobId, Instruction)>,
+    /// The active synchronous operation job.
+    pub sync_job: Option<(JobId, Instruction)>,
+    /// `StatusSynchronizedMotion.FunctionState`: 0 none, 1 GearIn, 2 GearInPos, 3 CamIn.
+    pub sync_function: u8,
+    /// `StatusSynchronizedMotion.StatusWord`: bit 0 MaxVelocityExceeded, 1
+    /// MaxAccelerationExceeded, 2 MaxDecelerationExceeded.
+    pub sync_status_word: u8,
+    /// `StatusSynchronizedMotion.PhaseShift`.
+    pub phase_shift: f64,
 }
 
 impl AxisStatus {
@@ -124,6 +136,8 @@ enum Goal {
     },
     /// Disabled: the setpoint follows the actual value.
     Track,
+    /// Synchronous operation: the setpoint is the coupling function of the leading value.
+    Sync,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -221,6 +235,14 @@ pub struct Axis {
     sup_job: Option<SupJob>,
     passive: Option<PassiveHoming>,
     stop_lock: bool,
+    sync: Option<sync::SyncJob>,
+    sync_pending: Option<sync::SyncJob>,
+    phasing: Option<sync::PhasingJob>,
+    /// Phase shift state (leading value units).
+    phase: State,
+    /// Leading values for this cycle: of the active and of the pending job's leader.
+    lead: [Option<crate::leading::LeadingValue>; 2],
+    sync_flags: u8,
     alarms: [Option<AlarmInstance>; MAX_ALARMS],
     hw_trigger: Option<(Sense, f64)>,
     sw_active: Option<Sense>,
@@ -281,6 +303,12 @@ impl Axis {
             sup_job: None,
             passive: None,
             stop_lock: false,
+            sync: None,
+            sync_pending: None,
+            phasing: None,
+            phase: State::default(),
+            lead: [None; 2],
+            sync_flags: 0,
             alarms: [None; MAX_ALARMS],
             hw_trigger: None,
             sw_active: None,
@@ -309,6 +337,10 @@ impl Axis {
                 position_unwrapped: p0,
                 motion_job: None,
                 superimposed_job: None,
+                sync_job: None,
+                sync_function: 0,
+                sync_status_word: 0,
+                phase_shift: 0.0,
             },
             cfg,
         };
@@ -428,6 +460,11 @@ impl Axis {
         let s = self.basic;
         let ovr = self.override_pct / 100.0;
         let planned = match self.goal {
+            Goal::Sync => {
+                // The coupling law computes the setpoint; nothing to plan.
+                self.t0 = self.now;
+                return;
+            }
             Goal::Hold | Goal::Direct { .. } | Goal::Track => {
                 self.basic = State { a: 0.0, ..s };
                 Ok(Profile::hold(self.basic))
@@ -507,8 +544,9 @@ impl Axis {
         ]
     }
 
-    /// Aborts the running jobs that `new` overrides (seed 001 §3.3 table 1).
+    /// Aborts the running jobs that `new` overrides (seed 001 §3.3 tables 1 and 2).
     fn apply_override_table(&mut self, new: NewJob) {
+        self.apply_table2(new);
         let [main, sup, passive] = self.running_classes();
         if main.1 && table1(new, main.0).aborts() {
             self.abort_main(JobEventKind::CommandAborted);
@@ -543,6 +581,10 @@ impl Axis {
     }
 
     fn abort_all(&mut self, how: JobEventKind) {
+        self.abort_sync(how);
+        if let Some(p) = self.sync_pending.take() {
+            self.emit(p.id, p.instr, how);
+        }
         self.abort_main(how);
         self.abort_sup(how);
         self.abort_passive(how);
@@ -598,7 +640,7 @@ impl Axis {
 
     fn enable_now(&mut self) {
         self.enabled = true;
-        self.pos_ctrl = self.cfg.kind == AxisKind::Positioning
+        self.pos_ctrl = self.cfg.kind != AxisKind::Speed
             && self.power.start_mode == StartMode::PositionControlled;
         // The setpoint takes over the actual position (StartMode 1 pulls a moving axis back
         // to the position it had when the enable came).
@@ -804,6 +846,39 @@ impl Axis {
                 self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Busy);
                 Ok(id)
             }
+            Command::GearIn {
+                master,
+                ratio_numerator,
+                ratio_denominator,
+                dynamics,
+            } => self.cmd_gear_in(master, ratio_numerator, ratio_denominator, &dynamics),
+            Command::GearInPos {
+                master,
+                ratio_numerator,
+                ratio_denominator,
+                master_sync_position,
+                slave_sync_position,
+                sync_profile_reference,
+                master_start_distance,
+                dynamics,
+                sync_direction,
+            } => self.cmd_gear_in_pos(
+                master,
+                ratio_numerator,
+                ratio_denominator,
+                master_sync_position,
+                slave_sync_position,
+                sync_profile_reference,
+                master_start_distance,
+                &dynamics,
+                sync_direction,
+            ),
+            Command::GearOut => self.cmd_gear_out(),
+            Command::Phasing {
+                phase_shift,
+                absolute,
+                dynamics,
+            } => self.cmd_phasing(phase_shift, absolute, &dynamics),
             Command::SetOverride { velocity } => {
                 if !(velocity.is_finite() && (0.0..=200.0).contains(&velocity)) {
                     return Err(ErrorId::IllegalOverride);
@@ -903,7 +978,7 @@ impl Axis {
     }
 
     fn set_position_control(&mut self, on: bool) {
-        let on = on && self.cfg.kind == AxisKind::Positioning;
+        let on = on && self.cfg.kind != AxisKind::Speed;
         if on && !self.pos_ctrl {
             // Closing the loop: the position setpoint takes over the actual position.
             self.basic.p = self.actual_p - self.sup.p;
@@ -1177,6 +1252,13 @@ impl Axis {
 
     fn cmd_home(&mut self, mode: u8, position: f64) -> Result<JobId, ErrorId> {
         self.require_positioning()?;
+        let absolute_sync = |s: Option<sync::SyncJob>| {
+            s.map(|j| j.instr == Instruction::GearInPos)
+                .unwrap_or(false)
+        };
+        if absolute_sync(self.sync) || absolute_sync(self.sync_pending) {
+            return Err(ErrorId::SyncJobActive);
+        }
         if !position.is_finite() {
             return Err(ErrorId::IllegalPosition);
         }
@@ -1352,6 +1434,9 @@ impl Axis {
             if let Some(pm) = m.monitoring.as_mut() {
                 pm.target += delta;
             }
+        }
+        if let Some(s) = self.sync.as_mut() {
+            s.shift_follower(delta);
         }
         self.replan();
     }

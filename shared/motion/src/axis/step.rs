@@ -24,6 +24,8 @@ impl Axis {
         self.active_homing(prev, phys);
         self.passive_homing(prev, phys);
         self.generate();
+        self.sync_step();
+        self.lead = [None; 2];
         self.check_sw_limits();
         self.update_jobs();
         self.monitor(act.balanced + self.offset);
@@ -57,6 +59,10 @@ impl Axis {
                 a,
             },
             Goal::Track => self.basic,
+            Goal::Sync => State {
+                p: self.basic.p + self.basic.v * dt,
+                ..self.basic
+            },
             _ => self.prof.at(self.elapsed(self.t0) + dt),
         };
         let sup = match self.sup_job {
@@ -89,6 +95,7 @@ impl Axis {
                     a,
                 };
             }
+            Goal::Sync => {}
             Goal::Track => {
                 self.basic = State {
                     p: self.actual_p,
@@ -583,7 +590,7 @@ impl Axis {
         set(
             &mut sw,
             status_bit::DONE,
-            self.main.is_none() && self.sup_job.is_none(),
+            self.main.is_none() && self.sup_job.is_none() && self.sync.is_none(),
         );
         let standstill = self
             .standstill_since
@@ -592,7 +599,7 @@ impl Axis {
         set(
             &mut sw,
             status_bit::STANDSTILL,
-            standstill && self.cfg.kind == AxisKind::Positioning,
+            standstill && self.cfg.kind != AxisKind::Speed,
         );
         set(
             &mut sw,
@@ -664,6 +671,18 @@ impl Axis {
                 Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
             ),
         );
+        let sync_phase = self.sync.map(|j| j.phase);
+        set(
+            &mut sw,
+            status_bit::SYNCHRONIZING,
+            sync_phase == Some(super::sync::SyncPhase::Synchronizing),
+        );
+        set(
+            &mut sw,
+            status_bit::SYNCHRONOUS,
+            sync_phase == Some(super::sync::SyncPhase::Synchronous),
+        );
+        set(&mut sw, status_bit::PHASING_COMMAND, self.phasing.is_some());
         if self.cfg.kind == AxisKind::Speed {
             sw &= status_bit::SPEED_AXIS_MASK;
         }
@@ -684,7 +703,12 @@ impl Axis {
                     | Instruction::MotionInVelocity,
                 ) => AxisState::ContinuousMotion,
                 Some(_) => AxisState::DiscreteMotion,
+                None if self.sync.is_some() => AxisState::SynchronizedMotion,
                 None if self.sup_job.is_some() => AxisState::DiscreteMotion,
+                // After MC_GearOut the axis keeps moving with no job (PLCopen).
+                None if matches!(self.goal, Goal::Velocity { .. }) && tot.v != 0.0 => {
+                    AxisState::ContinuousMotion
+                }
                 None => AxisState::Standstill,
             }
         };
@@ -705,6 +729,18 @@ impl Axis {
             position_unwrapped: tot.p,
             motion_job: self.main.map(|m| (m.id, m.instr)),
             superimposed_job: self.sup_job.map(|s| (s.id, Instruction::MoveSuperimposed)),
+            sync_job: self.sync.map(|s| (s.id, s.instr)),
+            sync_function: match self.sync.map(|s| s.instr) {
+                Some(Instruction::GearIn) => 1,
+                Some(Instruction::GearInPos) => 2,
+                _ => 0,
+            },
+            sync_status_word: if self.sync.is_some() {
+                self.sync_flags
+            } else {
+                0
+            },
+            phase_shift: self.phase.p,
         };
     }
 }

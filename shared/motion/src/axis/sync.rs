@@ -1,0 +1,800 @@
+//! Synchronous operation of a synchronous axis (seed 001 §1.6, §3.2): relative gearing
+//! (MC_GearIn), absolute gearing with synchronization in advance (MC_GearInPos), MC_GearOut and
+//! phasing. The leading value is an input of each cycle ([`Axis::set_leading_value`]); once
+//! synchronous, the follower setpoint is the coupling function of the leading value, exactly.
+
+use super::{Axis, AxisKind, Goal, SyncDirection, SyncProfileReference};
+use crate::alarm::{supplement, AlarmId};
+use crate::dynamics::Dynamics;
+use crate::error_id::ErrorId;
+use crate::job::{Instruction, JobEventKind, JobId};
+use crate::leading::{LeaderId, LeadingValue};
+use crate::override_table::{table2, NewJob, RunningSync};
+use crate::profile::{plan_position, plan_velocity, Limits, Profile, State};
+
+/// Phase of a synchronous operation job.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(super) enum SyncPhase {
+    /// Waiting for the start condition (Busy, neither StartSync nor InSync).
+    Pending,
+    /// Synchronizing (`StartSync`, StatusWord.X21).
+    Synchronizing,
+    /// Synchronous (`InGear` / `InSync`, StatusWord.X22).
+    Synchronous,
+}
+
+/// A quintic polynomial of the leading value, on `[x0, x0 + len]` (len may be negative).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(super) struct Quintic {
+    x0: f64,
+    len: f64,
+    c: [f64; 6],
+}
+
+impl Quintic {
+    /// The quintic with value, first and second derivative (in x) given at both ends.
+    fn hermite(x0: f64, len: f64, start: (f64, f64, f64), end: (f64, f64, f64)) -> Self {
+        let (p0, v0, a0) = (start.0, start.1 * len, start.2 * len * len);
+        let (p1, v1, a1) = (end.0, end.1 * len, end.2 * len * len);
+        let d = p1 - p0;
+        let c = [
+            p0,
+            v0,
+            0.5 * a0,
+            10.0 * d - 6.0 * v0 - 4.0 * v1 - 0.5 * (3.0 * a0 - a1),
+            -15.0 * d + 8.0 * v0 + 7.0 * v1 + 0.5 * (3.0 * a0 - 2.0 * a1),
+            6.0 * d - 3.0 * (v0 + v1) - 0.5 * (a0 - a1),
+        ];
+        Self { x0, len, c }
+    }
+
+    /// Value, first, second and third derivative with respect to x.
+    #[inline]
+    fn eval(&self, x: f64) -> [f64; 4] {
+        let u = (x - self.x0) / self.len;
+        let c = &self.c;
+        let p = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * (c[4] + u * c[5]))));
+        let du = c[1] + u * (2.0 * c[2] + u * (3.0 * c[3] + u * (4.0 * c[4] + u * 5.0 * c[5])));
+        let ddu = 2.0 * c[2] + u * (6.0 * c[3] + u * (12.0 * c[4] + u * 20.0 * c[5]));
+        let dddu = 6.0 * c[3] + u * (24.0 * c[4] + u * 60.0 * c[5]);
+        let l = self.len;
+        [p, du / l, ddu / (l * l), dddu / (l * l * l)]
+    }
+}
+
+/// The coupling law of a job.
+// The profile lives inline on purpose: jobs start between cycles of the cyclic executive, where
+// nothing may allocate.
+#[allow(clippy::large_enum_variant)]
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(super) enum SyncLaw {
+    /// MC_GearIn: synchronizing is a relative profile (follower minus ratio times leader) that
+    /// brings relative velocity and acceleration to zero; then `offset + ratio * x`.
+    Gear { rel: Profile, t0: i64, offset: f64 },
+    /// MC_GearInPos: synchronizing follows a quintic of the leading value from `x_start` to
+    /// `x_sync`; then `y_sync + ratio * (x - x_sync)`.
+    GearPos {
+        msp: f64,
+        ssp: f64,
+        reference: SyncProfileReference,
+        msd: f64,
+        direction: SyncDirection,
+        /// Direction the leader travels in (+1 / -1), fixed when the job first sees it.
+        lead_dir: f64,
+        x_sync: f64,
+        x_start: f64,
+        y_sync: f64,
+        quintic: Option<Quintic>,
+    },
+}
+
+/// A synchronous operation job.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(super) struct SyncJob {
+    pub id: JobId,
+    pub instr: Instruction,
+    pub master: LeaderId,
+    pub ratio: f64,
+    pub lim: Limits,
+    pub phase: SyncPhase,
+    pub law: SyncLaw,
+    /// The law has been set up from the first leading value.
+    pub ready: bool,
+}
+
+impl SyncJob {
+    /// The follower's coordinates moved by `delta` (homing): the coupling moves with them.
+    pub(super) fn shift_follower(&mut self, delta: f64) {
+        match &mut self.law {
+            SyncLaw::Gear { rel, offset, .. } => {
+                *offset += delta;
+                *rel = rel.shifted(delta);
+            }
+            SyncLaw::GearPos {
+                y_sync, quintic, ..
+            } => {
+                *y_sync += delta;
+                if let Some(q) = quintic {
+                    q.c[0] += delta;
+                }
+            }
+        }
+    }
+}
+
+/// A phasing job: a profile of the phase shift (leading value units).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(super) struct PhasingJob {
+    pub id: JobId,
+    pub instr: Instruction,
+    pub prof: Profile,
+    pub t0: i64,
+}
+
+fn ratio_of(num: i32, den: i32) -> Result<f64, ErrorId> {
+    if num == 0 {
+        return Err(ErrorId::IllegalRatioNumerator);
+    }
+    if den < 1 {
+        return Err(ErrorId::IllegalRatioDenominator);
+    }
+    Ok(f64::from(num) / f64::from(den))
+}
+
+impl Axis {
+    /// The leaders this axis needs leading values for in the next cycle (active job first).
+    pub fn leaders(&self) -> [Option<LeaderId>; 2] {
+        [
+            self.sync.map(|s| s.master),
+            self.sync_pending.map(|s| s.master),
+        ]
+    }
+
+    /// Hands the axis the value of leader `id` for its next cycle (`None`: not available).
+    pub fn set_leading_value(&mut self, id: LeaderId, lv: Option<LeadingValue>) {
+        if self.sync.map(|s| s.master) == Some(id) {
+            self.lead[0] = lv;
+        }
+        if self.sync_pending.map(|s| s.master) == Some(id) {
+            self.lead[1] = lv;
+        }
+    }
+
+    fn require_synchronous(&self) -> Result<(), ErrorId> {
+        if self.cfg.kind != AxisKind::Synchronous {
+            return Err(ErrorId::IllegalObject);
+        }
+        Ok(())
+    }
+
+    /// The table-2 classes of the running synchronous operation jobs.
+    fn running_sync(&self) -> [(RunningSync, bool); 3] {
+        let active = self.sync.map(|s| match s.instr {
+            Instruction::GearInPos => RunningSync::GearInPosActive,
+            _ => RunningSync::GearIn,
+        });
+        [
+            (active.unwrap_or(RunningSync::GearIn), active.is_some()),
+            (RunningSync::GearInPosPending, self.sync_pending.is_some()),
+            (RunningSync::Phasing, self.phasing.is_some()),
+        ]
+    }
+
+    /// Aborts the synchronous operation jobs that `new` overrides (seed 001 §3.3 table 2).
+    pub(super) fn apply_table2(&mut self, new: NewJob) {
+        let [active, pending, phasing] = self.running_sync();
+        if active.1 && table2(new, active.0).aborts() {
+            self.abort_sync(JobEventKind::CommandAborted);
+        }
+        if pending.1 && table2(new, pending.0).aborts() {
+            if let Some(p) = self.sync_pending.take() {
+                self.emit(p.id, p.instr, JobEventKind::CommandAborted);
+            }
+        }
+        if phasing.1 && table2(new, phasing.0).aborts() {
+            self.abort_phasing(JobEventKind::CommandAborted);
+        }
+    }
+
+    /// Ends the active synchronous operation (the phase shift is reset with it).
+    pub(super) fn abort_sync(&mut self, how: JobEventKind) {
+        if let Some(s) = self.sync.take() {
+            self.emit(s.id, s.instr, how);
+        }
+        self.abort_phasing(how);
+        self.phase = State::default();
+        if self.goal == Goal::Sync {
+            // The caller sets the next goal; until then hold the current motion.
+            self.goal = Goal::Velocity {
+                v: self.basic.v,
+                lim: self.default_limits(),
+            };
+            self.replan();
+        }
+    }
+
+    fn abort_phasing(&mut self, how: JobEventKind) {
+        if let Some(p) = self.phasing.take() {
+            self.emit(p.id, p.instr, how);
+        }
+    }
+
+    /// Starts an active synchronous operation job (table 1 and 2 as for an active sync job).
+    fn activate_sync(&mut self, mut job: SyncJob, new: NewJob) {
+        self.apply_override_table(new);
+        self.fold_superimposed();
+        self.force_position_control();
+        // Until the first leading value sets the coupling up, the current motion goes on from
+        // the (folded) setpoint.
+        self.replan();
+        job.ready = false;
+        self.sync = Some(job);
+    }
+
+    pub(super) fn cmd_gear_in(
+        &mut self,
+        master: LeaderId,
+        num: i32,
+        den: i32,
+        dynamics: &Dynamics,
+    ) -> Result<JobId, ErrorId> {
+        self.require_synchronous()?;
+        self.check_motion_allowed()?;
+        let ratio = ratio_of(num, den)?;
+        let d = Dynamics {
+            velocity: -1.0,
+            ..*dynamics
+        };
+        let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+        self.warn_clamped(r.clamped);
+        let id = self.new_id();
+        self.emit(id, Instruction::GearIn, JobEventKind::Busy);
+        let lim = Limits {
+            vel: self.cfg.limits.max_velocity,
+            ..r.limits
+        };
+        let job = SyncJob {
+            id,
+            instr: Instruction::GearIn,
+            master,
+            ratio,
+            lim,
+            phase: SyncPhase::Synchronizing,
+            law: SyncLaw::Gear {
+                rel: Profile::hold(State::default()),
+                t0: 0,
+                offset: 0.0,
+            },
+            ready: false,
+        };
+        self.activate_sync(job, NewJob::GearIn);
+        Ok(id)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn cmd_gear_in_pos(
+        &mut self,
+        master: LeaderId,
+        num: i32,
+        den: i32,
+        msp: f64,
+        ssp: f64,
+        reference: SyncProfileReference,
+        msd: f64,
+        dynamics: &Dynamics,
+        direction: SyncDirection,
+    ) -> Result<JobId, ErrorId> {
+        self.require_synchronous()?;
+        self.check_motion_allowed()?;
+        let ratio = ratio_of(num, den)?;
+        if !msp.is_finite() {
+            return Err(ErrorId::IllegalMasterSyncPosition);
+        }
+        if !ssp.is_finite() {
+            return Err(ErrorId::IllegalSlaveSyncPosition);
+        }
+        if reference == SyncProfileReference::MasterStartDistance && !(msd.is_finite() && msd > 0.0)
+        {
+            return Err(ErrorId::IllegalMasterStartDistance);
+        }
+        let r = self
+            .cfg
+            .limits
+            .resolve(&self.cfg.defaults, dynamics, false)?;
+        self.warn_clamped(r.clamped);
+        let id = self.new_id();
+        self.emit(id, Instruction::GearInPos, JobEventKind::Busy);
+        let job = SyncJob {
+            id,
+            instr: Instruction::GearInPos,
+            master,
+            ratio,
+            lim: r.limits,
+            phase: SyncPhase::Pending,
+            law: SyncLaw::GearPos {
+                msp,
+                ssp,
+                reference,
+                msd,
+                direction,
+                lead_dir: 0.0,
+                x_sync: 0.0,
+                x_start: 0.0,
+                y_sync: 0.0,
+                quintic: None,
+            },
+            ready: false,
+        };
+        // A pending job aborts nothing but an older pending one (tables 1 and 2, "pending").
+        self.apply_override_table(NewJob::GearInPosPending);
+        self.sync_pending = Some(job);
+        self.lead[1] = None;
+        Ok(id)
+    }
+
+    pub(super) fn cmd_gear_out(&mut self) -> Result<JobId, ErrorId> {
+        self.require_synchronous()?;
+        let Some(s) = self.sync.filter(|s| s.phase != SyncPhase::Pending) else {
+            return Err(ErrorId::NoSynchronousOperation);
+        };
+        let id = self.new_id();
+        self.emit(id, Instruction::GearOut, JobEventKind::Busy);
+        let v = self.basic.v;
+        self.sync = None;
+        self.emit(s.id, s.instr, JobEventKind::CommandAborted);
+        self.abort_phasing(JobEventKind::CommandAborted);
+        self.phase = State::default();
+        // PLCopen: the follower continues with the velocity it has (acceleration released).
+        let lim = Limits {
+            vel: self.cfg.limits.max_velocity.max(v.abs()),
+            ..self.default_limits()
+        };
+        self.set_goal(Goal::Velocity { v, lim });
+        self.emit(id, Instruction::GearOut, JobEventKind::Done);
+        Ok(id)
+    }
+
+    pub(super) fn cmd_phasing(
+        &mut self,
+        shift: f64,
+        absolute: bool,
+        dynamics: &Dynamics,
+    ) -> Result<JobId, ErrorId> {
+        self.require_synchronous()?;
+        if !shift.is_finite() {
+            return Err(ErrorId::IllegalPhaseShift);
+        }
+        let Some(s) = self.sync else {
+            return Err(ErrorId::NoSynchronousOperation);
+        };
+        if s.phase != SyncPhase::Synchronous {
+            return Err(ErrorId::SynchronizingActive);
+        }
+        let r = self
+            .cfg
+            .limits
+            .resolve(&self.cfg.defaults, dynamics, false)?;
+        self.warn_clamped(r.clamped);
+        self.apply_table2(NewJob::Phasing);
+        let instr = if absolute {
+            Instruction::PhasingAbsolute
+        } else {
+            Instruction::PhasingRelative
+        };
+        let target = if absolute {
+            shift
+        } else {
+            self.phase.p + shift
+        };
+        let prof =
+            plan_position(self.phase, target, &r.limits).map_err(|_| ErrorId::IllegalPhaseShift)?;
+        let id = self.new_id();
+        self.emit(id, instr, JobEventKind::Busy);
+        self.phasing = Some(PhasingJob {
+            id,
+            instr,
+            prof,
+            t0: self.now,
+        });
+        Ok(id)
+    }
+
+    /// The cyclic part: pending start conditions, set-up, the coupling law, job events.
+    /// Runs after the basic setpoint of the current goal was computed for this cycle.
+    pub(super) fn sync_step(&mut self) {
+        if let Some(mut p) = self.sync_pending {
+            match self.lead[1] {
+                None => {
+                    self.raise(AlarmId::LeaderMissing, supplement::NONE);
+                    return;
+                }
+                Some(lv) => {
+                    if let Some(started) = self.pending_start(&mut p, lv) {
+                        self.sync_pending = None;
+                        if started {
+                            self.lead[0] = Some(lv);
+                            self.apply_override_table(NewJob::GearInPosActive);
+                            self.fold_superimposed();
+                            self.force_position_control();
+                            self.emit(p.id, p.instr, JobEventKind::StartSync);
+                            p.phase = SyncPhase::Synchronizing;
+                            self.sync = Some(p);
+                            self.goal = Goal::Sync;
+                        }
+                    } else {
+                        self.sync_pending = Some(p);
+                    }
+                }
+            }
+        }
+        let Some(mut job) = self.sync else {
+            return;
+        };
+        let Some(lv) = self.lead[0] else {
+            self.raise(AlarmId::LeaderMissing, supplement::NONE);
+            return;
+        };
+        if let Some(ph) = self.phasing {
+            self.phase = ph.prof.at(self.elapsed(ph.t0));
+            if self.elapsed(ph.t0) >= ph.prof.duration() {
+                self.phase = ph.prof.end();
+                self.phasing = None;
+                self.emit(ph.id, ph.instr, JobEventKind::Done);
+            }
+        }
+        let x = State {
+            p: lv.p + self.phase.p,
+            v: lv.v + self.phase.v,
+            a: lv.a + self.phase.a,
+        };
+        let g = job.ratio;
+        if !job.ready {
+            // Set up from this cycle's follower setpoint (from the previous goal) and leader.
+            if let SyncLaw::Gear { rel, t0, .. } = &mut job.law {
+                let r = State {
+                    p: self.basic.p - g * x.p,
+                    v: self.basic.v - g * x.v,
+                    a: self.basic.a - g * x.a,
+                };
+                *rel = plan_velocity(
+                    r,
+                    0.0,
+                    &Limits {
+                        vel: job.lim.vel.max(r.v.abs()),
+                        ..job.lim
+                    },
+                )
+                .unwrap_or_else(|_| {
+                    Profile::hold(State {
+                        v: 0.0,
+                        a: 0.0,
+                        ..r
+                    })
+                });
+                *t0 = self.now;
+            }
+            job.ready = true;
+            self.goal = Goal::Sync;
+        }
+        let mut events = [None; 2];
+        match &mut job.law {
+            SyncLaw::Gear { rel, t0, offset } => {
+                if job.phase == SyncPhase::Synchronizing {
+                    let e = self.elapsed(*t0);
+                    let r = rel.at(e);
+                    self.basic = State {
+                        p: g * x.p + r.p,
+                        v: g * x.v + r.v,
+                        a: g * x.a + r.a,
+                    };
+                    if e >= rel.duration() {
+                        *offset = rel.end().p;
+                        job.phase = SyncPhase::Synchronous;
+                        events[0] = Some(JobEventKind::InGear);
+                    }
+                } else {
+                    self.basic = State {
+                        p: *offset + g * x.p,
+                        v: g * x.v,
+                        a: g * x.a,
+                    };
+                }
+            }
+            SyncLaw::GearPos {
+                lead_dir,
+                x_sync,
+                y_sync,
+                quintic,
+                ..
+            } => {
+                if job.phase == SyncPhase::Synchronizing && *lead_dir * (x.p - *x_sync) < 0.0 {
+                    if x.v * *lead_dir < 0.0 {
+                        // The leading value reversed during synchronization (alarm 608).
+                        self.sync = Some(job);
+                        self.raise(AlarmId::SynchronizationError, supplement::NONE);
+                        return;
+                    }
+                    if let Some(q) = quintic {
+                        let [y, d1, d2, _] = q.eval(x.p);
+                        self.basic = State {
+                            p: y,
+                            v: d1 * x.v,
+                            a: d2 * x.v * x.v + d1 * x.a,
+                        };
+                    }
+                } else {
+                    if job.phase == SyncPhase::Synchronizing {
+                        job.phase = SyncPhase::Synchronous;
+                        events[0] = Some(JobEventKind::InSync);
+                    }
+                    self.basic = State {
+                        p: *y_sync + g * (x.p - *x_sync),
+                        v: g * x.v,
+                        a: g * x.a,
+                    };
+                }
+            }
+        }
+        self.sync = Some(job);
+        for e in events.into_iter().flatten() {
+            self.emit(job.id, job.instr, e);
+        }
+        // Synchronous followers are not limited by their own dynamics: flag exceedances.
+        let lim = &self.cfg.limits;
+        let b = self.total();
+        let mut flags = 0u8;
+        if b.v.abs() > lim.max_velocity * (1.0 + 1e-12) {
+            flags |= 1;
+        }
+        if b.v * b.a > 0.0 && b.a.abs() > lim.max_acceleration * (1.0 + 1e-12) {
+            flags |= 2;
+        }
+        if b.v * b.a < 0.0 && b.a.abs() > lim.max_deceleration * (1.0 + 1e-12) {
+            flags |= 4;
+        }
+        self.sync_flags = flags;
+    }
+
+    /// Pending GearInPos: sets the sync positions up on first sight of the leader and checks the
+    /// start condition. `Some(true)`: start now; `Some(false)`: the job ended with an error;
+    /// `None`: still pending.
+    fn pending_start(&mut self, job: &mut SyncJob, lv: LeadingValue) -> Option<bool> {
+        let g = job.ratio;
+        // The total setpoint: a superimposed motion is folded into the coupling when it starts.
+        let follower = self.total();
+        let cfg_mod = self.cfg.modulo;
+        let SyncLaw::GearPos {
+            msp,
+            ssp,
+            reference,
+            msd,
+            direction,
+            lead_dir,
+            x_sync,
+            x_start,
+            y_sync,
+            quintic,
+        } = &mut job.law
+        else {
+            return Some(false);
+        };
+        if *lead_dir == 0.0 {
+            // The leader approaches the sync position: on a linear leader the direction towards
+            // it; on a modulo leader the direction it moves in (positive at standstill).
+            *lead_dir = match lv.modulo {
+                None if *msp != lv.p => (*msp - lv.p).signum(),
+                _ if lv.v < 0.0 => -1.0,
+                _ => 1.0,
+            };
+        }
+        let dir = *lead_dir;
+        // Synchronization length: the start distance, or from the dynamics at the leader's
+        // current velocity.
+        let len = match reference {
+            SyncProfileReference::MasterStartDistance => *msd,
+            SyncProfileReference::Dynamics => {
+                if lv.v == 0.0 {
+                    return None;
+                }
+                sync_length(follower, g, lv, &job.lim, |l| {
+                    target_rep(
+                        *ssp,
+                        cfg_mod,
+                        *direction,
+                        follower.p,
+                        follower.p + g * l * dir,
+                    )
+                })
+            }
+        };
+        // The next sync position ahead of the leader with room for the synchronization, fixed
+        // when the job first sees the leader.
+        let xs = match lv.modulo {
+            Some(_) if job.ready => *x_sync,
+            Some(m) => {
+                let ahead = if dir > 0.0 {
+                    m.forward(lv.p, *msp)
+                } else {
+                    -m.forward(*msp, lv.p)
+                };
+                let mut xs = lv.p + ahead;
+                if dir * (xs - lv.p) < len - 1e-12 * m.length {
+                    xs += dir * m.length * ((len - dir * (xs - lv.p)) / m.length).ceil();
+                }
+                xs
+            }
+            None => *msp,
+        };
+        if !job.ready || *reference == SyncProfileReference::Dynamics {
+            *x_sync = xs;
+            *x_start = xs - dir * len;
+        }
+        if !job.ready {
+            job.ready = true;
+            if lv.modulo.is_none() && dir * (*x_start - lv.p) < 0.0 {
+                if *reference == SyncProfileReference::MasterStartDistance {
+                    // The leader is already inside the start distance.
+                    self.emit(
+                        job.id,
+                        job.instr,
+                        JobEventKind::Error(ErrorId::IllegalMasterStartDistance),
+                    );
+                    return Some(false);
+                }
+                // Dynamics: start at once over the remaining distance.
+                *x_start = lv.p;
+            }
+        }
+        // Start when the leader passes the start position; with the dynamics reference one
+        // cycle early rather than late, so that the remaining length is never shorter than the
+        // one the dynamics need.
+        let ahead = match reference {
+            SyncProfileReference::Dynamics => lv.v * self.cfg.cycle,
+            SyncProfileReference::MasterStartDistance => 0.0,
+        };
+        if dir * (lv.p + ahead - *x_start) < 0.0 {
+            return None;
+        }
+        // Start: the quintic from this cycle's follower state to the sync point.
+        let len = *x_sync - lv.p;
+        let yt = target_rep(*ssp, cfg_mod, *direction, follower.p, follower.p + g * len);
+        *y_sync = yt;
+        let (d1, d2) = if lv.v.abs() > 1e-12 {
+            let d1 = follower.v / lv.v;
+            (d1, (follower.a - d1 * lv.a) / (lv.v * lv.v))
+        } else {
+            (0.0, 0.0)
+        };
+        *quintic = (len.abs() > 0.0)
+            .then(|| Quintic::hermite(lv.p, len, (follower.p, d1, d2), (yt, g, 0.0)));
+        Some(true)
+    }
+}
+
+/// The continuous representation of the follower sync position `ssp`: on a modulo follower the
+/// one nearest to `natural` (where the follower would be if it were synchronous already) that
+/// `direction` allows from `here`.
+fn target_rep(
+    ssp: f64,
+    modulo: Option<crate::modulo::Modulo>,
+    direction: SyncDirection,
+    here: f64,
+    natural: f64,
+) -> f64 {
+    let Some(m) = modulo else {
+        return ssp;
+    };
+    let near = natural + m.shortest(natural, ssp);
+    match direction {
+        SyncDirection::Shortest => near,
+        SyncDirection::Positive => {
+            if near < here {
+                near + m.length * ((here - near) / m.length).ceil()
+            } else {
+                near
+            }
+        }
+        SyncDirection::Negative => {
+            if near > here {
+                near - m.length * ((near - here) / m.length).ceil()
+            } else {
+                near
+            }
+        }
+    }
+}
+
+/// Synchronization length (leading value distance) for SyncProfileReference 0: the shortest
+/// length for which the quintic synchronization at the leader's current velocity keeps the
+/// follower within its velocity (or the synchronous velocity, if higher), acceleration and jerk.
+fn sync_length(
+    follower: State,
+    g: f64,
+    lv: LeadingValue,
+    lim: &Limits,
+    target: impl Fn(f64) -> f64,
+) -> f64 {
+    let v = lv.v.abs();
+    let vmax = lim.vel.max((g * lv.v).abs()).max(follower.v.abs());
+    let amax = lim.acc.min(lim.dec);
+    let (d1, d2) = (
+        follower.v / lv.v,
+        (follower.a - follower.v / lv.v * lv.a) / (lv.v * lv.v),
+    );
+    let dir = lv.v.signum();
+    let feasible = |l: f64| -> bool {
+        let q = Quintic::hermite(0.0, dir * l, (follower.p, d1, d2), (target(l), g, 0.0));
+        (0..=64).all(|i| {
+            let [_, y1, y2, y3] = q.eval(dir * l * f64::from(i) / 64.0);
+            (y1 * v).abs() <= vmax * (1.0 + 1e-9)
+                && (y2 * v * v).abs() <= amax * (1.0 + 1e-9)
+                && (lim.jerk == 0.0 || (y3 * v * v * v).abs() <= lim.jerk * (1.0 + 1e-9))
+        })
+    };
+    // Grow until feasible, then bisect (feasibility is monotonic in practice).
+    let mut hi = (v * v / amax).max(v * 1e-3).max(1e-9);
+    let mut n = 0;
+    while !feasible(hi) && n < 60 {
+        hi *= 2.0;
+        n += 1;
+    }
+    let mut lo = hi / 2.0;
+    if n == 0 {
+        lo = 0.0;
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if feasible(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quintic_meets_its_boundary_conditions() {
+        let q = Quintic::hermite(10.0, -4.0, (1.0, 0.5, 0.25), (7.0, 2.0, -1.0));
+        let [p0, d0, a0, _] = q.eval(10.0);
+        let [p1, d1, a1, _] = q.eval(6.0);
+        for (x, y) in [
+            (p0, 1.0),
+            (d0, 0.5),
+            (a0, 0.25),
+            (p1, 7.0),
+            (d1, 2.0),
+            (a1, -1.0),
+        ] {
+            assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn target_representation_respects_the_direction() {
+        let m = crate::modulo::Modulo {
+            start: 0.0,
+            length: 360.0,
+        };
+        assert_eq!(
+            target_rep(10.0, Some(m), SyncDirection::Shortest, 0.0, 355.0),
+            370.0
+        );
+        assert_eq!(
+            target_rep(10.0, Some(m), SyncDirection::Negative, 0.0, 355.0),
+            10.0 - 360.0
+        );
+        assert_eq!(
+            target_rep(10.0, Some(m), SyncDirection::Positive, 400.0, 355.0),
+            730.0
+        );
+        assert_eq!(
+            target_rep(10.0, None, SyncDirection::Positive, 400.0, 355.0),
+            10.0
+        );
+    }
+}

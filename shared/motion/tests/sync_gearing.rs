@@ -1,0 +1,565 @@
+//! Synchronous operation: MC_GearIn, MC_GearInPos, MC_GearOut, phasing (seed 001 §1.6, §3.2,
+//! table 2). A leader and a follower in one process, the leader stepped first (D = 0).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use proptest::prelude::*;
+use tandem_motion::alarm::{status_bit, AlarmId};
+use tandem_motion::axis::{
+    Axis, AxisConfig, AxisKind, AxisState, AxisStatus, Command, Direction, StartMode, StopMode,
+    SyncDirection, SyncProfileReference, VelocityDirection,
+};
+use tandem_motion::dynamics::Dynamics;
+use tandem_motion::error_id::ErrorId;
+use tandem_motion::job::{JobEvent, JobEventKind, JobId};
+use tandem_motion::leading::LeadingValue;
+use tandem_motion::modulo::Modulo;
+
+const LEADER: u32 = 7;
+
+struct Pair {
+    leader: Axis,
+    follower: Axis,
+    k: i64,
+    events: Vec<JobEvent>,
+}
+
+fn power() -> Command {
+    Command::Power {
+        enable: true,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Emergency,
+    }
+}
+
+fn dynamics(v: f64, a: f64, d: f64, j: f64) -> Dynamics {
+    Dynamics {
+        velocity: v,
+        acceleration: a,
+        deceleration: d,
+        jerk: j,
+    }
+}
+
+impl Pair {
+    fn new(leader: AxisConfig, mut follower: AxisConfig) -> Self {
+        follower.kind = AxisKind::Synchronous;
+        let mut p = Self {
+            leader: Axis::new(leader).unwrap(),
+            follower: Axis::new(follower).unwrap(),
+            k: 0,
+            events: vec![],
+        };
+        p.step(1);
+        p.leader.command(&power()).unwrap();
+        p.follower.command(&power()).unwrap();
+        p.leader
+            .command(&Command::Home {
+                mode: 0,
+                position: 0.0,
+            })
+            .unwrap();
+        p.follower
+            .command(&Command::Home {
+                mode: 0,
+                position: 0.0,
+            })
+            .unwrap();
+        p.step(1);
+        p
+    }
+
+    fn lv(&self) -> LeadingValue {
+        let s = self.leader.status();
+        LeadingValue {
+            p: s.position_unwrapped,
+            v: s.velocity,
+            a: s.acceleration,
+            modulo: self.leader.config().modulo,
+        }
+    }
+
+    fn step(&mut self, n: usize) {
+        for _ in 0..n {
+            let t = self.k * 1_000_000;
+            self.leader.step(t);
+            let lv = self.lv();
+            for id in self.follower.leaders().into_iter().flatten() {
+                self.follower
+                    .set_leading_value(id, (id == LEADER).then_some(lv));
+            }
+            self.follower.step(t);
+            while let Some(e) = self.follower.pop_event() {
+                self.events.push(e);
+            }
+            while self.leader.pop_event().is_some() {}
+            self.k += 1;
+        }
+    }
+
+    fn f(&mut self, c: Command) -> Result<JobId, ErrorId> {
+        let r = self.follower.command(&c);
+        while let Some(e) = self.follower.pop_event() {
+            self.events.push(e);
+        }
+        r
+    }
+
+    fn has(&self, job: JobId, kind: JobEventKind) -> bool {
+        self.events.iter().any(|e| e.job == job && e.kind == kind)
+    }
+
+    fn until(&mut self, job: JobId, kind: JobEventKind, max: usize) {
+        for _ in 0..max {
+            if self.has(job, kind) {
+                return;
+            }
+            self.step(1);
+        }
+        panic!(
+            "job {job}: no {kind:?} within {max} cycles: {:?}",
+            self.events
+        );
+    }
+
+    fn fs(&self) -> AxisStatus {
+        *self.follower.status()
+    }
+}
+
+fn gear_in(num: i32, den: i32) -> Command {
+    Command::GearIn {
+        master: LEADER,
+        ratio_numerator: num,
+        ratio_denominator: den,
+        dynamics: dynamics(-1.0, 2000.0, 2000.0, 40000.0),
+    }
+}
+
+#[test]
+fn gear_in_synchronizes_then_follows_exactly() {
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(100.0, 1000.0, 1000.0, 10000.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    p.step(50);
+    let g = p.f(gear_in(3, 2)).unwrap();
+    assert_eq!(p.fs().state, AxisState::SynchronizedMotion);
+    p.step(1);
+    assert!(p.fs().has(status_bit::SYNCHRONIZING));
+    p.until(g, JobEventKind::InGear, 5000);
+    assert!(p.fs().has(status_bit::SYNCHRONOUS));
+    assert_eq!(p.fs().sync_function, 1);
+    let offset = p.fs().position_unwrapped - 1.5 * p.lv().p;
+    // Leader: reversals and stops; follower: exactly offset + 1.5 x in every cycle.
+    for target in [500.0, -200.0, 50.0] {
+        p.leader
+            .command(&Command::MoveAbsolute {
+                position: target,
+                dynamics: dynamics(300.0, 3000.0, 2000.0, 50000.0),
+                direction: Direction::Shortest,
+            })
+            .unwrap();
+        for _ in 0..1500 {
+            p.step(1);
+            let s = p.fs();
+            let x = p.lv();
+            assert!(
+                (s.position_unwrapped - (offset + 1.5 * x.p)).abs() <= 1e-9 * 1000.0,
+                "{} vs {}",
+                s.position_unwrapped,
+                offset + 1.5 * x.p
+            );
+            assert_eq!(s.velocity, 1.5 * x.v);
+            assert_eq!(s.acceleration, 1.5 * x.a);
+        }
+    }
+    assert!(!p.has(g, JobEventKind::CommandAborted));
+}
+
+#[test]
+fn gear_in_checks_its_inputs_and_the_axis_type() {
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    assert_eq!(p.f(gear_in(0, 1)), Err(ErrorId::IllegalRatioNumerator));
+    assert_eq!(p.f(gear_in(1, 0)), Err(ErrorId::IllegalRatioDenominator));
+    assert_eq!(p.f(Command::GearOut), Err(ErrorId::NoSynchronousOperation));
+    assert_eq!(
+        p.f(Command::Phasing {
+            phase_shift: 1.0,
+            absolute: false,
+            dynamics: Dynamics::DEFAULT
+        }),
+        Err(ErrorId::NoSynchronousOperation)
+    );
+    // A positioning axis cannot follow.
+    assert_eq!(
+        p.leader.command(&gear_in(1, 1)),
+        Err(ErrorId::IllegalObject)
+    );
+}
+
+#[test]
+fn gear_out_continues_with_the_current_velocity_and_table_2() {
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(80.0, -1.0, -1.0, -1.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    let g = p.f(gear_in(-1, 1)).unwrap();
+    p.until(g, JobEventKind::InGear, 5000);
+    // MoveSuperimposed on a follower does not abort gearing (table 2) and moves only it.
+    let s = p
+        .f(Command::MoveSuperimposed {
+            distance: 10.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    assert!(
+        !p.has(g, JobEventKind::CommandAborted),
+        "table 2: superimposed does not abort GearIn"
+    );
+    p.until(s, JobEventKind::Done, 3000);
+    let before = p.fs();
+    let out = p.f(Command::GearOut).unwrap();
+    assert!(p.has(out, JobEventKind::Done));
+    assert!(p.has(g, JobEventKind::CommandAborted));
+    p.step(300);
+    let after = p.fs();
+    assert!((after.velocity + 80.0).abs() < 1e-9, "{}", after.velocity);
+    assert!((before.velocity + 80.0).abs() < 1e-9);
+    assert_eq!(after.state, AxisState::ContinuousMotion);
+    // Halt aborts gearing (table 2).
+    let alarms: Vec<_> = p.follower.alarms().collect();
+    assert!(alarms.is_empty(), "{alarms:?} {:?}", p.fs());
+    let g = p.f(gear_in(1, 1)).unwrap();
+    p.step(10);
+    let alarms: Vec<_> = p.follower.alarms().collect();
+    assert!(alarms.is_empty(), "{alarms:?} {:?}", p.fs());
+    let h = p
+        .f(Command::Halt {
+            deceleration: -1.0,
+            jerk: -1.0,
+            abort_acceleration: false,
+        })
+        .unwrap();
+    assert!(p.has(g, JobEventKind::CommandAborted));
+    p.until(h, JobEventKind::Done, 3000);
+}
+
+fn gear_in_pos(msp: f64, ssp: f64, msd: f64, reference: SyncProfileReference) -> Command {
+    Command::GearInPos {
+        master: LEADER,
+        ratio_numerator: 1,
+        ratio_denominator: 1,
+        master_sync_position: msp,
+        slave_sync_position: ssp,
+        sync_profile_reference: reference,
+        master_start_distance: msd,
+        dynamics: dynamics(400.0, 4000.0, 4000.0, 100000.0),
+        sync_direction: SyncDirection::Shortest,
+    }
+}
+
+#[test]
+fn gear_in_pos_is_synchronous_exactly_at_the_sync_positions() {
+    // Leader at constant 100; MasterSyncPosition 300, SlaveSyncPosition 50, MasterStartDistance
+    // 100: StartSync when the leader passes 200, InSync at 300 with the follower at 50.
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(100.0, 1000.0, 1000.0, 0.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    let m = p
+        .f(Command::MoveVelocity {
+            dynamics: dynamics(20.0, -1.0, -1.0, -1.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    let g = p
+        .f(gear_in_pos(
+            300.0,
+            50.0,
+            100.0,
+            SyncProfileReference::MasterStartDistance,
+        ))
+        .unwrap();
+    assert!(
+        !p.has(m, JobEventKind::CommandAborted),
+        "a pending GearInPos aborts nothing"
+    );
+    let mut started_at = None;
+    let mut insync_at = None;
+    for _ in 0..4000 {
+        p.step(1);
+        let x = p.lv().p;
+        if started_at.is_none() && p.has(g, JobEventKind::StartSync) {
+            started_at = Some(x);
+            assert!(
+                p.has(m, JobEventKind::CommandAborted),
+                "StartSync aborts the motion"
+            );
+        }
+        if insync_at.is_none() && p.has(g, JobEventKind::InSync) {
+            insync_at = Some(x);
+        }
+        if x >= 300.0 {
+            assert!(
+                (p.fs().position_unwrapped - (50.0 + (x - 300.0))).abs() < 1e-9,
+                "x {x}: {}",
+                p.fs().position_unwrapped
+            );
+        }
+        if x > 400.0 {
+            break;
+        }
+    }
+    let s = started_at.unwrap();
+    assert!((200.0..200.0 + 0.1 + 1e-9).contains(&s), "StartSync at {s}");
+    let i = insync_at.unwrap();
+    assert!((300.0..300.1 + 1e-9).contains(&i), "InSync at {i}");
+}
+
+#[test]
+fn gear_in_pos_inside_the_start_distance_is_an_error_and_reversal_is_alarm_608() {
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    p.leader
+        .command(&Command::Home {
+            mode: 0,
+            position: 250.0,
+        })
+        .unwrap();
+    p.step(1);
+    let g = p
+        .f(gear_in_pos(
+            300.0,
+            0.0,
+            100.0,
+            SyncProfileReference::MasterStartDistance,
+        ))
+        .unwrap();
+    p.step(2);
+    assert!(p.has(g, JobEventKind::Error(ErrorId::IllegalMasterStartDistance)));
+    // Reversal during synchronization.
+    p.leader
+        .command(&Command::Home {
+            mode: 0,
+            position: 0.0,
+        })
+        .unwrap();
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(100.0, 1000.0, 1000.0, 0.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    let g = p
+        .f(gear_in_pos(
+            300.0,
+            0.0,
+            250.0,
+            SyncProfileReference::MasterStartDistance,
+        ))
+        .unwrap();
+    p.until(g, JobEventKind::StartSync, 2000);
+    p.step(200);
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(100.0, 1000.0, 1000.0, 0.0),
+            direction: VelocityDirection::Negative,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    p.until(g, JobEventKind::Error(ErrorId::TechnologyAlarm), 2000);
+    assert!(p.follower.has_alarm(AlarmId::SynchronizationError));
+}
+
+#[test]
+fn phasing_shifts_the_leading_value() {
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(50.0, -1.0, -1.0, -1.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    let g = p.f(gear_in(2, 1)).unwrap();
+    p.until(g, JobEventKind::InGear, 5000);
+    let offset = p.fs().position_unwrapped - 2.0 * p.lv().p;
+    // Relative 50 twice: 100 in total; the follower moves 2 * 100 more.
+    for _ in 0..2 {
+        let ph = p
+            .f(Command::Phasing {
+                phase_shift: 50.0,
+                absolute: false,
+                dynamics: Dynamics::DEFAULT,
+            })
+            .unwrap();
+        assert!(p.fs().has(status_bit::PHASING_COMMAND));
+        p.until(ph, JobEventKind::Done, 5000);
+    }
+    p.step(1);
+    assert!((p.fs().phase_shift - 100.0).abs() < 1e-9);
+    assert!((p.fs().position_unwrapped - (offset + 2.0 * (p.lv().p + 100.0))).abs() < 1e-9);
+    // Absolute to the same value: no motion.
+    let ph = p
+        .f(Command::Phasing {
+            phase_shift: 100.0,
+            absolute: true,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    p.until(ph, JobEventKind::Done, 10);
+    // Overriding the gearing resets the shift.
+    p.f(Command::Halt {
+        deceleration: -1.0,
+        jerk: -1.0,
+        abort_acceleration: false,
+    })
+    .unwrap();
+    p.step(1);
+    assert_eq!(p.fs().phase_shift, 0.0);
+}
+
+#[test]
+fn gear_in_pos_on_modulo_axes_with_dynamics_reference() {
+    // Modulo leader and follower (360); sync by dynamics: the follower keeps its limits while
+    // synchronizing behind a constant-speed leader and is synchronous at the next 90 degrees.
+    let mut lc = AxisConfig::example(0.001);
+    lc.modulo = Some(Modulo {
+        start: 0.0,
+        length: 360.0,
+    });
+    let mut fc = AxisConfig::example(0.001);
+    fc.modulo = Some(Modulo {
+        start: 0.0,
+        length: 360.0,
+    });
+    fc.limits.max_velocity = 1000.0;
+    let mut p = Pair::new(lc, fc);
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(200.0, 2000.0, 2000.0, 0.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    p.step(500);
+    let g = p
+        .f(Command::GearInPos {
+            master: LEADER,
+            ratio_numerator: 1,
+            ratio_denominator: 1,
+            master_sync_position: 90.0,
+            slave_sync_position: 180.0,
+            sync_profile_reference: SyncProfileReference::Dynamics,
+            master_start_distance: -1.0,
+            dynamics: dynamics(400.0, 1500.0, 1500.0, 30000.0),
+            sync_direction: SyncDirection::Shortest,
+        })
+        .unwrap();
+    p.until(g, JobEventKind::StartSync, 10_000);
+    let mut max_a: f64 = 0.0;
+    let mut max_v: f64 = 0.0;
+    while !p.has(g, JobEventKind::InSync) {
+        p.step(1);
+        if p.k > 30_000 {
+            panic!("no InSync");
+        }
+        max_a = max_a.max(p.fs().acceleration.abs());
+        max_v = max_v.max(p.fs().velocity.abs());
+    }
+    assert!(max_a <= 1500.0 * (1.0 + 1e-6), "{max_a}");
+    assert!(max_v <= 400.0 * (1.0 + 1e-6), "{max_v}");
+    p.step(1);
+    let s = p.fs();
+    let x = p.follower.status();
+    let _ = x;
+    let leader_mod = p.leader.status().position;
+    // Synchronous: follower = 180 + (leader - 90) modulo 360.
+    let expect = Modulo {
+        start: 0.0,
+        length: 360.0,
+    }
+    .wrap(180.0 + leader_mod - 90.0);
+    assert!(
+        (s.position - expect).abs() < 1e-9,
+        "{} vs {expect}",
+        s.position
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5e_ed_6e_a2), ..ProptestConfig::default() })]
+
+    /// Exact synchronism for random ratios and leader profiles, and GearInPos hitting the sync
+    /// positions exactly for constant-speed and accelerating leaders.
+    #[test]
+    fn gearing_is_exact(
+        num in prop_oneof![-5i32..-1, 1i32..6], den in 1i32..5,
+        moves in prop::collection::vec((-800.0f64..800.0, 50.0f64..400.0), 1..4),
+        msd in 20.0f64..200.0, accel in prop::bool::ANY,
+    ) {
+        let g = f64::from(num) / f64::from(den);
+        let mut fc = AxisConfig::example(0.001);
+        fc.limits.max_velocity = 5000.0;
+        fc.following_error.enable = false;
+        let mut p = Pair::new(AxisConfig::example(0.001), fc);
+        let gid = p.f(gear_in(num, den)).unwrap();
+        p.until(gid, JobEventKind::InGear, 5000);
+        let offset = p.fs().position_unwrapped - g * p.lv().p;
+        for (target, v) in &moves {
+            p.leader.command(&Command::MoveAbsolute { position: *target, dynamics: dynamics(*v, 2000.0, 1500.0, 30000.0), direction: Direction::Shortest }).unwrap();
+            for _ in 0..800 {
+                p.step(1);
+                let s = p.fs();
+                prop_assert!((s.position_unwrapped - (offset + g * p.lv().p)).abs() <= 1e-9 * 1000.0 * g.abs().max(1.0));
+            }
+        }
+        // GearInPos: the leader starts from rest 500 before the sync position, constant speed
+        // or accelerating through the synchronization; exact at MasterSyncPosition.
+        let x0 = p.lv().p;
+        let msp = x0 + 500.0;
+        let lead = if accel { dynamics(400.0, 300.0, 300.0, 0.0) } else { dynamics(150.0, 5000.0, 5000.0, 0.0) };
+        p.leader.command(&Command::MoveVelocity { dynamics: lead, direction: VelocityDirection::Positive, current: false, position_controlled: true }).unwrap();
+        let gp = p.f(Command::GearInPos {
+            master: LEADER, ratio_numerator: num, ratio_denominator: den,
+            master_sync_position: msp, slave_sync_position: 123.0,
+            sync_profile_reference: SyncProfileReference::MasterStartDistance, master_start_distance: msd,
+            dynamics: Dynamics::DEFAULT, sync_direction: SyncDirection::Shortest,
+        }).unwrap();
+        let mut prev = p.fs().position_unwrapped;
+        for _ in 0..20_000 {
+            p.step(1);
+            let x = p.lv().p;
+            let y = p.fs().position_unwrapped;
+            if x >= msp {
+                prop_assert!(p.has(gp, JobEventKind::InSync));
+                prop_assert!((y - (123.0 + g * (x - msp))).abs() <= 1e-9 * 1000.0 * g.abs().max(1.0), "{} vs {}", y, 123.0 + g * (x - msp));
+            }
+            prop_assert!(y.is_finite() && (y - prev).abs() < 100.0);
+            prev = y;
+            if x > msp + 50.0 { break; }
+        }
+        prop_assert!(p.has(gp, JobEventKind::InSync));
+    }
+}
