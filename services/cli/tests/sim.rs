@@ -104,3 +104,53 @@ fn check_reports_file_line_and_key() {
     assert!(out.contains("is valid"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn flying_saw_is_synchronous_at_every_cut() {
+    let dir = std::env::temp_dir().join(format!("tandem-saw-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let trace = dir.join("saw.csv");
+    let (code, log, err) = run(&[
+        "sim",
+        root().join("config/flying-saw.toml").to_str().unwrap(),
+        "--script",
+        root()
+            .join("config/flying-saw-script.toml")
+            .to_str()
+            .unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+        "--strict",
+    ]);
+    assert_eq!(code, 0, "{err}\n{log}");
+    assert_eq!(log.matches(": InSync").count(), 3, "{log}");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (t, x, y, job) = (
+        col("time_s"),
+        col("material.position"),
+        col("saw.position"),
+        col("saw.job"),
+    );
+    let mut synchronous_rows = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let xv: f64 = f[x].parse().unwrap();
+        let yv: f64 = f[y].parse().unwrap();
+        let tv: f64 = f[t].parse().unwrap();
+        // While MC_GearInPos runs past its sync position the saw is 100 + (x - cut) exactly.
+        for cut in [1000.0, 2000.0, 3000.0] {
+            if f[job] == "MC_GearInPos" && xv >= cut && xv < cut + 150.0 {
+                assert!(
+                    (yv - (100.0 + xv - cut)).abs() < 1e-9,
+                    "t {tv}: saw {yv}, material {xv}"
+                );
+                synchronous_rows += 1;
+            }
+        }
+    }
+    assert!(synchronous_rows >= 3 * 300, "{synchronous_rows}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -4,8 +4,11 @@
 //! references' input names in snake case (`position`, `velocity`, `abort_acceleration`...).
 //! Defaults are the references' defaults (dynamics -1.0 = the axis defaults).
 
-use tandem_motion::axis::{Command, Direction, StartMode, StopMode, VelocityDirection};
+use tandem_motion::axis::{
+    Command, Direction, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+};
 use tandem_motion::dynamics::Dynamics;
+use tandem_motion::leading::LeaderId;
 
 /// A parameter value.
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -140,7 +143,50 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("position_controlled", Some(Value::Bool(true))),
         ],
     },
+    InstructionSpec {
+        name: "MC_GearIn",
+        params: &[
+            ("ratio_numerator", Some(Value::Num(1.0))),
+            ("ratio_denominator", Some(Value::Num(1.0))),
+            DYN[1],
+            DYN[2],
+            DYN[3],
+        ],
+    },
+    InstructionSpec {
+        name: "MC_GearInPos",
+        params: &[
+            ("ratio_numerator", Some(Value::Num(1.0))),
+            ("ratio_denominator", Some(Value::Num(1.0))),
+            ("master_sync_position", None),
+            ("slave_sync_position", None),
+            ("sync_profile_reference", Some(Value::Num(1.0))),
+            ("master_start_distance", Some(Value::Num(1.0))),
+            DYN[0],
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            ("sync_direction", Some(Value::Num(3.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_GearOut",
+        params: &[],
+    },
+    InstructionSpec {
+        name: "MC_PhasingAbsolute",
+        params: &[("phase_shift", None), DYN[0], DYN[1], DYN[2], DYN[3]],
+    },
+    InstructionSpec {
+        name: "MC_PhasingRelative",
+        params: &[("phase_shift", None), DYN[0], DYN[1], DYN[2], DYN[3]],
+    },
 ];
+
+/// Instructions that name a leader (`master = "<axis>"`).
+pub fn needs_master(spec: &InstructionSpec) -> bool {
+    matches!(spec.name, "MC_GearIn" | "MC_GearInPos")
+}
 
 fn normalize(s: &str) -> String {
     let s = s.to_ascii_lowercase().replace(['_', '-'], "");
@@ -191,6 +237,15 @@ impl Args<'_> {
         Ok(x as i32)
     }
 
+    fn dynamics_no_velocity(&self) -> Result<Dynamics, String> {
+        Ok(Dynamics {
+            velocity: -1.0,
+            acceleration: self.num("acceleration")?,
+            deceleration: self.num("deceleration")?,
+            jerk: self.num("jerk")?,
+        })
+    }
+
     fn dynamics(&self, vel_key: &str) -> Result<Dynamics, String> {
         Ok(Dynamics {
             velocity: self.num(vel_key)?,
@@ -202,8 +257,13 @@ impl Args<'_> {
 }
 
 /// Builds a command. Unknown instructions and parameters, missing required parameters and
-/// values of the wrong type are errors naming what was wrong.
-pub fn parse(instruction: &str, params: &[(String, Value)]) -> Result<Command, String> {
+/// values of the wrong type are errors naming what was wrong. `master` is the leader the
+/// instruction names (resolved by the caller), for the instructions that need one.
+pub fn parse(
+    instruction: &str,
+    params: &[(String, Value)],
+    master: Option<LeaderId>,
+) -> Result<Command, String> {
     let spec = find(instruction).ok_or_else(|| {
         let names: Vec<&str> = INSTRUCTIONS.iter().map(|i| i.name).collect();
         format!(
@@ -225,7 +285,48 @@ pub fn parse(instruction: &str, params: &[(String, Value)]) -> Result<Command, S
         spec,
         given: params,
     };
+    let leader = || {
+        master.ok_or_else(|| {
+            format!(
+                "{}: parameter `master` (the leading axis) is required",
+                spec.name
+            )
+        })
+    };
+    let ratio = |k: &str| -> Result<i32, String> { a.code(k) };
     let cmd = match spec.name {
+        "MC_GearIn" => Command::GearIn {
+            master: leader()?,
+            ratio_numerator: ratio("ratio_numerator")?,
+            ratio_denominator: ratio("ratio_denominator")?,
+            dynamics: a.dynamics_no_velocity()?,
+        },
+        "MC_GearInPos" => Command::GearInPos {
+            master: leader()?,
+            ratio_numerator: ratio("ratio_numerator")?,
+            ratio_denominator: ratio("ratio_denominator")?,
+            master_sync_position: a.num("master_sync_position")?,
+            slave_sync_position: a.num("slave_sync_position")?,
+            sync_profile_reference: match a.code("sync_profile_reference")? {
+                0 => SyncProfileReference::Dynamics,
+                1 => SyncProfileReference::MasterStartDistance,
+                _ => return Err("MC_GearInPos: sync_profile_reference must be 0 or 1".into()),
+            },
+            master_start_distance: a.num("master_start_distance")?,
+            dynamics: a.dynamics("velocity")?,
+            sync_direction: match a.code("sync_direction")? {
+                1 => SyncDirection::Positive,
+                2 => SyncDirection::Negative,
+                3 => SyncDirection::Shortest,
+                _ => return Err("MC_GearInPos: sync_direction must be 1, 2 or 3".into()),
+            },
+        },
+        "MC_GearOut" => Command::GearOut,
+        "MC_PhasingAbsolute" | "MC_PhasingRelative" => Command::Phasing {
+            phase_shift: a.num("phase_shift")?,
+            absolute: spec.name == "MC_PhasingAbsolute",
+            dynamics: a.dynamics("velocity")?,
+        },
         "MC_Power" => Command::Power {
             enable: a.flag("enable")?,
             start_mode: match a.code("start_mode")? {
@@ -336,6 +437,7 @@ mod tests {
                 p("position", Value::Num(40.0)),
                 p("direction", Value::Num(3.0)),
             ],
+            None,
         )
         .unwrap();
         assert_eq!(
@@ -346,16 +448,18 @@ mod tests {
                 direction: Direction::Shortest
             }
         );
-        assert!(parse("MoveAbsolute", &[])
+        assert!(parse("MoveAbsolute", &[], None)
             .unwrap_err()
             .contains("`position` is required"));
-        assert!(parse("MoveAbsolute", &[p("postion", Value::Num(1.0))])
-            .unwrap_err()
-            .contains("unknown parameter `postion`"));
-        assert!(parse("MC_Power", &[p("enable", Value::Num(1.0))])
+        assert!(
+            parse("MoveAbsolute", &[p("postion", Value::Num(1.0))], None)
+                .unwrap_err()
+                .contains("unknown parameter `postion`")
+        );
+        assert!(parse("MC_Power", &[p("enable", Value::Num(1.0))], None)
             .unwrap_err()
             .contains("true or false"));
-        assert!(parse("MC_Home", &[p("mode", Value::Num(2.5))])
+        assert!(parse("MC_Home", &[p("mode", Value::Num(2.5))], None)
             .unwrap_err()
             .contains("integer"));
     }
@@ -369,7 +473,7 @@ mod tests {
                 .filter(|(_, d)| d.is_none())
                 .map(|(k, _)| p(k, Value::Num(1.0)))
                 .collect();
-            assert!(parse(spec.name, &given).is_ok(), "{}", spec.name);
+            assert!(parse(spec.name, &given, Some(0)).is_ok(), "{}", spec.name);
         }
     }
 }

@@ -10,6 +10,9 @@
 //! instruction = "MC_Power"
 //! enable = true           # the instruction's parameters follow
 //! ```
+//!
+//! Synchronous operation names its leader: `master = "<axis>"` (the leader's id is its index
+//! in the cell's axis list, in name order).
 
 use crate::command::{self, Value};
 use crate::ConfigError;
@@ -125,9 +128,29 @@ pub fn parse(file: &str, src: &str, axes: &[&str]) -> Result<Script, ConfigError
                 .get("instruction")
                 .and_then(|x| x.as_str())
                 .ok_or_else(|| e(line, &key, "`instruction` is required".into()))?;
+            // A leader is named by its axis name; its id is the axis' index in the cell.
+            let master = match t.get("master") {
+                None => None,
+                Some(m) => {
+                    let name = m
+                        .as_str()
+                        .ok_or_else(|| e(line, &key, "`master` must be an axis name".into()))?;
+                    let idx = axes.iter().position(|a| *a == name).ok_or_else(|| {
+                        e(
+                            line,
+                            &key,
+                            format!("unknown master `{name}`; the cell has: {}", axes.join(", ")),
+                        )
+                    })?;
+                    if name == axis {
+                        return Err(e(line, &key, format!("axis `{axis}` cannot follow itself")));
+                    }
+                    Some(idx as u32)
+                }
+            };
             let mut params = Vec::new();
             for (k, v) in t.iter() {
-                if matches!(k, "t" | "axis" | "instruction") {
+                if matches!(k, "t" | "axis" | "instruction" | "master") {
                     continue;
                 }
                 let value = if let Some(b) = v.as_bool() {
@@ -143,7 +166,7 @@ pub fn parse(file: &str, src: &str, axes: &[&str]) -> Result<Script, ConfigError
                 };
                 params.push((k.to_string(), value));
             }
-            let command = command::parse(instr, &params).map_err(|m| e(line, &key, m))?;
+            let command = command::parse(instr, &params, master).map_err(|m| e(line, &key, m))?;
             let name = command::find(instr).map(|s| s.name).unwrap_or("?");
             entries.push(ScriptEntry {
                 t_ns: time,

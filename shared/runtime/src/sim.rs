@@ -5,8 +5,10 @@
 use std::io::{self, Write};
 use tandem_config::script::Script;
 use tandem_config::Cell;
-use tandem_motion::axis::{Axis, AxisStatus};
+use tandem_motion::axis::{Axis, AxisStatus, Command};
+use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::JobEventKind;
+use tandem_motion::leading::{LeaderId, LeadingValue};
 
 /// The per-axis columns of the trace, in order (prefixed with `<axis>.`).
 pub const AXIS_COLUMNS: &[&str] = &[
@@ -56,7 +58,11 @@ pub fn seconds(t_ns: i64) -> String {
 fn write_row(out: &mut impl Write, t_ns: i64, status: &[AxisStatus]) -> io::Result<()> {
     write!(out, "{}", seconds(t_ns))?;
     for s in status {
-        let job = s.motion_job.map(|(_, i)| i.name()).unwrap_or("");
+        let job = s
+            .motion_job
+            .or(s.sync_job)
+            .map(|(_, i)| i.name())
+            .unwrap_or("");
         write!(
             out,
             ",{},{},{},{},{},{},{},{},{},{},{},{},{}",
@@ -76,6 +82,36 @@ fn write_row(out: &mut impl Write, t_ns: i64, status: &[AxisStatus]) -> io::Resu
         )?;
     }
     writeln!(out)
+}
+
+/// Whether `follower` appears in the leader chain of `leader` (a recursive coupling).
+fn recursive(axes: &[Axis], follower: usize, leader: usize) -> bool {
+    let mut stack = vec![leader];
+    let mut seen = vec![false; axes.len()];
+    while let Some(i) = stack.pop() {
+        if i == follower {
+            return true;
+        }
+        if std::mem::replace(&mut seen[i], true) {
+            continue;
+        }
+        for l in axes[i].leaders().into_iter().flatten() {
+            if let Some(j) = usize::try_from(l).ok().filter(|j| *j < axes.len()) {
+                stack.push(j);
+            }
+        }
+    }
+    false
+}
+
+fn leading_value(axis: &Axis) -> LeadingValue {
+    let s = axis.status();
+    LeadingValue {
+        p: s.position_unwrapped,
+        v: s.velocity,
+        a: s.acceleration,
+        modulo: axis.config().modulo,
+    }
 }
 
 fn describe(kind: JobEventKind) -> String {
@@ -141,25 +177,64 @@ pub fn run(
                 continue;
             };
             summary.commands += 1;
-            match axes[i].command(&e.command) {
-                Ok(_) => {}
-                Err(id) => {
-                    summary.rejected += 1;
-                    writeln!(
-                        log,
-                        "t={} {} {} rejected: {id} ({})",
-                        seconds(t),
-                        e.axis,
-                        e.instruction,
-                        id.description()
-                    )?;
+            let master = match e.command {
+                Command::GearIn { master, .. } | Command::GearInPos { master, .. } => Some(master),
+                _ => None,
+            };
+            let result = match master.and_then(|m| usize::try_from(m).ok()) {
+                Some(m) if recursive(&axes, i, m) => Err(ErrorId::RecursiveSyncChain),
+                _ => axes[i].command(&e.command),
+            };
+            if let Err(id) = result {
+                summary.rejected += 1;
+                writeln!(
+                    log,
+                    "t={} {} {} rejected: {id} ({})",
+                    seconds(t),
+                    e.axis,
+                    e.instruction,
+                    id.description()
+                )?;
+            }
+        }
+        // Leaders before their followers: an axis steps once every leader it needs has.
+        let mut stepped = vec![false; axes.len()];
+        for _pass in 0..=axes.len() {
+            for i in 0..axes.len() {
+                if stepped[i] {
+                    continue;
                 }
+                let needs: [Option<LeaderId>; 2] = axes[i].leaders();
+                let ready = needs.iter().flatten().all(|l| {
+                    usize::try_from(*l)
+                        .ok()
+                        .map(|j| j >= axes.len() || stepped[j])
+                        .unwrap_or(true)
+                });
+                if !ready {
+                    continue;
+                }
+                for l in needs.into_iter().flatten() {
+                    let lv = usize::try_from(l)
+                        .ok()
+                        .filter(|j| *j < axes.len())
+                        .map(|j| leading_value(&axes[j]));
+                    axes[i].set_leading_value(l, lv);
+                }
+                if t % cycles[i] == 0 {
+                    axes[i].step(t);
+                }
+                stepped[i] = true;
+            }
+        }
+        // Not reached only with a coupling loop, which commands cannot create (16#8019): the
+        // axis then runs without its leading value and raises "leader missing".
+        for (i, axis) in axes.iter_mut().enumerate() {
+            if !stepped[i] && t % cycles[i] == 0 {
+                axis.step(t);
             }
         }
         for (i, axis) in axes.iter_mut().enumerate() {
-            if t % cycles[i] == 0 {
-                axis.step(t);
-            }
             while let Some(ev) = axis.pop_event() {
                 writeln!(
                     log,
