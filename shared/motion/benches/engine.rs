@@ -485,3 +485,73 @@ mod profile_at {
         });
     }
 }
+
+/// One cycle of a following axis in synchronous operation (the leading value is computed, not
+/// stepped, so only the follower is timed).
+#[divan::bench_group(sample_count = 3000, sample_size = 1000)]
+mod follower_step {
+    use super::*;
+    use tandem_motion::axis::{Axis, AxisConfig, AxisKind, Command, StartMode, StopMode};
+    use tandem_motion::dynamics::Dynamics;
+    use tandem_motion::job::JobEventKind;
+    use tandem_motion::leading::LeadingValue;
+
+    const MS: i64 = 1_000_000;
+
+    fn lv(k: i64) -> LeadingValue {
+        LeadingValue {
+            p: 100.0 * k as f64 * 1e-3,
+            v: 100.0,
+            a: 0.0,
+            modulo: None,
+        }
+    }
+
+    /// A follower geared 3:2 to a leader at 100/s, in sync.
+    fn geared() -> (Axis, i64) {
+        let mut cfg = AxisConfig::example(0.001);
+        cfg.kind = AxisKind::Synchronous;
+        cfg.following_error.enable = false;
+        let mut axis = Axis::new(cfg).unwrap();
+        axis.step(0);
+        axis.command(&Command::Power {
+            enable: true,
+            start_mode: StartMode::PositionControlled,
+            stop_mode: StopMode::Emergency,
+        })
+        .unwrap();
+        let id = axis
+            .command(&Command::GearIn {
+                master: 1,
+                ratio_numerator: 3,
+                ratio_denominator: 2,
+                dynamics: Dynamics::DEFAULT,
+            })
+            .unwrap();
+        let mut k = 1;
+        let mut in_gear = false;
+        while k < 5000 {
+            axis.set_leading_value(1, Some(lv(k)));
+            axis.step(k * MS);
+            while let Some(e) = axis.pop_event() {
+                in_gear |= e.job == id && e.kind == JobEventKind::InGear;
+            }
+            k += 1;
+        }
+        assert!(in_gear);
+        (axis, k)
+    }
+
+    #[divan::bench]
+    fn gear_in_synchronous(bencher: divan::Bencher) {
+        let (mut axis, mut k) = geared();
+        bencher.bench_local(|| {
+            let a = black_box(&mut axis);
+            a.set_leading_value(1, Some(lv(k)));
+            a.step(black_box(k * MS));
+            k += 1;
+        });
+        assert!(axis.alarms().next().is_none());
+        assert!((axis.status().velocity - 150.0).abs() < 1e-9);
+    }
+}

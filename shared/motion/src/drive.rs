@@ -96,6 +96,8 @@ pub struct SimDrive {
     v_cmd: f64,
     balanced: f64,
     prev_p: f64,
+    /// `exp(-dt / T_vtc)` of the position-loop model.
+    decay: f64,
 }
 
 impl SimDrive {
@@ -116,6 +118,10 @@ impl SimDrive {
             v_cmd: 0.0,
             balanced: p0,
             prev_p: p0,
+            decay: match model {
+                DriveModel::PositionLoop { t_vtc, .. } if t_vtc > 0.0 => (-cycle / t_vtc).exp(),
+                _ => 0.0,
+            },
         }
     }
 
@@ -187,11 +193,7 @@ impl SimDrive {
             DriveModel::PositionLoop { kv, kpc, t_vtc } => {
                 // Balanced setpoint: dead time of one cycle, then the velocity-loop model.
                 let (bp_in, _) = self.hist_at(1);
-                let e = if t_vtc > 0.0 {
-                    (-dt / t_vtc).exp()
-                } else {
-                    0.0
-                };
+                let e = self.decay;
                 // Velocity command computed from this cycle's values, effective after the
                 // transport delay (it was computed last cycle: v_cmd).
                 let v_cmd = self.v_cmd;

@@ -461,8 +461,7 @@ impl Axis {
         let ovr = self.override_pct / 100.0;
         let planned = match self.goal {
             Goal::Sync => {
-                // The coupling law computes the setpoint; nothing to plan.
-                self.t0 = self.now;
+                // The coupling law computes the setpoint (and owns the profile slot).
                 return;
             }
             Goal::Hold | Goal::Direct { .. } | Goal::Track => {
@@ -1437,6 +1436,10 @@ impl Axis {
         }
         if let Some(s) = self.sync.as_mut() {
             s.shift_follower(delta);
+            if self.goal == Goal::Sync {
+                // A synchronizing GearIn keeps its relative profile in the profile slot.
+                self.prof = self.prof.shifted(delta);
+            }
         }
         self.replan();
     }

@@ -65,7 +65,7 @@ impl Axis {
             },
             _ => self.prof.at(self.elapsed(self.t0) + dt),
         };
-        let sup = match self.sup_job {
+        let sup = match &self.sup_job {
             Some(j) => j.prof.at(self.elapsed(j.t0) + dt),
             None => self.sup,
         };
@@ -106,7 +106,7 @@ impl Axis {
             }
             _ => self.basic = self.prof.at(self.elapsed(self.t0)),
         }
-        if let Some(j) = self.sup_job {
+        if let Some(j) = &self.sup_job {
             self.sup = j.prof.at(self.elapsed(j.t0));
         }
     }
@@ -409,12 +409,15 @@ impl Axis {
 
     fn update_jobs(&mut self) {
         let finished = self.elapsed(self.t0) >= self.prof.duration();
-        if let Some(j) = self.sup_job {
-            if self.elapsed(j.t0) >= j.prof.duration() {
-                self.sup = j.prof.end();
-                self.sup_job = None;
-                self.emit(j.id, Instruction::MoveSuperimposed, JobEventKind::Done);
-            }
+        let sup_done = self
+            .sup_job
+            .as_ref()
+            .filter(|j| self.elapsed(j.t0) >= j.prof.duration())
+            .map(|j| (j.id, j.prof.end()));
+        if let Some((id, end)) = sup_done {
+            self.sup = end;
+            self.sup_job = None;
+            self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Done);
         }
         if self.power.disabling && finished {
             self.remove_enable();

@@ -63,14 +63,12 @@ impl Quintic {
 }
 
 /// The coupling law of a job.
-// The profile lives inline on purpose: jobs start between cycles of the cyclic executive, where
-// nothing may allocate.
-#[allow(clippy::large_enum_variant)]
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub(super) enum SyncLaw {
     /// MC_GearIn: synchronizing is a relative profile (follower minus ratio times leader) that
-    /// brings relative velocity and acceleration to zero; then `offset + ratio * x`.
-    Gear { rel: Profile, t0: i64, offset: f64 },
+    /// brings relative velocity and acceleration to zero (kept in the axis' profile slot, which
+    /// the synchronous goal does not otherwise use); then `offset + ratio * x`.
+    Gear { offset: f64 },
     /// MC_GearInPos: synchronizing follows a quintic of the leading value from `x_start` to
     /// `x_sync`; then `y_sync + ratio * (x - x_sync)`.
     GearPos {
@@ -106,10 +104,7 @@ impl SyncJob {
     /// The follower's coordinates moved by `delta` (homing): the coupling moves with them.
     pub(super) fn shift_follower(&mut self, delta: f64) {
         match &mut self.law {
-            SyncLaw::Gear { rel, offset, .. } => {
-                *offset += delta;
-                *rel = rel.shifted(delta);
-            }
+            SyncLaw::Gear { offset } => *offset += delta,
             SyncLaw::GearPos {
                 y_sync, quintic, ..
             } => {
@@ -260,11 +255,7 @@ impl Axis {
             ratio,
             lim,
             phase: SyncPhase::Synchronizing,
-            law: SyncLaw::Gear {
-                rel: Profile::hold(State::default()),
-                t0: 0,
-                offset: 0.0,
-            },
+            law: SyncLaw::Gear { offset: 0.0 },
             ready: false,
         };
         self.activate_sync(job, NewJob::GearIn);
@@ -450,45 +441,41 @@ impl Axis {
         let g = job.ratio;
         if !job.ready {
             // Set up from this cycle's follower setpoint (from the previous goal) and leader.
-            if let SyncLaw::Gear { rel, t0, .. } = &mut job.law {
+            if let SyncLaw::Gear { .. } = job.law {
                 let r = State {
                     p: self.basic.p - g * x.p,
                     v: self.basic.v - g * x.v,
                     a: self.basic.a - g * x.a,
                 };
-                *rel = plan_velocity(
-                    r,
-                    0.0,
-                    &Limits {
-                        vel: job.lim.vel.max(r.v.abs()),
-                        ..job.lim
-                    },
-                )
-                .unwrap_or_else(|_| {
+                let lim = Limits {
+                    vel: job.lim.vel.max(r.v.abs()),
+                    ..job.lim
+                };
+                self.prof = plan_velocity(r, 0.0, &lim).unwrap_or_else(|_| {
                     Profile::hold(State {
                         v: 0.0,
                         a: 0.0,
                         ..r
                     })
                 });
-                *t0 = self.now;
+                self.t0 = self.now;
             }
             job.ready = true;
             self.goal = Goal::Sync;
         }
         let mut events = [None; 2];
         match &mut job.law {
-            SyncLaw::Gear { rel, t0, offset } => {
+            SyncLaw::Gear { offset } => {
                 if job.phase == SyncPhase::Synchronizing {
-                    let e = self.elapsed(*t0);
-                    let r = rel.at(e);
+                    let e = self.elapsed(self.t0);
+                    let r = self.prof.at(e);
                     self.basic = State {
                         p: g * x.p + r.p,
                         v: g * x.v + r.v,
                         a: g * x.a + r.a,
                     };
-                    if e >= rel.duration() {
-                        *offset = rel.end().p;
+                    if e >= self.prof.duration() {
+                        *offset = self.prof.end().p;
                         job.phase = SyncPhase::Synchronous;
                         events[0] = Some(JobEventKind::InGear);
                     }
