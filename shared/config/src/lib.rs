@@ -15,6 +15,7 @@ use tandem_motion::axis::{
 };
 use tandem_motion::drive::{DriveModel, Plant, ZeroMark};
 use tandem_motion::dynamics::{DynamicDefaults, DynamicLimits};
+use tandem_motion::extrapolation::{ExtrapolationConfig, VelocityMode};
 use tandem_motion::modulo::Modulo;
 
 /// A problem in a configuration file, located.
@@ -55,6 +56,15 @@ pub struct Node {
     pub cycle_ns: i64,
 }
 
+/// How a follower reads a leader.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Coupling {
+    /// The leader's setpoint.
+    Setpoint,
+    /// The leader's actual value, filtered and extrapolated.
+    Actual,
+}
+
 /// An axis of the cell, with the node that hosts it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AxisEntry {
@@ -64,6 +74,18 @@ pub struct AxisEntry {
     pub node: usize,
     /// Engine configuration.
     pub config: AxisConfig,
+    /// The leaders it may follow (index into [`Cell::axes`]) and how; `None`: any, by setpoint.
+    pub leaders: Option<Vec<(usize, Coupling)>>,
+}
+
+impl AxisEntry {
+    /// How this axis reads leader `leader`, or `None` if it may not follow it.
+    pub fn coupling(&self, leader: usize) -> Option<Coupling> {
+        match &self.leaders {
+            None => Some(Coupling::Setpoint),
+            Some(list) => list.iter().find(|(i, _)| *i == leader).map(|(_, c)| *c),
+        }
+    }
 }
 
 /// A validated cell.
@@ -179,7 +201,43 @@ pub fn parse(file: &str, src: &str) -> Result<Cell, ConfigError> {
             name: name.clone(),
             node,
             config,
+            leaders: None,
         });
+    }
+    // Leader tables refer to axes by name: resolve them once every axis is known.
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    for (entry, (name, a)) in axes.iter_mut().zip(raw.axes.iter()) {
+        let Some(table) = &a.leaders else {
+            continue;
+        };
+        let mut list = Vec::new();
+        for (leader, kind) in table {
+            let path = ["axes", name.as_str(), "leaders", leader.as_str()];
+            let idx = names.iter().position(|n| n == leader).ok_or_else(|| {
+                err(
+                    &path,
+                    format!(
+                        "unknown leader `{leader}`; the cell has: {}",
+                        names.join(", ")
+                    ),
+                )
+            })?;
+            if leader == name {
+                return Err(err(&path, "an axis cannot lead itself".into()));
+            }
+            let coupling = match kind.as_str() {
+                "setpoint" => Coupling::Setpoint,
+                "actual" => Coupling::Actual,
+                other => {
+                    return Err(err(
+                        &path,
+                        format!("`{other}` is not one of setpoint, actual"),
+                    ));
+                }
+            };
+            list.push((idx, coupling));
+        }
+        entry.leaders = Some(list);
     }
     Ok(Cell {
         name: raw.cell.name,
@@ -328,6 +386,25 @@ fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, FieldError> {
             hw_limit_max: hw.and_then(|h| h.max),
         },
         initial_position: a.initial_position,
+        extrapolation: ExtrapolationConfig {
+            position_t1: a.extrapolation.position_t1,
+            position_t2: a.extrapolation.position_t2,
+            velocity_t1: a.extrapolation.velocity_t1,
+            velocity_t2: a.extrapolation.velocity_t2,
+            velocity_tolerance: a.extrapolation.velocity_tolerance,
+            hysteresis: a.extrapolation.hysteresis,
+            following_time: a.extrapolation.following_time,
+            acquisition_time: a.extrapolation.acquisition_time,
+            system_defined: a.extrapolation.system_defined,
+            velocity_mode: pick(
+                "extrapolation.velocity_mode",
+                &a.extrapolation.velocity_mode,
+                &[
+                    ("filtered", VelocityMode::Filtered),
+                    ("differentiation", VelocityMode::Differentiation),
+                ],
+            )?,
+        },
     })
 }
 

@@ -90,6 +90,70 @@ pub struct AxisSection {
     /// `[axes.<name>.plant]`.
     #[serde(default)]
     pub plant: PlantSection,
+    /// `[axes.<name>.extrapolation]`: preparation of this axis' actual value for followers
+    /// coupled by actual value.
+    #[serde(default)]
+    pub extrapolation: ExtrapolationSection,
+    /// `[axes.<name>.leaders]`: the leaders this axis may follow, `name = "setpoint"` or
+    /// `"actual"` (the coupling). Without the table any axis may lead, by setpoint.
+    pub leaders: Option<BTreeMap<String, String>>,
+}
+
+/// `[axes.<name>.extrapolation]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExtrapolationSection {
+    /// `PositionFilter.T1` (s).
+    #[serde(default)]
+    pub position_t1: f64,
+    /// `PositionFilter.T2` (s).
+    #[serde(default)]
+    pub position_t2: f64,
+    /// `VelocityFilter.T1` (s).
+    #[serde(default)]
+    pub velocity_t1: f64,
+    /// `VelocityFilter.T2` (s).
+    #[serde(default)]
+    pub velocity_t2: f64,
+    /// `VelocityTolerance.Range`.
+    #[serde(default)]
+    pub velocity_tolerance: f64,
+    /// `Hysteresis.Value`.
+    #[serde(default)]
+    pub hysteresis: f64,
+    /// `FollowingAxisDependentTime` (s).
+    #[serde(default)]
+    pub following_time: f64,
+    /// Actual value acquisition time (s).
+    #[serde(default)]
+    pub acquisition_time: f64,
+    /// `Settings.SystemDefinedExtrapolation`.
+    #[serde(default = "yes")]
+    pub system_defined: bool,
+    /// `filtered` or `differentiation`.
+    #[serde(default = "d_vmode")]
+    pub velocity_mode: String,
+}
+
+fn d_vmode() -> String {
+    "filtered".into()
+}
+
+impl Default for ExtrapolationSection {
+    fn default() -> Self {
+        Self {
+            position_t1: 0.0,
+            position_t2: 0.0,
+            velocity_t1: 0.0,
+            velocity_t2: 0.0,
+            velocity_tolerance: 0.0,
+            hysteresis: 0.0,
+            following_time: 0.0,
+            acquisition_time: 0.0,
+            system_defined: true,
+            velocity_mode: d_vmode(),
+        }
+    }
 }
 
 fn default_kind() -> String {

@@ -11,6 +11,7 @@ pub mod axis;
 pub mod drive;
 pub mod dynamics;
 pub mod error_id;
+pub mod extrapolation;
 pub mod job;
 pub mod leading;
 pub mod modulo;

@@ -21,6 +21,8 @@ struct Pair {
     follower: Axis,
     k: i64,
     events: Vec<JobEvent>,
+    /// Actual-value coupling instead of setpoint coupling.
+    actual: bool,
 }
 
 fn power() -> Command {
@@ -48,6 +50,7 @@ impl Pair {
             follower: Axis::new(follower).unwrap(),
             k: 0,
             events: vec![],
+            actual: false,
         };
         p.step(1);
         p.leader.command(&power()).unwrap();
@@ -562,4 +565,33 @@ proptest! {
         }
         prop_assert!(p.has(gp, JobEventKind::InSync));
     }
+}
+
+#[test]
+fn actual_value_coupling_compensates_the_leader_delay() {
+    // The leader's actual value lags its setpoint by T_t = 4 ms (delay model). Extrapolating
+    // by cycle (1 ms) + following time (3 ms) brings it back: at constant velocity the follower
+    // coupled by actual value is where a setpoint-coupled one would be.
+    let mut lc = AxisConfig::example(0.001);
+    lc.drive = tandem_motion::drive::DriveModel::Delay { delay: 0.004 };
+    lc.following_error.enable = false;
+    lc.extrapolation.position_t1 = 0.002;
+    lc.extrapolation.velocity_t1 = 0.005;
+    lc.extrapolation.following_time = 0.003;
+    let mut p = Pair::new(lc, AxisConfig::example(0.001));
+    p.actual = true;
+    p.leader
+        .command(&Command::MoveVelocity { dynamics: dynamics(120.0, 1000.0, 1000.0, 0.0), direction: VelocityDirection::Positive, current: false, position_controlled: true })
+        .unwrap();
+    p.step(500);
+    let g = p.f(gear_in(1, 1)).unwrap();
+    p.until(g, JobEventKind::InGear, 5000);
+    let offset = p.fs().position_unwrapped - p.lv().p;
+    p.step(200);
+    // Extrapolated actual = setpoint at constant velocity, to rounding.
+    let sp = p.leader.setpoint_leading_value();
+    let ex = p.leader.actual_leading_value();
+    assert!((ex.p - sp.p).abs() < 1e-9, "{} vs {}", ex.p, sp.p);
+    assert!((ex.v - 120.0).abs() < 1e-9);
+    assert!((p.fs().position_unwrapped - (offset + sp.p)).abs() < 1e-9);
 }

@@ -4,11 +4,11 @@
 
 use std::io::{self, Write};
 use tandem_config::script::Script;
-use tandem_config::Cell;
+use tandem_config::{Cell, Coupling};
 use tandem_motion::axis::{Axis, AxisStatus, Command};
 use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::JobEventKind;
-use tandem_motion::leading::{LeaderId, LeadingValue};
+use tandem_motion::leading::LeaderId;
 
 /// The per-axis columns of the trace, in order (prefixed with `<axis>.`).
 pub const AXIS_COLUMNS: &[&str] = &[
@@ -104,16 +104,6 @@ fn recursive(axes: &[Axis], follower: usize, leader: usize) -> bool {
     false
 }
 
-fn leading_value(axis: &Axis) -> LeadingValue {
-    let s = axis.status();
-    LeadingValue {
-        p: s.position_unwrapped,
-        v: s.velocity,
-        a: s.acceleration,
-        modulo: axis.config().modulo,
-    }
-}
-
 fn describe(kind: JobEventKind) -> String {
     match kind {
         JobEventKind::Error(e) => format!("Error {e}"),
@@ -183,6 +173,8 @@ pub fn run(
             };
             let result = match master.and_then(|m| usize::try_from(m).ok()) {
                 Some(m) if recursive(&axes, i, m) => Err(ErrorId::RecursiveSyncChain),
+                // The leader must be one of the follower's configured leaders.
+                Some(m) if cell.axes[i].coupling(m).is_none() => Err(ErrorId::IllegalObject),
                 _ => axes[i].command(&e.command),
             };
             if let Err(id) = result {
@@ -215,10 +207,14 @@ pub fn run(
                     continue;
                 }
                 for l in needs.into_iter().flatten() {
-                    let lv = usize::try_from(l)
-                        .ok()
-                        .filter(|j| *j < axes.len())
-                        .map(|j| leading_value(&axes[j]));
+                    let lv =
+                        usize::try_from(l)
+                            .ok()
+                            .filter(|j| *j < axes.len())
+                            .map(|j| match cell.axes[i].coupling(j) {
+                                Some(Coupling::Actual) => axes[j].actual_leading_value(),
+                                _ => axes[j].setpoint_leading_value(),
+                            });
                     axes[i].set_leading_value(l, lv);
                 }
                 if t % cycles[i] == 0 {

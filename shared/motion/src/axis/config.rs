@@ -2,6 +2,7 @@
 
 use crate::drive::{DriveModel, Plant};
 use crate::dynamics::{DynamicDefaults, DynamicLimits};
+use crate::extrapolation::ExtrapolationConfig;
 use crate::modulo::Modulo;
 
 /// Speed, positioning or synchronous axis (seed 001 §1.4 to §1.6).
@@ -200,6 +201,9 @@ pub struct AxisConfig {
     pub plant: Plant,
     /// Physical position of the load at start.
     pub initial_position: f64,
+    /// `Extrapolation.*`: how this axis' actual value is prepared when a follower couples to it
+    /// by actual value.
+    pub extrapolation: ExtrapolationConfig,
 }
 
 /// A configuration value that is not acceptable: which field, and why.
@@ -299,6 +303,7 @@ impl AxisConfig {
             },
             plant: Plant::default(),
             initial_position: 0.0,
+            extrapolation: ExtrapolationConfig::default(),
         }
     }
 
@@ -443,6 +448,15 @@ impl AxisConfig {
             }
         }
         finite("initial_position", self.initial_position)?;
+        let ex = &self.extrapolation;
+        non_negative("extrapolation.position_t1", ex.position_t1)?;
+        non_negative("extrapolation.position_t2", ex.position_t2)?;
+        non_negative("extrapolation.velocity_t1", ex.velocity_t1)?;
+        non_negative("extrapolation.velocity_t2", ex.velocity_t2)?;
+        non_negative("extrapolation.velocity_tolerance", ex.velocity_tolerance)?;
+        non_negative("extrapolation.hysteresis", ex.hysteresis)?;
+        non_negative("extrapolation.following_time", ex.following_time)?;
+        non_negative("extrapolation.acquisition_time", ex.acquisition_time)?;
         Ok(())
     }
 }

@@ -23,7 +23,9 @@ use crate::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
 use crate::drive::SimDrive;
 use crate::dynamics::{Clamped, Dynamics};
 use crate::error_id::ErrorId;
+use crate::extrapolation::{Extrapolated, Extrapolator};
 use crate::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
+use crate::leading::LeadingValue;
 use crate::override_table::{table1, NewJob, RunningMotion};
 use crate::profile::{plan_position, plan_velocity, Limits, Profile, State};
 
@@ -243,6 +245,8 @@ pub struct Axis {
     /// Leading values for this cycle: of the active and of the pending job's leader.
     lead: [Option<crate::leading::LeadingValue>; 2],
     sync_flags: u8,
+    /// The actual value prepared for actual-value coupling.
+    extrapolator: Extrapolator,
     alarms: [Option<AlarmInstance>; MAX_ALARMS],
     hw_trigger: Option<(Sense, f64)>,
     sw_active: Option<Sense>,
@@ -309,6 +313,7 @@ impl Axis {
             phase: State::default(),
             lead: [None; 2],
             sync_flags: 0,
+            extrapolator: Extrapolator::new(cfg.extrapolation, cfg.cycle),
             alarms: [None; MAX_ALARMS],
             hw_trigger: None,
             sw_active: None,
@@ -371,6 +376,34 @@ impl Axis {
     /// Whether the alarm `id` is pending.
     pub fn has_alarm(&self, id: AlarmId) -> bool {
         self.alarms().any(|a| a.id == id)
+    }
+
+    /// This axis as a leader with setpoint coupling: its total setpoint (continuous position).
+    pub fn setpoint_leading_value(&self) -> LeadingValue {
+        let s = &self.status;
+        LeadingValue {
+            p: s.position_unwrapped,
+            v: s.velocity,
+            a: s.acceleration,
+            modulo: self.cfg.modulo,
+        }
+    }
+
+    /// This axis as a leader with actual-value coupling: its actual value filtered and
+    /// extrapolated (`StatusExtrapolation`, see [`crate::extrapolation`]).
+    pub fn actual_leading_value(&self) -> LeadingValue {
+        let e = self.extrapolator.last();
+        LeadingValue {
+            p: e.position,
+            v: e.velocity,
+            a: e.acceleration,
+            modulo: self.cfg.modulo,
+        }
+    }
+
+    /// `StatusExtrapolation`.
+    pub fn extrapolation_status(&self) -> Extrapolated {
+        self.extrapolator.last()
     }
 
     /// Job events dropped because nobody drained them.
@@ -1421,6 +1454,8 @@ impl Axis {
     fn shift(&mut self, delta: f64) {
         self.offset += delta;
         self.actual_p += delta;
+        // Homing is a jump of the actual value: the extrapolation starts again from it.
+        self.extrapolator.reset(self.actual_p, self.actual_v);
         self.basic.p += delta;
         match &mut self.goal {
             Goal::Position { target, .. } => *target += delta,

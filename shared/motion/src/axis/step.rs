@@ -19,6 +19,7 @@ impl Axis {
         self.prev_phys = phys;
         self.actual_p = phys + self.offset;
         self.actual_v = act.v;
+        self.extrapolator.step(self.actual_p, self.actual_v);
 
         self.check_hw_limits(phys);
         self.active_homing(prev, phys);
