@@ -185,7 +185,10 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
 
 /// Instructions that name a leader (`master = "<axis>"`).
 pub fn needs_master(spec: &InstructionSpec) -> bool {
-    matches!(spec.name, "MC_GearIn" | "MC_GearInPos")
+    matches!(
+        spec.name,
+        "MC_GearIn" | "MC_GearInPos" | "MC_GearInVelocity"
+    )
 }
 
 fn normalize(s: &str) -> String {
@@ -322,6 +325,17 @@ pub fn parse(
             },
         },
         "MC_GearOut" => Command::GearOut,
+        "MC_GearInVelocity" => Command::GearInVelocity {
+            master: leader()?,
+            ratio_numerator: ratio("ratio_numerator")?,
+            ratio_denominator: ratio("ratio_denominator")?,
+            dynamics: a.dynamics_no_velocity()?,
+        },
+        "MC_OffsetAbsolute" | "MC_OffsetRelative" => Command::Offset {
+            offset: a.num("offset")?,
+            absolute: spec.name == "MC_OffsetAbsolute",
+            dynamics: a.dynamics("velocity")?,
+        },
         "MC_PhasingAbsolute" | "MC_PhasingRelative" => Command::Phasing {
             phase_shift: a.num("phase_shift")?,
             absolute: spec.name == "MC_PhasingAbsolute",

@@ -45,6 +45,12 @@ pub enum Instruction {
     GearInPos,
     /// `MC_GearOut`.
     GearOut,
+    /// `MC_GearInVelocity`.
+    GearInVelocity,
+    /// `MC_OffsetAbsolute`.
+    OffsetAbsolute,
+    /// `MC_OffsetRelative`.
+    OffsetRelative,
     /// `MC_PhasingAbsolute`.
     PhasingAbsolute,
     /// `MC_PhasingRelative`.
@@ -71,6 +77,9 @@ impl Instruction {
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::GearOut => "MC_GearOut",
+            Self::GearInVelocity => "MC_GearInVelocity",
+            Self::OffsetAbsolute => "MC_OffsetAbsolute",
+            Self::OffsetRelative => "MC_OffsetRelative",
             Self::PhasingAbsolute => "MC_PhasingAbsolute",
             Self::PhasingRelative => "MC_PhasingRelative",
         }

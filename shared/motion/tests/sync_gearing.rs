@@ -581,7 +581,12 @@ fn actual_value_coupling_compensates_the_leader_delay() {
     let mut p = Pair::new(lc, AxisConfig::example(0.001));
     p.actual = true;
     p.leader
-        .command(&Command::MoveVelocity { dynamics: dynamics(120.0, 1000.0, 1000.0, 0.0), direction: VelocityDirection::Positive, current: false, position_controlled: true })
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(120.0, 1000.0, 1000.0, 0.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
         .unwrap();
     p.step(500);
     let g = p.f(gear_in(1, 1)).unwrap();
@@ -594,4 +599,76 @@ fn actual_value_coupling_compensates_the_leader_delay() {
     assert!((ex.p - sp.p).abs() < 1e-9, "{} vs {}", ex.p, sp.p);
     assert!((ex.v - 120.0).abs() < 1e-9);
     assert!((p.fs().position_unwrapped - (offset + sp.p)).abs() < 1e-9);
+}
+
+#[test]
+fn velocity_gearing_ignores_a_leader_position_jump_and_offsets_shift_the_follower() {
+    let mut p = Pair::new(AxisConfig::example(0.001), AxisConfig::example(0.001));
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(60.0, -1.0, -1.0, -1.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    p.step(300);
+    let g = p
+        .f(Command::GearInVelocity {
+            master: LEADER,
+            ratio_numerator: 2,
+            ratio_denominator: 1,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    p.until(g, JobEventKind::InSync, 5000);
+    p.step(10);
+    assert!((p.fs().velocity - 120.0).abs() < 1e-9);
+    // Homing the leader (a jump of 500) does not move a velocity-geared follower.
+    let before = p.fs().position_unwrapped;
+    p.leader
+        .command(&Command::Home {
+            mode: 1,
+            position: 500.0,
+        })
+        .unwrap();
+    p.step(1);
+    let after = p.fs().position_unwrapped;
+    assert!(
+        (after - before - 120.0 * 0.001).abs() < 1e-9,
+        "{}",
+        after - before
+    );
+    assert!(p
+        .f(Command::Phasing {
+            phase_shift: 1.0,
+            absolute: false,
+            dynamics: Dynamics::DEFAULT
+        })
+        .is_err());
+
+    // Position gearing with an offset of the following value: relative +10 then absolute 0.
+    let g = p.f(gear_in(1, 1)).unwrap();
+    p.until(g, JobEventKind::InGear, 5000);
+    let base = p.fs().position_unwrapped - p.lv().p;
+    let o = p
+        .f(Command::Offset {
+            offset: 10.0,
+            absolute: false,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    p.until(o, JobEventKind::Done, 5000);
+    p.step(1);
+    assert!((p.fs().position_unwrapped - (base + 10.0 + p.lv().p)).abs() < 1e-9);
+    let o = p
+        .f(Command::Offset {
+            offset: 0.0,
+            absolute: true,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    p.until(o, JobEventKind::Done, 5000);
+    p.step(1);
+    assert!((p.fs().position_unwrapped - (base + p.lv().p)).abs() < 1e-9);
 }

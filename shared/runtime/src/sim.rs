@@ -168,7 +168,9 @@ pub fn run(
             };
             summary.commands += 1;
             let master = match e.command {
-                Command::GearIn { master, .. } | Command::GearInPos { master, .. } => Some(master),
+                Command::GearIn { master, .. }
+                | Command::GearInPos { master, .. }
+                | Command::GearInVelocity { master, .. } => Some(master),
                 _ => None,
             };
             let result = match master.and_then(|m| usize::try_from(m).ok()) {

@@ -256,6 +256,32 @@ pub enum Command {
     /// `MC_GearOut`: ends gearing; the follower continues with its current velocity.
     #[doc(alias = "MC_GearOut")]
     GearOut,
+    /// `MC_GearInVelocity`: velocity gearing. Synchronizes like MC_GearIn, then follows the
+    /// leader's velocity times the ratio; the position is integrated, not locked, so a jump of
+    /// the leader's position (homing) does not move the follower.
+    #[doc(alias = "MC_GearInVelocity")]
+    GearInVelocity {
+        /// The leader.
+        master: LeaderId,
+        /// `RatioNumerator`.
+        ratio_numerator: i32,
+        /// `RatioDenominator`.
+        ratio_denominator: i32,
+        /// `Acceleration`, `Deceleration`, `Jerk`.
+        dynamics: Dynamics,
+    },
+    /// `MC_OffsetAbsolute` / `MC_OffsetRelative`: shifts the following value of a synchronous
+    /// operation (follower units).
+    #[doc(alias = "MC_OffsetAbsolute")]
+    #[doc(alias = "MC_OffsetRelative")]
+    Offset {
+        /// `Offset`.
+        offset: f64,
+        /// Absolute (the total becomes `offset`) or relative (added).
+        absolute: bool,
+        /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` of the shift.
+        dynamics: Dynamics,
+    },
     /// `MC_PhasingAbsolute` / `MC_PhasingRelative`: shifts the leading value the follower sees.
     #[doc(alias = "MC_PhasingAbsolute")]
     #[doc(alias = "MC_PhasingRelative")]

@@ -242,6 +242,9 @@ pub struct Axis {
     phasing: Option<sync::PhasingJob>,
     /// Phase shift state (leading value units).
     phase: State,
+    offset_job: Option<sync::PhasingJob>,
+    /// Offset of the following value (MC_OffsetAbsolute/Relative), follower units.
+    shift_out: State,
     /// Leading values for this cycle: of the active and of the pending job's leader.
     lead: [Option<crate::leading::LeadingValue>; 2],
     sync_flags: u8,
@@ -311,6 +314,8 @@ impl Axis {
             sync_pending: None,
             phasing: None,
             phase: State::default(),
+            offset_job: None,
+            shift_out: State::default(),
             lead: [None; 2],
             sync_flags: 0,
             extrapolator: Extrapolator::new(cfg.extrapolation, cfg.cycle),
@@ -883,7 +888,7 @@ impl Axis {
                 ratio_numerator,
                 ratio_denominator,
                 dynamics,
-            } => self.cmd_gear_in(master, ratio_numerator, ratio_denominator, &dynamics),
+            } => self.cmd_gear_in(master, ratio_numerator, ratio_denominator, &dynamics, false),
             Command::GearInPos {
                 master,
                 ratio_numerator,
@@ -906,6 +911,17 @@ impl Axis {
                 sync_direction,
             ),
             Command::GearOut => self.cmd_gear_out(),
+            Command::GearInVelocity {
+                master,
+                ratio_numerator,
+                ratio_denominator,
+                dynamics,
+            } => self.cmd_gear_in(master, ratio_numerator, ratio_denominator, &dynamics, true),
+            Command::Offset {
+                offset,
+                absolute,
+                dynamics,
+            } => self.cmd_offset(offset, absolute, &dynamics),
             Command::Phasing {
                 phase_shift,
                 absolute,

@@ -68,7 +68,11 @@ pub(super) enum SyncLaw {
     /// MC_GearIn: synchronizing is a relative profile (follower minus ratio times leader) that
     /// brings relative velocity and acceleration to zero (kept in the axis' profile slot, which
     /// the synchronous goal does not otherwise use); then `offset + ratio * x`.
-    Gear { offset: f64 },
+    Gear {
+        offset: f64,
+        /// The leading value of the previous cycle (velocity gearing integrates its velocity).
+        prev: State,
+    },
     /// MC_GearInPos: synchronizing follows a quintic of the leading value from `x_start` to
     /// `x_sync`; then `y_sync + ratio * (x - x_sync)`.
     GearPos {
@@ -104,7 +108,7 @@ impl SyncJob {
     /// The follower's coordinates moved by `delta` (homing): the coupling moves with them.
     pub(super) fn shift_follower(&mut self, delta: f64) {
         match &mut self.law {
-            SyncLaw::Gear { offset } => *offset += delta,
+            SyncLaw::Gear { offset, .. } => *offset += delta,
             SyncLaw::GearPos {
                 y_sync, quintic, ..
             } => {
@@ -197,7 +201,9 @@ impl Axis {
             self.emit(s.id, s.instr, how);
         }
         self.abort_phasing(how);
+        self.abort_offset(how);
         self.phase = State::default();
+        self.shift_out = State::default();
         if self.goal == Goal::Sync {
             // The caller sets the next goal; until then hold the current motion.
             self.goal = Goal::Velocity {
@@ -214,6 +220,12 @@ impl Axis {
         }
     }
 
+    fn abort_offset(&mut self, how: JobEventKind) {
+        if let Some(o) = self.offset_job.take() {
+            self.emit(o.id, o.instr, how);
+        }
+    }
+
     /// Starts an active synchronous operation job (table 1 and 2 as for an active sync job).
     fn activate_sync(&mut self, mut job: SyncJob, new: NewJob) {
         self.apply_override_table(new);
@@ -226,12 +238,14 @@ impl Axis {
         self.sync = Some(job);
     }
 
+    /// MC_GearIn, or MC_GearInVelocity when `velocity` is set.
     pub(super) fn cmd_gear_in(
         &mut self,
         master: LeaderId,
         num: i32,
         den: i32,
         dynamics: &Dynamics,
+        velocity: bool,
     ) -> Result<JobId, ErrorId> {
         self.require_synchronous()?;
         self.check_motion_allowed()?;
@@ -243,19 +257,27 @@ impl Axis {
         let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
         self.warn_clamped(r.clamped);
         let id = self.new_id();
-        self.emit(id, Instruction::GearIn, JobEventKind::Busy);
+        let instr = if velocity {
+            Instruction::GearInVelocity
+        } else {
+            Instruction::GearIn
+        };
+        self.emit(id, instr, JobEventKind::Busy);
         let lim = Limits {
             vel: self.cfg.limits.max_velocity,
             ..r.limits
         };
         let job = SyncJob {
             id,
-            instr: Instruction::GearIn,
+            instr,
             master,
             ratio,
             lim,
             phase: SyncPhase::Synchronizing,
-            law: SyncLaw::Gear { offset: 0.0 },
+            law: SyncLaw::Gear {
+                offset: 0.0,
+                prev: State::default(),
+            },
             ready: false,
         };
         self.activate_sync(job, NewJob::GearIn);
@@ -334,6 +356,8 @@ impl Axis {
         self.sync = None;
         self.emit(s.id, s.instr, JobEventKind::CommandAborted);
         self.abort_phasing(JobEventKind::CommandAborted);
+        self.abort_offset(JobEventKind::CommandAborted);
+        self.shift_out = State::default();
         self.phase = State::default();
         // PLCopen: the follower continues with the velocity it has (acceleration released).
         let lim = Limits {
@@ -358,6 +382,10 @@ impl Axis {
         let Some(s) = self.sync else {
             return Err(ErrorId::NoSynchronousOperation);
         };
+        if s.instr == Instruction::GearInVelocity {
+            // Phasing shifts a position coupling; velocity gearing has none.
+            return Err(ErrorId::NoSynchronousOperation);
+        }
         if s.phase != SyncPhase::Synchronous {
             return Err(ErrorId::SynchronizingActive);
         }
@@ -382,6 +410,53 @@ impl Axis {
         let id = self.new_id();
         self.emit(id, instr, JobEventKind::Busy);
         self.phasing = Some(PhasingJob {
+            id,
+            instr,
+            prof,
+            t0: self.now,
+        });
+        Ok(id)
+    }
+
+    pub(super) fn cmd_offset(
+        &mut self,
+        offset: f64,
+        absolute: bool,
+        dynamics: &Dynamics,
+    ) -> Result<JobId, ErrorId> {
+        self.require_synchronous()?;
+        if !offset.is_finite() {
+            return Err(ErrorId::IllegalSlaveOffset);
+        }
+        let Some(s) = self.sync else {
+            return Err(ErrorId::NoSynchronousOperation);
+        };
+        if s.phase != SyncPhase::Synchronous {
+            return Err(ErrorId::SynchronizingActive);
+        }
+        let r = self
+            .cfg
+            .limits
+            .resolve(&self.cfg.defaults, dynamics, false)?;
+        self.warn_clamped(r.clamped);
+        if let Some(o) = self.offset_job.take() {
+            self.emit(o.id, o.instr, JobEventKind::CommandAborted);
+        }
+        let instr = if absolute {
+            Instruction::OffsetAbsolute
+        } else {
+            Instruction::OffsetRelative
+        };
+        let target = if absolute {
+            offset
+        } else {
+            self.shift_out.p + offset
+        };
+        let prof = plan_position(self.shift_out, target, &r.limits)
+            .map_err(|_| ErrorId::IllegalSlaveOffset)?;
+        let id = self.new_id();
+        self.emit(id, instr, JobEventKind::Busy);
+        self.offset_job = Some(PhasingJob {
             id,
             instr,
             prof,
@@ -465,7 +540,8 @@ impl Axis {
         }
         let mut events = [None; 2];
         match &mut job.law {
-            SyncLaw::Gear { offset } => {
+            SyncLaw::Gear { offset, prev } => {
+                let velocity = job.instr == Instruction::GearInVelocity;
                 if job.phase == SyncPhase::Synchronizing {
                     let e = self.elapsed(self.t0);
                     let r = self.prof.at(e);
@@ -477,15 +553,26 @@ impl Axis {
                     if e >= self.prof.duration() {
                         *offset = self.prof.end().p;
                         job.phase = SyncPhase::Synchronous;
-                        events[0] = Some(JobEventKind::InGear);
+                        events[0] = Some(if velocity {
+                            JobEventKind::InSync
+                        } else {
+                            JobEventKind::InGear
+                        });
                     }
                 } else {
+                    if velocity {
+                        // Integrate the leader's velocity: a jump of its position is not
+                        // followed (the offset absorbs what the position did beyond it).
+                        let dx = 0.5 * (prev.v + x.v) * self.cfg.cycle;
+                        *offset += g * (dx - (x.p - prev.p));
+                    }
                     self.basic = State {
                         p: *offset + g * x.p,
                         v: g * x.v,
                         a: g * x.a,
                     };
                 }
+                *prev = x;
             }
             SyncLaw::GearPos {
                 lead_dir,
@@ -526,6 +613,23 @@ impl Axis {
         for e in events.into_iter().flatten() {
             self.emit(job.id, job.instr, e);
         }
+        // MC_OffsetAbsolute/Relative: a profile shift of the following value.
+        let offset_done = match &self.offset_job {
+            Some(o) => {
+                let e = self.elapsed(o.t0);
+                self.shift_out = o.prof.at(e);
+                (e >= o.prof.duration()).then_some((o.id, o.instr, o.prof.end()))
+            }
+            None => None,
+        };
+        if let Some((id, instr, end)) = offset_done {
+            self.shift_out = end;
+            self.offset_job = None;
+            self.emit(id, instr, JobEventKind::Done);
+        }
+        self.basic.p += self.shift_out.p;
+        self.basic.v += self.shift_out.v;
+        self.basic.a += self.shift_out.a;
         // Synchronous followers are not limited by their own dynamics: flag exceedances.
         let lim = &self.cfg.limits;
         let b = self.total();
