@@ -80,11 +80,12 @@ pub fn run(args: Vec<OsString>, out: &mut impl Write, err: &mut impl Write) -> E
                 Ok(cell) => {
                     let _ = writeln!(
                         out,
-                        "{}: cell `{}` is valid: {} node(s), {} axis/axes",
+                        "{}: cell `{}` is valid: {} node(s), {} axis/axes, {} external encoder(s)",
                         path.display(),
                         cell.name,
                         cell.nodes.len(),
-                        cell.axes.len()
+                        cell.axes.len(),
+                        cell.encoders.len()
                     );
                     ExitCode::SUCCESS
                 }
@@ -121,7 +122,7 @@ fn sim(m: &clap::ArgMatches, out: &mut impl Write, err: &mut impl Write) -> Exit
             return ExitCode::from(2);
         }
     };
-    let names: Vec<&str> = cell.axes.iter().map(|a| a.name.as_str()).collect();
+    let names: Vec<&str> = cell.object_names();
     let script =
         match tandem_config::script::parse(&script_path.display().to_string(), &src, &names) {
             Ok(s) => s,

@@ -154,3 +154,118 @@ fn flying_saw_is_synchronous_at_every_cut() {
     assert!(synchronous_rows >= 3 * 300, "{synchronous_rows}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_follower_gears_to_an_external_encoder() {
+    let dir = std::env::temp_dir().join(format!("tandem-enc-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cell = dir.join("cell.toml");
+    std::fs::write(
+        &cell,
+        r#"
+[cell]
+name = "encoder-test"
+
+[[nodes]]
+name = "n"
+cycle_us = 1000
+
+[encoders.wheel]
+node = "n"
+source = "profile"
+profile = [[0.0, 0.0], [0.5, 200.0], [3.0, 200.0], [3.5, 50.0]]
+
+[encoders.wheel.extrapolation]
+velocity_t1 = 0.002
+following_time = 0.002
+
+[axes.knife]
+node = "n"
+kind = "synchronous"
+virtual = true
+
+[axes.knife.leaders]
+wheel = "actual"
+
+[axes.knife.dynamics]
+max_velocity = 2000.0
+max_acceleration = 20000.0
+max_deceleration = 20000.0
+max_jerk = 400000.0
+velocity = 500.0
+acceleration = 5000.0
+deceleration = 5000.0
+jerk = 100000.0
+emergency_deceleration = 40000.0
+"#,
+    )
+    .unwrap();
+    let script = dir.join("script.toml");
+    std::fs::write(
+        &script,
+        r#"
+[sim]
+duration = 4.0
+
+[[at]]
+t = 0.0
+axis = "wheel"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "knife"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.6
+axis = "knife"
+instruction = "MC_GearIn"
+master = "wheel"
+ratio_numerator = 1
+ratio_denominator = 2
+"#,
+    )
+    .unwrap();
+    let trace = dir.join("trace.csv");
+    let (code, log, err) = run(&[
+        "sim",
+        cell.to_str().unwrap(),
+        "--script",
+        script.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+        "--strict",
+    ]);
+    assert_eq!(code, 0, "{err}\n{log}");
+    assert!(log.contains("knife MC_GearIn job 2: InGear"), "{log}");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (x, y, job) = (
+        col("wheel.extrapolated_position"),
+        col("knife.position"),
+        col("knife.job"),
+    );
+    let mut offset = None;
+    let mut rows = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let (xv, yv): (f64, f64) = (f[x].parse().unwrap(), f[y].parse().unwrap());
+        // From the first synchronous row on: knife = offset + x / 2 exactly.
+        if f[job] == "MC_GearIn" && log.contains("InGear") {
+            rows += 1;
+            if rows > 200 {
+                let o = *offset.get_or_insert(yv - 0.5 * xv);
+                assert!(
+                    (yv - (o + 0.5 * xv)).abs() < 1e-9,
+                    "{yv} vs {}",
+                    o + 0.5 * xv
+                );
+            }
+        }
+    }
+    assert!(rows > 2000);
+    std::fs::remove_dir_all(&dir).ok();
+}

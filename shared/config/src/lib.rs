@@ -88,6 +88,52 @@ impl AxisEntry {
     }
 }
 
+/// Where a simulated external encoder gets its position from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EncoderSource {
+    /// The actual position of an axis (index into [`Cell::axes`]) times `scale`.
+    Axis {
+        /// The measured axis.
+        axis: usize,
+        /// Encoder units per axis unit.
+        scale: f64,
+    },
+    /// A velocity profile: `(t s, v)` points, linear in between, constant after the last.
+    Profile(Vec<(f64, f64)>),
+}
+
+impl EncoderSource {
+    /// Position and velocity of a profile source at `t` (s), from 0 at t = 0.
+    pub fn profile_at(points: &[(f64, f64)], t: f64) -> (f64, f64) {
+        let mut p = 0.0;
+        let mut prev = (0.0, points.first().map(|x| x.1).unwrap_or(0.0));
+        for &(ti, vi) in points {
+            if t <= ti {
+                let span = ti - prev.0;
+                let f = if span > 0.0 { (t - prev.0) / span } else { 1.0 };
+                let v = prev.1 + (vi - prev.1) * f;
+                return (p + 0.5 * (prev.1 + v) * (t - prev.0), v);
+            }
+            p += 0.5 * (prev.1 + vi) * (ti - prev.0);
+            prev = (ti, vi);
+        }
+        (p + prev.1 * (t - prev.0), prev.1)
+    }
+}
+
+/// An external encoder of the cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EncoderEntry {
+    /// Name (unique among axes and encoders).
+    pub name: String,
+    /// Index into [`Cell::nodes`].
+    pub node: usize,
+    /// Engine configuration.
+    pub config: tandem_motion::encoder::EncoderConfig,
+    /// Simulated source.
+    pub source: EncoderSource,
+}
+
 /// A validated cell.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
@@ -99,6 +145,20 @@ pub struct Cell {
     pub nodes: Vec<Node>,
     /// Axes, in name order.
     pub axes: Vec<AxisEntry>,
+    /// External encoders, in name order. As leaders they are numbered after the axes.
+    pub encoders: Vec<EncoderEntry>,
+}
+
+impl Cell {
+    /// The names of all technology objects that can be addressed or lead: axes, then encoders
+    /// (a leader's id is its index here).
+    pub fn object_names(&self) -> Vec<&str> {
+        self.axes
+            .iter()
+            .map(|a| a.name.as_str())
+            .chain(self.encoders.iter().map(|e| e.name.as_str()))
+            .collect()
+    }
 }
 
 /// Finds the 1-based line of a dotted key path in TOML source (best effort).
@@ -204,8 +264,12 @@ pub fn parse(file: &str, src: &str) -> Result<Cell, ConfigError> {
             leaders: None,
         });
     }
-    // Leader tables refer to axes by name: resolve them once every axis is known.
-    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    // Leader tables refer to axes and encoders by name: resolve them once all are known.
+    let names: Vec<String> = axes
+        .iter()
+        .map(|a| a.name.clone())
+        .chain(raw.encoders.keys().cloned())
+        .collect();
     for (entry, (name, a)) in axes.iter_mut().zip(raw.axes.iter()) {
         let Some(table) = &a.leaders else {
             continue;
@@ -239,11 +303,134 @@ pub fn parse(file: &str, src: &str) -> Result<Cell, ConfigError> {
         }
         entry.leaders = Some(list);
     }
+    let mut encoders = Vec::new();
+    for (name, e) in &raw.encoders {
+        if raw.axes.contains_key(name) {
+            return Err(err(
+                &["encoders", name],
+                format!("`{name}` is also an axis: names must be unique"),
+            ));
+        }
+        let node = nodes.iter().position(|n| n.name == e.node).ok_or_else(|| {
+            err(
+                &["encoders", name, "node"],
+                format!("unknown node `{}` (define it in [[nodes]])", e.node),
+            )
+        })?;
+        let encoder = pick(
+            "encoder",
+            &e.encoder,
+            &[
+                ("incremental", EncoderType::Incremental),
+                ("absolute", EncoderType::Absolute),
+            ],
+        )
+        .map_err(|(k, m)| err(&["encoders", name, k], m))?;
+        let source = match e.source.as_str() {
+            "axis" => {
+                let axis_name = e.axis.as_deref().ok_or_else(|| {
+                    err(
+                        &["encoders", name, "source"],
+                        "source = \"axis\" needs `axis = \"<name>\"`".into(),
+                    )
+                })?;
+                let axis = axes
+                    .iter()
+                    .position(|a| a.name == axis_name)
+                    .ok_or_else(|| {
+                        err(
+                            &["encoders", name, "axis"],
+                            format!("unknown axis `{axis_name}`"),
+                        )
+                    })?;
+                if !(e.scale.is_finite() && e.scale != 0.0) {
+                    return Err(err(
+                        &["encoders", name, "scale"],
+                        "must be a non-zero number".into(),
+                    ));
+                }
+                EncoderSource::Axis {
+                    axis,
+                    scale: e.scale,
+                }
+            }
+            "profile" => {
+                let pts = e.profile.as_ref().ok_or_else(|| {
+                    err(
+                        &["encoders", name, "source"],
+                        "source = \"profile\" needs `profile = [[t, v], ...]`".into(),
+                    )
+                })?;
+                let mut last = 0.0;
+                for [t, v] in pts {
+                    if !(t.is_finite() && v.is_finite() && *t >= last) {
+                        return Err(err(
+                            &["encoders", name, "profile"],
+                            "points must be finite [time, velocity] pairs with times rising from 0"
+                                .into(),
+                        ));
+                    }
+                    last = *t;
+                }
+                EncoderSource::Profile(pts.iter().map(|[t, v]| (*t, *v)).collect())
+            }
+            other => {
+                return Err(err(
+                    &["encoders", name, "source"],
+                    format!("`{other}` is not one of axis, profile"),
+                ));
+            }
+        };
+        let x = &e.extrapolation;
+        let config = tandem_motion::encoder::EncoderConfig {
+            cycle: nodes[node].cycle_ns as f64 * 1e-9,
+            modulo: e.modulo.as_ref().map(|m| Modulo {
+                start: m.start,
+                length: m.length,
+            }),
+            encoder,
+            extrapolation: ExtrapolationConfig {
+                position_t1: x.position_t1,
+                position_t2: x.position_t2,
+                velocity_t1: x.velocity_t1,
+                velocity_t2: x.velocity_t2,
+                velocity_tolerance: x.velocity_tolerance,
+                hysteresis: x.hysteresis,
+                following_time: x.following_time,
+                acquisition_time: x.acquisition_time,
+                system_defined: x.system_defined,
+                velocity_mode: pick(
+                    "extrapolation.velocity_mode",
+                    &x.velocity_mode,
+                    &[
+                        ("filtered", VelocityMode::Filtered),
+                        ("differentiation", VelocityMode::Differentiation),
+                    ],
+                )
+                .map_err(|(k, m)| err(&["encoders", name, k], m))?,
+            },
+        };
+        if let Some(m) = config.modulo {
+            if !(m.length.is_finite() && m.length > 0.0 && m.start.is_finite()) {
+                return Err(err(
+                    &["encoders", name, "modulo"],
+                    "length must be positive".into(),
+                ));
+            }
+        }
+        encoders.push(EncoderEntry {
+            name: name.clone(),
+            node,
+            config,
+            source,
+        });
+    }
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: base as i64 * 1000,
         nodes,
         axes,
+        encoders,
     })
 }
 

@@ -16,6 +16,39 @@ pub struct CellFile {
     /// `[axes.<name>]`.
     #[serde(default)]
     pub axes: BTreeMap<String, AxisSection>,
+    /// `[encoders.<name>]`.
+    #[serde(default)]
+    pub encoders: BTreeMap<String, EncoderSection>,
+}
+
+/// `[encoders.<name>]`: an external encoder with a simulated source.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderSection {
+    /// The node that hosts it.
+    pub node: String,
+    /// `incremental` or `absolute`.
+    #[serde(default = "default_encoder")]
+    pub encoder: String,
+    /// `[encoders.<name>.modulo]`.
+    pub modulo: Option<ModuloSection>,
+    /// `axis` (measures another axis' actual position) or `profile` (a velocity profile).
+    pub source: String,
+    /// With `source = "axis"`: the axis it measures.
+    pub axis: Option<String>,
+    /// With `source = "axis"`: encoder units per axis unit (measuring gear).
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// With `source = "profile"`: `[time s, velocity]` points, velocity linear in between and
+    /// constant after the last.
+    pub profile: Option<Vec<[f64; 2]>>,
+    /// `[encoders.<name>.extrapolation]`.
+    #[serde(default)]
+    pub extrapolation: ExtrapolationSection,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// `[cell]`.

@@ -10,6 +10,7 @@ pub mod alarm;
 pub mod axis;
 pub mod drive;
 pub mod dynamics;
+pub mod encoder;
 pub mod error_id;
 pub mod extrapolation;
 pub mod job;

@@ -4,8 +4,9 @@
 
 use std::io::{self, Write};
 use tandem_config::script::Script;
-use tandem_config::{Cell, Coupling};
+use tandem_config::{Cell, Coupling, EncoderSource};
 use tandem_motion::axis::{Axis, AxisStatus, Command};
+use tandem_motion::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::JobEventKind;
 use tandem_motion::leading::LeaderId;
@@ -25,6 +26,16 @@ pub const AXIS_COLUMNS: &[&str] = &[
     "alarm",
     "override",
     "job",
+];
+
+/// The per-encoder columns of the trace, in order (prefixed with `<encoder>.`).
+pub const ENCODER_COLUMNS: &[&str] = &[
+    "state",
+    "position",
+    "velocity",
+    "extrapolated_position",
+    "extrapolated_velocity",
+    "status_word",
 ];
 
 /// What a run did.
@@ -55,7 +66,12 @@ pub fn seconds(t_ns: i64) -> String {
     format!("{sign}{}.{:09}", t / 1_000_000_000, t % 1_000_000_000)
 }
 
-fn write_row(out: &mut impl Write, t_ns: i64, status: &[AxisStatus]) -> io::Result<()> {
+fn write_row(
+    out: &mut impl Write,
+    t_ns: i64,
+    status: &[AxisStatus],
+    encoders: &[EncoderStatus],
+) -> io::Result<()> {
     write!(out, "{}", seconds(t_ns))?;
     for s in status {
         let job = s
@@ -81,6 +97,23 @@ fn write_row(out: &mut impl Write, t_ns: i64, status: &[AxisStatus]) -> io::Resu
             job
         )?;
     }
+    for e in encoders {
+        let state = if e.has(tandem_motion::alarm::status_bit::ENABLE) {
+            "Enabled"
+        } else {
+            "Disabled"
+        };
+        write!(
+            out,
+            ",{},{},{},{},{},{}",
+            state,
+            e.position,
+            e.velocity,
+            e.extrapolated.position,
+            e.extrapolated.velocity,
+            e.status_word
+        )?;
+    }
     writeln!(out)
 }
 
@@ -91,6 +124,10 @@ fn recursive(axes: &[Axis], follower: usize, leader: usize) -> bool {
     while let Some(i) = stack.pop() {
         if i == follower {
             return true;
+        }
+        if i >= axes.len() {
+            // An external encoder follows nothing.
+            continue;
         }
         if std::mem::replace(&mut seen[i], true) {
             continue;
@@ -127,6 +164,17 @@ pub fn run(
         })?;
         axes.push(axis);
     }
+    let mut encoders = Vec::with_capacity(cell.encoders.len());
+    for e in &cell.encoders {
+        let enc = ExternalEncoder::new(e.config).map_err(|x| {
+            io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("encoder {}: {x}", e.name),
+            )
+        })?;
+        encoders.push(enc);
+    }
+    let n_axes = axes.len();
     let cycles: Vec<i64> = cell
         .axes
         .iter()
@@ -149,6 +197,11 @@ pub fn run(
             write!(trace, ",{}.{c}", a.name)?;
         }
     }
+    for e in &cell.encoders {
+        for c in ENCODER_COLUMNS {
+            write!(trace, ",{}.{c}", e.name)?;
+        }
+    }
     writeln!(trace)?;
 
     let mut summary = Summary::default();
@@ -163,6 +216,21 @@ pub fn run(
         }
         while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
             next += 1;
+            if let Some(k) = cell.encoders.iter().position(|x| x.name == e.axis) {
+                summary.commands += 1;
+                if let Err(id) = encoders[k].command(&e.command) {
+                    summary.rejected += 1;
+                    writeln!(
+                        log,
+                        "t={} {} {} rejected: {id} ({})",
+                        seconds(t),
+                        e.axis,
+                        e.instruction,
+                        id.description()
+                    )?;
+                }
+                continue;
+            }
             let Some(i) = cell.axes.iter().position(|a| a.name == e.axis) else {
                 continue;
             };
@@ -191,6 +259,37 @@ pub fn run(
                 )?;
             }
         }
+        // External encoders first: they lead and follow nothing. An encoder on an axis reads
+        // that axis' actual position of the previous cycle (one cycle of acquisition delay).
+        for (k, enc) in encoders.iter_mut().enumerate() {
+            if t % cell.nodes[cell.encoders[k].node].cycle_ns != 0 {
+                continue;
+            }
+            let (p, v) = match &cell.encoders[k].source {
+                EncoderSource::Axis { axis, scale } => {
+                    let s = axes[*axis].status();
+                    (
+                        s.actual_position_unwrapped * scale,
+                        s.actual_velocity * scale,
+                    )
+                }
+                EncoderSource::Profile(points) => {
+                    EncoderSource::profile_at(points, t as f64 * 1e-9)
+                }
+            };
+            enc.step(t, p, v);
+            while let Some(ev) = enc.pop_event() {
+                writeln!(
+                    log,
+                    "t={} {} {} job {}: {}",
+                    seconds(ev.time_ns),
+                    cell.encoders[k].name,
+                    ev.instruction.name(),
+                    ev.job,
+                    describe(ev.kind)
+                )?;
+            }
+        }
         // Leaders before their followers: an axis steps once every leader it needs has.
         let mut stepped = vec![false; axes.len()];
         for _pass in 0..=axes.len() {
@@ -209,14 +308,18 @@ pub fn run(
                     continue;
                 }
                 for l in needs.into_iter().flatten() {
-                    let lv =
-                        usize::try_from(l)
-                            .ok()
-                            .filter(|j| *j < axes.len())
-                            .map(|j| match cell.axes[i].coupling(j) {
+                    let lv = usize::try_from(l).ok().and_then(|j| {
+                        if j >= n_axes {
+                            encoders.get(j - n_axes).and_then(|e| e.leading_value())
+                        } else if j < n_axes {
+                            Some(match cell.axes[i].coupling(j) {
                                 Some(Coupling::Actual) => axes[j].actual_leading_value(),
                                 _ => axes[j].setpoint_leading_value(),
-                            });
+                            })
+                        } else {
+                            None
+                        }
+                    });
                     axes[i].set_leading_value(l, lv);
                 }
                 if t % cycles[i] == 0 {
@@ -265,7 +368,8 @@ pub fn run(
             alarms_seen[i] = now;
             status[i] = *axis.status();
         }
-        write_row(trace, t, &status)?;
+        let enc_status: Vec<EncoderStatus> = encoders.iter().map(|e| *e.status()).collect();
+        write_row(trace, t, &status, &enc_status)?;
         summary.rows += 1;
         k += 1;
     }

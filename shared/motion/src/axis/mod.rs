@@ -97,6 +97,8 @@ pub struct AxisStatus {
     pub override_velocity: f64,
     /// Setpoint position, continuous (not reduced).
     pub position_unwrapped: f64,
+    /// Actual position, continuous (not reduced).
+    pub actual_position_unwrapped: f64,
     /// The running basic-motion job.
     pub motion_job: Option<(JobId, Instruction)>,
     /// The running superimposed job.
@@ -345,6 +347,7 @@ impl Axis {
                 following_error: 0.0,
                 override_velocity: 100.0,
                 position_unwrapped: p0,
+                actual_position_unwrapped: p0,
                 motion_job: None,
                 superimposed_job: None,
                 sync_job: None,

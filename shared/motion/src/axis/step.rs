@@ -731,6 +731,7 @@ impl Axis {
             following_error: self.fe,
             override_velocity: self.override_pct,
             position_unwrapped: tot.p,
+            actual_position_unwrapped: self.actual_p,
             motion_job: self.main.map(|m| (m.id, m.instr)),
             superimposed_job: self.sup_job.map(|s| (s.id, Instruction::MoveSuperimposed)),
             sync_job: self.sync.map(|s| (s.id, s.instr)),
