@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The test command of README: sets up what the tests need on a fresh machine, then runs them.
-#  1. Python oracle: installs the pinned `ruckig` package and regenerates the committed
-#     fixtures into a temp file; they must match byte for byte (the oracle is real and current).
+#  1. Python oracles: installs the pinned `ruckig` and `pyplcopen` packages and regenerates the
+#     committed fixtures into temp files; they must match byte for byte (the oracles are real).
 #  2. All Rust tests of the workspace, in release (proptest and the simulator run faster).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,5 +15,11 @@ if ! cmp -s "$tmp/ruckig_1dof.csv" shared/motion/tests/fixtures/ruckig_1dof.csv;
     exit 1
 fi
 echo "ruckig oracle fixtures: reproduced exactly"
+python3 tests/oracle/gen_cam_fixtures.py --out "$tmp/cam_laws.csv" >/dev/null
+if ! cmp -s "$tmp/cam_laws.csv" shared/motion/tests/fixtures/cam_laws.csv; then
+    echo "error: the cam law fixtures do not match tests/oracle/gen_cam_fixtures.py output" >&2
+    exit 1
+fi
+echo "pyplcopen cam law fixtures: reproduced exactly"
 
 cargo test --workspace --release --locked "$@"

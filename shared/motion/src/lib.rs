@@ -8,6 +8,7 @@
 
 pub mod alarm;
 pub mod axis;
+pub mod cam;
 pub mod drive;
 pub mod dynamics;
 pub mod encoder;

@@ -36,7 +36,7 @@ pub enum SegmentDef {
     /// The S7-1500T technology-DB segment (`<TO>.Segment[i]`, seed 001 §A.7.4):
     /// `y = a0 + a1·x + … + a6·x⁶ + sineAmplitude·sin(2π·x/sinePeriod + sinePhase)` with `x`
     /// the **absolute** leading value. This is a literal reading of the tag descriptions
-    /// ("coefficient for xᵏ", "period length", "phase offset [rad]"); the manual's formula
+    /// ("coefficient for xᵏ", "period length", "phase offset \[rad\]"); the manual's formula
     /// itself is not in the reference text, so treat the sine part as unverified. With
     /// `sine_amplitude = 0` the period is ignored; otherwise it must be non-zero.
     #[doc(alias = "Segment")]
@@ -51,7 +51,7 @@ pub enum SegmentDef {
         sine_amplitude: f64,
         /// `sinePeriod`: period length in leading-value units.
         sine_period: f64,
-        /// `sinePhase` [rad].
+        /// `sinePhase` \[rad\].
         sine_phase: f64,
     },
 }

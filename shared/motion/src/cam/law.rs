@@ -5,26 +5,6 @@
 //! maps a law onto the box `[x0, x1] × [y0, y1]`:
 //! `y(x) = y0 + (y1 − y0)·s(u)`, `u = (x − x0)/(x1 − x0)`, so
 //! `y' = (y1 − y0)/(x1 − x0)·s'(u)` and `y'' = (y1 − y0)/(x1 − x0)²·s''(u)`.
-//!
-//! Boundary values (normalized; R = dwell `v = a = 0`, G = constant velocity `v ≠ 0, a = 0`,
-//! U = reversal `v = 0, a ≠ 0`, VDI 2143 working ranges) and characteristic values
-//! (`Cv = max |s'|`, `Ca = max |s''|`):
-//!
-//! | Law | s'(0), s''(0) | s'(1), s''(1) | Cv | Ca | smoothness inside |
-//! |---|---|---|---|---|---|
-//! | [`StraightLine`](MotionLaw::StraightLine) | 1, 0 (G) | 1, 0 (G) | 1 | 0 | C∞ |
-//! | [`QuadraticParabola`](MotionLaw::QuadraticParabola) | 0, 4 | 0, −4 | 2 | 4 | C1 (s'' jumps at ½) |
-//! | [`Poly5`](MotionLaw::Poly5) (3-4-5) | 0, 0 (R) | 0, 0 (R) | 15/8 = 1.875 | 10/√3 ≈ 5.7735 | C∞ |
-//! | [`SimpleSine`](MotionLaw::SimpleSine) (harmonic) | 0, π²/2 (U) | 0, −π²/2 (U) | π/2 | π²/2 | C∞ |
-//! | [`Cycloid`](MotionLaw::Cycloid) | 0, 0 (R) | 0, 0 (R) | 2 | 2π | C∞ |
-//! | [`ModifiedSine`](MotionLaw::ModifiedSine) | 0, 0 (R) | 0, 0 (R) | 4π/(4+π) ≈ 1.7596 | 4π²/(4+π) ≈ 5.5280 | C2 |
-//! | [`ModifiedTrapezoid`](MotionLaw::ModifiedTrapezoid) | 0, 0 (R) | 0, 0 (R) | 2 | 4π/(π+2) ≈ 4.8881 | C2 |
-//! | [`ModifiedAccelerationTrapezoid`](MotionLaw::ModifiedAccelerationTrapezoid) `{λ}` | 0, 0 (R) | 0, 0 (R) | 2 | 2/(min(λ,1−λ)·(½+1/π)) | C2 |
-//! | [`InclinedSine`](MotionLaw::InclinedSine) `{v}` | v, 0 | v, 0 | max(\|v\|, \|2−v\|) | 2π·\|1−v\| | C∞ |
-//! | [`Poly7`](MotionLaw::Poly7) (4-5-6-7) | 0, 0 (R), s‴ = 0 | 0, 0 (R), s‴ = 0 | 35/16 = 2.1875 | 84/(5√5) ≈ 7.5132 | C∞ |
-//!
-//! All laws except `StraightLine`, `InclinedSine` (`v ≠ 0`) and `ModifiedAccelerationTrapezoid`
-//! (`λ ≠ ½`) are point-symmetric: `s(1 − u) = 1 − s(u)`.
 
 use core::f64::consts::PI;
 
@@ -35,7 +15,25 @@ const MAT_G1: f64 = 0.5 + 1.0 / PI;
 
 /// A normalized VDI 2143 motion law on `u ∈ [0, 1]` (`s(0) = 0`, `s(1) = 1`).
 ///
-/// See the [module documentation](self) for the boundary and characteristic values.
+/// Boundary values (normalized; R = dwell `v = a = 0`, G = constant velocity `v ≠ 0, a = 0`,
+/// U = reversal `v = 0, a ≠ 0`, VDI 2143 working ranges) and characteristic values
+/// (`Cv = max |s'|`, `Ca = max |s''|`):
+///
+/// | Law | s'(0), s''(0) | s'(1), s''(1) | Cv | Ca | smoothness inside |
+/// |---|---|---|---|---|---|
+/// | [`StraightLine`](MotionLaw::StraightLine) | 1, 0 (G) | 1, 0 (G) | 1 | 0 | C∞ |
+/// | [`QuadraticParabola`](MotionLaw::QuadraticParabola) | 0, 4 | 0, −4 | 2 | 4 | C1 (s'' jumps at ½) |
+/// | [`Poly5`](MotionLaw::Poly5) (3-4-5) | 0, 0 (R) | 0, 0 (R) | 15/8 = 1.875 | 10/√3 ≈ 5.7735 | C∞ |
+/// | [`SimpleSine`](MotionLaw::SimpleSine) (harmonic) | 0, π²/2 (U) | 0, −π²/2 (U) | π/2 | π²/2 | C∞ |
+/// | [`Cycloid`](MotionLaw::Cycloid) | 0, 0 (R) | 0, 0 (R) | 2 | 2π | C∞ |
+/// | [`ModifiedSine`](MotionLaw::ModifiedSine) | 0, 0 (R) | 0, 0 (R) | 4π/(4+π) ≈ 1.7596 | 4π²/(4+π) ≈ 5.5280 | C2 |
+/// | [`ModifiedTrapezoid`](MotionLaw::ModifiedTrapezoid) | 0, 0 (R) | 0, 0 (R) | 2 | 8π/(π+2) ≈ 4.8881 | C2 |
+/// | [`ModifiedAccelerationTrapezoid`](MotionLaw::ModifiedAccelerationTrapezoid) `{λ}` | 0, 0 (R) | 0, 0 (R) | 2 | 2/(min(λ,1−λ)·(½+1/π)) | C2 |
+/// | [`InclinedSine`](MotionLaw::InclinedSine) `{v}` | v, 0 | v, 0 | max(\|v\|, \|2−v\|) | 2π·\|1−v\| | C∞ |
+/// | [`Poly7`](MotionLaw::Poly7) (4-5-6-7) | 0, 0 (R), s‴ = 0 | 0, 0 (R), s‴ = 0 | 35/16 = 2.1875 | 84/(5√5) ≈ 7.5132 | C∞ |
+///
+/// All laws except `StraightLine`, `InclinedSine` (`v ≠ 0`) and `ModifiedAccelerationTrapezoid`
+/// (`λ ≠ ½`) are point-symmetric: `s(1 − u) = 1 − s(u)`.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum MotionLaw {
     /// Straight line (Gerade), `s = u`. G-G: `s' = 1`, `s'' = 0` everywhere.

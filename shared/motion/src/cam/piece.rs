@@ -130,6 +130,11 @@ impl Piece {
         )
     }
 
+    /// The straight line from `(xa, ya)` to `(xb, yb)`.
+    pub fn line(xa: f64, ya: f64, xb: f64, yb: f64) -> Piece {
+        Piece::local(xa, xb, [ya, yb - ya, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    }
+
     /// A polynomial piece in `t = (x − xa)/(xb − xa)`.
     fn local(xa: f64, xb: f64, c: [f64; 8]) -> Piece {
         Piece {
