@@ -47,6 +47,10 @@ pub enum Instruction {
     GearOut,
     /// `MC_GearInVelocity`.
     GearInVelocity,
+    /// `MC_CamIn`.
+    CamIn,
+    /// `MC_CamOut`.
+    CamOut,
     /// `MC_OffsetAbsolute`.
     OffsetAbsolute,
     /// `MC_OffsetRelative`.
@@ -78,6 +82,8 @@ impl Instruction {
             Self::GearInPos => "MC_GearInPos",
             Self::GearOut => "MC_GearOut",
             Self::GearInVelocity => "MC_GearInVelocity",
+            Self::CamIn => "MC_CamIn",
+            Self::CamOut => "MC_CamOut",
             Self::OffsetAbsolute => "MC_OffsetAbsolute",
             Self::OffsetRelative => "MC_OffsetRelative",
             Self::PhasingAbsolute => "MC_PhasingAbsolute",
@@ -105,6 +111,8 @@ pub enum JobEventKind {
     StartSync,
     /// `InSync` (MC_GearInPos, MC_CamIn): synchronous at the sync positions.
     InSync,
+    /// `EndOfProfile` (MC_CamIn): the leading value passed an end of the cam.
+    EndOfProfile,
     /// Aborted by another job or by an alarm reaction (`CommandAborted`).
     CommandAborted,
     /// Ended with an error (`Error`, `ErrorID`), e.g. 16#8001 when an alarm ended it.

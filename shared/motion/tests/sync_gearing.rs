@@ -5,129 +5,16 @@
 use proptest::prelude::*;
 use tandem_motion::alarm::{status_bit, AlarmId};
 use tandem_motion::axis::{
-    Axis, AxisConfig, AxisKind, AxisState, AxisStatus, Command, Direction, StartMode, StopMode,
-    SyncDirection, SyncProfileReference, VelocityDirection,
+    AxisConfig, AxisState, Command, Direction, SyncDirection, SyncProfileReference,
+    VelocityDirection,
 };
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{JobEvent, JobEventKind, JobId};
-use tandem_motion::leading::LeadingValue;
+use tandem_motion::job::JobEventKind;
 use tandem_motion::modulo::Modulo;
 
-const LEADER: u32 = 7;
-
-struct Pair {
-    leader: Axis,
-    follower: Axis,
-    k: i64,
-    events: Vec<JobEvent>,
-    /// Actual-value coupling instead of setpoint coupling.
-    actual: bool,
-}
-
-fn power() -> Command {
-    Command::Power {
-        enable: true,
-        start_mode: StartMode::PositionControlled,
-        stop_mode: StopMode::Emergency,
-    }
-}
-
-fn dynamics(v: f64, a: f64, d: f64, j: f64) -> Dynamics {
-    Dynamics {
-        velocity: v,
-        acceleration: a,
-        deceleration: d,
-        jerk: j,
-    }
-}
-
-impl Pair {
-    fn new(leader: AxisConfig, mut follower: AxisConfig) -> Self {
-        follower.kind = AxisKind::Synchronous;
-        let mut p = Self {
-            leader: Axis::new(leader).unwrap(),
-            follower: Axis::new(follower).unwrap(),
-            k: 0,
-            events: vec![],
-            actual: false,
-        };
-        p.step(1);
-        p.leader.command(&power()).unwrap();
-        p.follower.command(&power()).unwrap();
-        p.leader
-            .command(&Command::Home {
-                mode: 0,
-                position: 0.0,
-            })
-            .unwrap();
-        p.follower
-            .command(&Command::Home {
-                mode: 0,
-                position: 0.0,
-            })
-            .unwrap();
-        p.step(1);
-        p
-    }
-
-    fn lv(&self) -> LeadingValue {
-        let s = self.leader.status();
-        LeadingValue {
-            p: s.position_unwrapped,
-            v: s.velocity,
-            a: s.acceleration,
-            modulo: self.leader.config().modulo,
-        }
-    }
-
-    fn step(&mut self, n: usize) {
-        for _ in 0..n {
-            let t = self.k * 1_000_000;
-            self.leader.step(t);
-            let lv = self.lv();
-            for id in self.follower.leaders().into_iter().flatten() {
-                self.follower
-                    .set_leading_value(id, (id == LEADER).then_some(lv));
-            }
-            self.follower.step(t);
-            while let Some(e) = self.follower.pop_event() {
-                self.events.push(e);
-            }
-            while self.leader.pop_event().is_some() {}
-            self.k += 1;
-        }
-    }
-
-    fn f(&mut self, c: Command) -> Result<JobId, ErrorId> {
-        let r = self.follower.command(&c);
-        while let Some(e) = self.follower.pop_event() {
-            self.events.push(e);
-        }
-        r
-    }
-
-    fn has(&self, job: JobId, kind: JobEventKind) -> bool {
-        self.events.iter().any(|e| e.job == job && e.kind == kind)
-    }
-
-    fn until(&mut self, job: JobId, kind: JobEventKind, max: usize) {
-        for _ in 0..max {
-            if self.has(job, kind) {
-                return;
-            }
-            self.step(1);
-        }
-        panic!(
-            "job {job}: no {kind:?} within {max} cycles: {:?}",
-            self.events
-        );
-    }
-
-    fn fs(&self) -> AxisStatus {
-        *self.follower.status()
-    }
-}
+mod common;
+use common::{dynamics, Pair, LEADER};
 
 fn gear_in(num: i32, den: i32) -> Command {
     Command::GearIn {

@@ -76,7 +76,23 @@ pub enum SyncProfileReference {
     Dynamics,
     /// 1: synchronize over the leading value distance `MasterStartDistance`.
     MasterStartDistance,
+    /// 2 (MC_CamIn only): set synchronous at once at the current positions.
+    Direct,
 }
+
+/// `ApplicationMode` of MC_CamIn.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum ApplicationMode {
+    /// 0: once; ends at the cam end going forward, at the cam start going backward.
+    Once,
+    /// 1: cyclic (absolute): the cam repeats; start and end values should match.
+    Cyclic,
+    /// 2: cyclic appending: each cycle adds the cam's rise to the following value.
+    CyclicAppending,
+}
+
+/// Identifies a cam for the runtime that provides it ([`crate::axis::Axis::provide_cam`]).
+pub type CamId = u32;
 
 /// `SyncDirection` of a modulo follower (MC_GearInPos, MC_CamIn).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -253,6 +269,39 @@ pub enum Command {
         /// `SyncDirection` (modulo followers).
         sync_direction: SyncDirection,
     },
+    /// `MC_CamIn`: camming. `following = f((leading - MasterOffset) / MasterScaling) *
+    /// SlaveScaling + SlaveOffset`; synchronous at `MasterSyncPosition` (relative to the cam
+    /// start) after a synchronization like MC_GearInPos, or at once (reference `Direct`).
+    #[doc(alias = "MC_CamIn")]
+    CamIn {
+        /// The leader.
+        master: LeaderId,
+        /// The cam (provided with [`crate::axis::Axis::provide_cam`] just before).
+        cam: CamId,
+        /// `MasterOffset`.
+        master_offset: f64,
+        /// `SlaveOffset`.
+        slave_offset: f64,
+        /// `MasterScaling` (> 0).
+        master_scaling: f64,
+        /// `SlaveScaling` (not 0).
+        slave_scaling: f64,
+        /// `MasterSyncPosition`, relative to the cam start, inside the cam.
+        master_sync_position: f64,
+        /// `SyncProfileReference` 0, 1 or 2.
+        sync_profile_reference: SyncProfileReference,
+        /// `MasterStartDistance` (reference 1).
+        master_start_distance: f64,
+        /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` (reference 0).
+        dynamics: Dynamics,
+        /// `ApplicationMode`.
+        application_mode: ApplicationMode,
+        /// `SyncDirection` (modulo followers).
+        sync_direction: SyncDirection,
+    },
+    /// `MC_CamOut`: ends camming; the follower continues with its current velocity.
+    #[doc(alias = "MC_CamOut")]
+    CamOut,
     /// `MC_GearOut`: ends gearing; the follower continues with its current velocity.
     #[doc(alias = "MC_GearOut")]
     GearOut,

@@ -5,13 +5,15 @@
 //!
 //! Positions are kept continuous (unwrapped) inside; modulo positions are what the status shows.
 
+mod camming;
 mod command;
 mod config;
 mod step;
 mod sync;
 
 pub use command::{
-    Command, Direction, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+    ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
+    SyncProfileReference, VelocityDirection,
 };
 pub use config::{
     AxisConfig, AxisKind, ConfigError, EncoderType, FollowingErrorMonitoring, HomingConfig,
@@ -245,6 +247,11 @@ pub struct Axis {
     /// Phase shift state (leading value units).
     phase: State,
     offset_job: Option<sync::PhasingJob>,
+    /// Cams of the active and the pending CamIn, with their mappings.
+    cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
+    cam_maps: [Option<camming::CamMap>; 2],
+    /// The cam handed over for the next MC_CamIn.
+    provided_cam: Option<(CamId, std::sync::Arc<crate::cam::Cam>)>,
     /// Offset of the following value (MC_OffsetAbsolute/Relative), follower units.
     shift_out: State,
     /// Leading values for this cycle: of the active and of the pending job's leader.
@@ -317,6 +324,9 @@ impl Axis {
             phasing: None,
             phase: State::default(),
             offset_job: None,
+            cams: [None, None],
+            cam_maps: [None; 2],
+            provided_cam: None,
             shift_out: State::default(),
             lead: [None; 2],
             sync_flags: 0,
@@ -622,9 +632,7 @@ impl Axis {
 
     fn abort_all(&mut self, how: JobEventKind) {
         self.abort_sync(how);
-        if let Some(p) = self.sync_pending.take() {
-            self.emit(p.id, p.instr, how);
-        }
+        self.abort_pending(how);
         self.abort_main(how);
         self.abort_sup(how);
         self.abort_passive(how);
@@ -914,6 +922,31 @@ impl Axis {
                 sync_direction,
             ),
             Command::GearOut => self.cmd_gear_out(),
+            Command::CamIn {
+                master,
+                cam,
+                master_offset,
+                slave_offset,
+                master_scaling,
+                slave_scaling,
+                master_sync_position,
+                sync_profile_reference,
+                master_start_distance,
+                dynamics,
+                application_mode,
+                sync_direction,
+            } => self.cmd_cam_in(
+                master,
+                cam,
+                (master_offset, slave_offset, master_scaling, slave_scaling),
+                master_sync_position,
+                sync_profile_reference,
+                master_start_distance,
+                &dynamics,
+                application_mode,
+                sync_direction,
+            ),
+            Command::CamOut => self.cmd_cam_out(),
             Command::GearInVelocity {
                 master,
                 ratio_numerator,
@@ -1304,7 +1337,7 @@ impl Axis {
     fn cmd_home(&mut self, mode: u8, position: f64) -> Result<JobId, ErrorId> {
         self.require_positioning()?;
         let absolute_sync = |s: Option<sync::SyncJob>| {
-            s.map(|j| j.instr == Instruction::GearInPos)
+            s.map(|j| matches!(j.instr, Instruction::GearInPos | Instruction::CamIn))
                 .unwrap_or(false)
         };
         if absolute_sync(self.sync) || absolute_sync(self.sync_pending) {

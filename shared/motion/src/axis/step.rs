@@ -738,6 +738,7 @@ impl Axis {
             sync_function: match self.sync.map(|s| s.instr) {
                 Some(Instruction::GearIn) => 1,
                 Some(Instruction::GearInPos) => 2,
+                Some(Instruction::CamIn) => 3,
                 _ => 0,
             },
             sync_status_word: if self.sync.is_some() {

@@ -3,6 +3,7 @@
 //! phasing. The leading value is an input of each cycle ([`Axis::set_leading_value`]); once
 //! synchronous, the follower setpoint is the coupling function of the leading value, exactly.
 
+use super::camming::CamStep;
 use super::{Axis, AxisKind, Goal, SyncDirection, SyncProfileReference};
 use crate::alarm::{supplement, AlarmId};
 use crate::dynamics::Dynamics;
@@ -78,6 +79,11 @@ pub(super) enum SyncLaw {
     GearPos {
         msp: f64,
         ssp: f64,
+        /// Slope and curvature (in the leading value) of the follower at the sync point: the
+        /// ratio and 0 for gearing, the scaled cam's for camming (MC_CamIn uses this law for
+        /// its synchronization, then the cam map).
+        slope: f64,
+        curv: f64,
         reference: SyncProfileReference,
         msd: f64,
         direction: SyncDirection,
@@ -159,7 +165,7 @@ impl Axis {
         }
     }
 
-    fn require_synchronous(&self) -> Result<(), ErrorId> {
+    pub(super) fn require_synchronous(&self) -> Result<(), ErrorId> {
         if self.cfg.kind != AxisKind::Synchronous {
             return Err(ErrorId::IllegalObject);
         }
@@ -170,11 +176,19 @@ impl Axis {
     fn running_sync(&self) -> [(RunningSync, bool); 3] {
         let active = self.sync.map(|s| match s.instr {
             Instruction::GearInPos => RunningSync::GearInPosActive,
+            Instruction::CamIn => RunningSync::CamInActive,
             _ => RunningSync::GearIn,
+        });
+        let pending = self.sync_pending.map(|s| match s.instr {
+            Instruction::CamIn => RunningSync::CamInPending,
+            _ => RunningSync::GearInPosPending,
         });
         [
             (active.unwrap_or(RunningSync::GearIn), active.is_some()),
-            (RunningSync::GearInPosPending, self.sync_pending.is_some()),
+            (
+                pending.unwrap_or(RunningSync::GearInPosPending),
+                pending.is_some(),
+            ),
             (RunningSync::Phasing, self.phasing.is_some()),
         ]
     }
@@ -186,9 +200,7 @@ impl Axis {
             self.abort_sync(JobEventKind::CommandAborted);
         }
         if pending.1 && table2(new, pending.0).aborts() {
-            if let Some(p) = self.sync_pending.take() {
-                self.emit(p.id, p.instr, JobEventKind::CommandAborted);
-            }
+            self.abort_pending(JobEventKind::CommandAborted);
         }
         if phasing.1 && table2(new, phasing.0).aborts() {
             self.abort_phasing(JobEventKind::CommandAborted);
@@ -200,10 +212,9 @@ impl Axis {
         if let Some(s) = self.sync.take() {
             self.emit(s.id, s.instr, how);
         }
-        self.abort_phasing(how);
-        self.abort_offset(how);
-        self.phase = State::default();
-        self.shift_out = State::default();
+        self.cams[0] = None;
+        self.cam_maps[0] = None;
+        self.clear_shifts(how);
         if self.goal == Goal::Sync {
             // The caller sets the next goal; until then hold the current motion.
             self.goal = Goal::Velocity {
@@ -212,6 +223,23 @@ impl Axis {
             };
             self.replan();
         }
+    }
+
+    /// Drops the pending synchronous operation job.
+    pub(super) fn abort_pending(&mut self, how: JobEventKind) {
+        if let Some(p) = self.sync_pending.take() {
+            self.emit(p.id, p.instr, how);
+        }
+        self.cams[1] = None;
+        self.cam_maps[1] = None;
+    }
+
+    /// Ends phasing and offsets; their shifts are reset with the synchronous operation.
+    pub(super) fn clear_shifts(&mut self, how: JobEventKind) {
+        self.abort_phasing(how);
+        self.abort_offset(how);
+        self.phase = State::default();
+        self.shift_out = State::default();
     }
 
     fn abort_phasing(&mut self, how: JobEventKind) {
@@ -306,6 +334,10 @@ impl Axis {
         if !ssp.is_finite() {
             return Err(ErrorId::IllegalSlaveSyncPosition);
         }
+        if reference == SyncProfileReference::Direct {
+            // Direct setting is for MC_CamIn only.
+            return Err(ErrorId::IllegalSyncProfileReference);
+        }
         if reference == SyncProfileReference::MasterStartDistance && !(msd.is_finite() && msd > 0.0)
         {
             return Err(ErrorId::IllegalMasterStartDistance);
@@ -327,6 +359,8 @@ impl Axis {
             law: SyncLaw::GearPos {
                 msp,
                 ssp,
+                slope: ratio,
+                curv: 0.0,
                 reference,
                 msd,
                 direction,
@@ -347,7 +381,10 @@ impl Axis {
 
     pub(super) fn cmd_gear_out(&mut self) -> Result<JobId, ErrorId> {
         self.require_synchronous()?;
-        let Some(s) = self.sync.filter(|s| s.phase != SyncPhase::Pending) else {
+        let Some(s) = self
+            .sync
+            .filter(|s| s.phase != SyncPhase::Pending && s.instr != Instruction::CamIn)
+        else {
             return Err(ErrorId::NoSynchronousOperation);
         };
         let id = self.new_id();
@@ -385,6 +422,9 @@ impl Axis {
         if s.instr == Instruction::GearInVelocity {
             // Phasing shifts a position coupling; velocity gearing has none.
             return Err(ErrorId::NoSynchronousOperation);
+        }
+        if s.instr == Instruction::CamIn {
+            return Err(ErrorId::CammingActive);
         }
         if s.phase != SyncPhase::Synchronous {
             return Err(ErrorId::SynchronizingActive);
@@ -468,7 +508,7 @@ impl Axis {
     /// The cyclic part: pending start conditions, set-up, the coupling law, job events.
     /// Runs after the basic setpoint of the current goal was computed for this cycle.
     pub(super) fn sync_step(&mut self) {
-        if let Some(mut p) = self.sync_pending {
+        if let Some(mut p) = self.sync_pending.filter(|_| !self.pending_at_cycle_end()) {
             match self.lead[1] {
                 None => {
                     self.raise(AlarmId::LeaderMissing, supplement::NONE);
@@ -477,15 +517,28 @@ impl Axis {
                 Some(lv) => {
                     if let Some(started) = self.pending_start(&mut p, lv) {
                         self.sync_pending = None;
+                        let camming = p.instr == Instruction::CamIn;
                         if started {
                             self.lead[0] = Some(lv);
-                            self.apply_override_table(NewJob::GearInPosActive);
+                            self.apply_override_table(if camming {
+                                NewJob::CamInActive
+                            } else {
+                                NewJob::GearInPosActive
+                            });
                             self.fold_superimposed();
                             self.force_position_control();
                             self.emit(p.id, p.instr, JobEventKind::StartSync);
                             p.phase = SyncPhase::Synchronizing;
+                            if camming {
+                                if let SyncLaw::GearPos { x_sync, y_sync, .. } = p.law {
+                                    self.activate_cam(x_sync, y_sync);
+                                }
+                            }
                             self.sync = Some(p);
                             self.goal = Goal::Sync;
+                        } else if camming {
+                            self.cams[1] = None;
+                            self.cam_maps[1] = None;
                         }
                     } else {
                         self.sync_pending = Some(p);
@@ -539,6 +592,7 @@ impl Axis {
             self.goal = Goal::Sync;
         }
         let mut events = [None; 2];
+        let mut cam_step = None;
         match &mut job.law {
             SyncLaw::Gear { offset, prev } => {
                 let velocity = job.instr == Instruction::GearInVelocity;
@@ -601,17 +655,42 @@ impl Axis {
                         job.phase = SyncPhase::Synchronous;
                         events[0] = Some(JobEventKind::InSync);
                     }
-                    self.basic = State {
-                        p: *y_sync + g * (x.p - *x_sync),
-                        v: g * x.v,
-                        a: g * x.a,
-                    };
+                    if job.instr == Instruction::CamIn {
+                        cam_step = Some(self.cam_synchronous(x));
+                    } else {
+                        self.basic = State {
+                            p: *y_sync + g * (x.p - *x_sync),
+                            v: g * x.v,
+                            a: g * x.a,
+                        };
+                    }
                 }
             }
         }
         self.sync = Some(job);
         for e in events.into_iter().flatten() {
             self.emit(job.id, job.instr, e);
+        }
+        match cam_step {
+            Some(CamStep::Running(true)) => {
+                self.emit(job.id, job.instr, JobEventKind::EndOfProfile);
+                if self.pending_at_cycle_end() {
+                    // A pending cam takes over here, seamlessly.
+                    self.cam_change_at_cycle_end();
+                    let _ = self.cam_synchronous(x);
+                }
+            }
+            Some(CamStep::Ended) => {
+                // A once-through cam ends synchronous operation (InSync and Busy fall).
+                self.emit(job.id, job.instr, JobEventKind::EndOfProfile);
+                self.end_sync_keep_velocity(JobEventKind::Done);
+                return;
+            }
+            Some(CamStep::Failed) => {
+                self.end_sync_keep_velocity(JobEventKind::Error(ErrorId::NoFollowingValue));
+                return;
+            }
+            Some(CamStep::Running(false)) | None => {}
         }
         // MC_OffsetAbsolute/Relative: a profile shift of the following value.
         let offset_done = match &self.offset_job {
@@ -650,13 +729,14 @@ impl Axis {
     /// start condition. `Some(true)`: start now; `Some(false)`: the job ended with an error;
     /// `None`: still pending.
     fn pending_start(&mut self, job: &mut SyncJob, lv: LeadingValue) -> Option<bool> {
-        let g = job.ratio;
         // The total setpoint: a superimposed motion is folded into the coupling when it starts.
         let follower = self.total();
         let cfg_mod = self.cfg.modulo;
         let SyncLaw::GearPos {
             msp,
             ssp,
+            slope,
+            curv,
             reference,
             msd,
             direction,
@@ -679,15 +759,26 @@ impl Axis {
             };
         }
         let dir = *lead_dir;
+        let (g, curv) = (*slope, *curv);
+        if *reference == SyncProfileReference::Direct {
+            // Synchronous at once: the sync point is where the leader and the follower are.
+            *x_sync = lv.p;
+            *x_start = lv.p;
+            *y_sync = follower.p;
+            *quintic = None;
+            job.ready = true;
+            return Some(true);
+        }
         // Synchronization length: the start distance, or from the dynamics at the leader's
         // current velocity.
         let len = match reference {
+            SyncProfileReference::Direct => 0.0,
             SyncProfileReference::MasterStartDistance => *msd,
             SyncProfileReference::Dynamics => {
                 if lv.v == 0.0 {
                     return None;
                 }
-                sync_length(follower, g, lv, &job.lim, |l| {
+                sync_length(follower, (g, curv), lv, &job.lim, |l| {
                     target_rep(
                         *ssp,
                         cfg_mod,
@@ -741,7 +832,7 @@ impl Axis {
         // one the dynamics need.
         let ahead = match reference {
             SyncProfileReference::Dynamics => lv.v * self.cfg.cycle,
-            SyncProfileReference::MasterStartDistance => 0.0,
+            SyncProfileReference::MasterStartDistance | SyncProfileReference::Direct => 0.0,
         };
         if dir * (lv.p + ahead - *x_start) < 0.0 {
             return None;
@@ -757,7 +848,7 @@ impl Axis {
             (0.0, 0.0)
         };
         *quintic = (len.abs() > 0.0)
-            .then(|| Quintic::hermite(lv.p, len, (follower.p, d1, d2), (yt, g, 0.0)));
+            .then(|| Quintic::hermite(lv.p, len, (follower.p, d1, d2), (yt, g, curv)));
         Some(true)
     }
 }
@@ -800,7 +891,7 @@ fn target_rep(
 /// follower within its velocity (or the synchronous velocity, if higher), acceleration and jerk.
 fn sync_length(
     follower: State,
-    g: f64,
+    (g, curv): (f64, f64),
     lv: LeadingValue,
     lim: &Limits,
     target: impl Fn(f64) -> f64,
@@ -814,7 +905,7 @@ fn sync_length(
     );
     let dir = lv.v.signum();
     let feasible = |l: f64| -> bool {
-        let q = Quintic::hermite(0.0, dir * l, (follower.p, d1, d2), (target(l), g, 0.0));
+        let q = Quintic::hermite(0.0, dir * l, (follower.p, d1, d2), (target(l), g, curv));
         (0..=64).all(|i| {
             let [_, y1, y2, y3] = q.eval(dir * l * f64::from(i) / 64.0);
             (y1 * v).abs() <= vmax * (1.0 + 1e-9)

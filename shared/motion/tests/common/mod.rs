@@ -2,10 +2,11 @@
 //! collected.
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use tandem_motion::axis::{Axis, AxisConfig, Command, StartMode, StopMode};
+use tandem_motion::axis::{Axis, AxisConfig, AxisKind, AxisStatus, Command, StartMode, StopMode};
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::{JobEvent, JobEventKind, JobId};
+use tandem_motion::leading::LeadingValue;
 
 pub const MS: i64 = 1_000_000;
 
@@ -92,5 +93,121 @@ pub fn dyn_(v: f64, a: f64, d: f64, j: f64) -> Dynamics {
         acceleration: a,
         deceleration: d,
         jerk: j,
+    }
+}
+
+/// A leader and a synchronous follower stepped together, the leader first (D = 0).
+pub const LEADER: u32 = 7;
+
+pub struct Pair {
+    pub leader: Axis,
+    pub follower: Axis,
+    pub k: i64,
+    pub events: Vec<JobEvent>,
+    /// Actual-value coupling instead of setpoint coupling.
+    pub actual: bool,
+}
+
+pub fn power() -> Command {
+    Command::Power {
+        enable: true,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Emergency,
+    }
+}
+
+pub fn dynamics(v: f64, a: f64, d: f64, j: f64) -> Dynamics {
+    Dynamics {
+        velocity: v,
+        acceleration: a,
+        deceleration: d,
+        jerk: j,
+    }
+}
+
+impl Pair {
+    pub fn new(leader: AxisConfig, mut follower: AxisConfig) -> Self {
+        follower.kind = AxisKind::Synchronous;
+        let mut p = Self {
+            leader: Axis::new(leader).unwrap(),
+            follower: Axis::new(follower).unwrap(),
+            k: 0,
+            events: vec![],
+            actual: false,
+        };
+        p.step(1);
+        p.leader.command(&power()).unwrap();
+        p.follower.command(&power()).unwrap();
+        p.leader
+            .command(&Command::Home {
+                mode: 0,
+                position: 0.0,
+            })
+            .unwrap();
+        p.follower
+            .command(&Command::Home {
+                mode: 0,
+                position: 0.0,
+            })
+            .unwrap();
+        p.step(1);
+        p
+    }
+
+    pub fn lv(&self) -> LeadingValue {
+        let s = self.leader.status();
+        LeadingValue {
+            p: s.position_unwrapped,
+            v: s.velocity,
+            a: s.acceleration,
+            modulo: self.leader.config().modulo,
+        }
+    }
+
+    pub fn step(&mut self, n: usize) {
+        for _ in 0..n {
+            let t = self.k * 1_000_000;
+            self.leader.step(t);
+            let lv = self.lv();
+            for id in self.follower.leaders().into_iter().flatten() {
+                self.follower
+                    .set_leading_value(id, (id == LEADER).then_some(lv));
+            }
+            self.follower.step(t);
+            while let Some(e) = self.follower.pop_event() {
+                self.events.push(e);
+            }
+            while self.leader.pop_event().is_some() {}
+            self.k += 1;
+        }
+    }
+
+    pub fn f(&mut self, c: Command) -> Result<JobId, ErrorId> {
+        let r = self.follower.command(&c);
+        while let Some(e) = self.follower.pop_event() {
+            self.events.push(e);
+        }
+        r
+    }
+
+    pub fn has(&self, job: JobId, kind: JobEventKind) -> bool {
+        self.events.iter().any(|e| e.job == job && e.kind == kind)
+    }
+
+    pub fn until(&mut self, job: JobId, kind: JobEventKind, max: usize) {
+        for _ in 0..max {
+            if self.has(job, kind) {
+                return;
+            }
+            self.step(1);
+        }
+        panic!(
+            "job {job}: no {kind:?} within {max} cycles: {:?}",
+            self.events
+        );
+    }
+
+    pub fn fs(&self) -> AxisStatus {
+        *self.follower.status()
     }
 }
