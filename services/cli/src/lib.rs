@@ -123,14 +123,19 @@ fn sim(m: &clap::ArgMatches, out: &mut impl Write, err: &mut impl Write) -> Exit
         }
     };
     let names: Vec<&str> = cell.object_names();
-    let script =
-        match tandem_config::script::parse(&script_path.display().to_string(), &src, &names) {
-            Ok(s) => s,
-            Err(e) => {
-                let _ = writeln!(err, "error: {e}");
-                return ExitCode::from(2);
-            }
-        };
+    let cam_names: Vec<&str> = cell.cams.iter().map(|c| c.name.as_str()).collect();
+    let script = match tandem_config::script::parse(
+        &script_path.display().to_string(),
+        &src,
+        &names,
+        &cam_names,
+    ) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = writeln!(err, "error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let file = match std::fs::File::create(trace_path) {
         Ok(f) => f,
         Err(e) => {

@@ -269,3 +269,67 @@ ratio_denominator = 2
     assert!(rows > 2000);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The cross cutter's cam, written out independently: 45 u on 0..50, the 7th-degree transition
+/// on 50..450, 315 + 45 u on 450..500.
+fn cut_cam(x: f64) -> f64 {
+    if x <= 50.0 {
+        0.9 * x
+    } else if x <= 450.0 {
+        let u = (x - 50.0) / 400.0;
+        let s = u.powi(4) * (35.0 - 84.0 * u + 70.0 * u * u - 20.0 * u.powi(3));
+        45.0 + 360.0 * u - 90.0 * s
+    } else {
+        315.0 + 0.9 * (x - 450.0)
+    }
+}
+
+#[test]
+fn cross_cutter_follows_its_cam_exactly_through_a_speed_change() {
+    let dir = std::env::temp_dir().join(format!("tandem-cut-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let trace = dir.join("cut.csv");
+    let (code, log, err) = run(&[
+        "sim",
+        root().join("config/cross-cutter.toml").to_str().unwrap(),
+        "--script",
+        root()
+            .join("config/cross-cutter-script.toml")
+            .to_str()
+            .unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+        "--strict",
+    ]);
+    assert_eq!(code, 0, "{err}\n{log}");
+    assert!(log.contains("knife MC_CamIn job 2: InSync"));
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (x, y, v) = (
+        col("web.position"),
+        col("knife.position"),
+        col("knife.velocity"),
+    );
+    let mut rows = 0;
+    let mut ends = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let xv: f64 = f[x].parse().unwrap();
+        let yv: f64 = f[y].parse().unwrap();
+        if xv >= 600.0 {
+            // Knife angle (modulo 360) = cam of the web position since the first cut.
+            let expect = cut_cam((xv - 600.0).rem_euclid(500.0));
+            let d = (yv - expect).rem_euclid(360.0);
+            assert!(d.min(360.0 - d) < 1e-9, "web {xv}: knife {yv} vs {expect}");
+            rows += 1;
+        }
+        let vv: f64 = f[v].parse().unwrap();
+        assert!(vv >= -1e-9, "the drum never turns back");
+    }
+    ends += log.matches("EndOfProfile").count();
+    assert!(rows > 4000, "{rows}");
+    assert!(ends >= 9, "{ends}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -5,7 +5,8 @@
 //! Defaults are the references' defaults (dynamics -1.0 = the axis defaults).
 
 use tandem_motion::axis::{
-    Command, Direction, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+    ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
+    SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::leading::LeaderId;
@@ -174,6 +175,46 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         params: &[],
     },
     InstructionSpec {
+        name: "MC_GearInVelocity",
+        params: &[
+            ("ratio_numerator", Some(Value::Num(1.0))),
+            ("ratio_denominator", Some(Value::Num(1.0))),
+            DYN[1],
+            DYN[2],
+            DYN[3],
+        ],
+    },
+    InstructionSpec {
+        name: "MC_OffsetAbsolute",
+        params: &[("offset", None), DYN[0], DYN[1], DYN[2], DYN[3]],
+    },
+    InstructionSpec {
+        name: "MC_OffsetRelative",
+        params: &[("offset", None), DYN[0], DYN[1], DYN[2], DYN[3]],
+    },
+    InstructionSpec {
+        name: "MC_CamIn",
+        params: &[
+            ("master_offset", Some(Value::Num(0.0))),
+            ("slave_offset", Some(Value::Num(0.0))),
+            ("master_scaling", Some(Value::Num(1.0))),
+            ("slave_scaling", Some(Value::Num(1.0))),
+            ("master_sync_position", Some(Value::Num(0.0))),
+            ("sync_profile_reference", Some(Value::Num(1.0))),
+            ("master_start_distance", Some(Value::Num(0.0))),
+            DYN[0],
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            ("application_mode", Some(Value::Num(0.0))),
+            ("sync_direction", Some(Value::Num(3.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_CamOut",
+        params: &[],
+    },
+    InstructionSpec {
         name: "MC_PhasingAbsolute",
         params: &[("phase_shift", None), DYN[0], DYN[1], DYN[2], DYN[3]],
     },
@@ -187,8 +228,22 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
 pub fn needs_master(spec: &InstructionSpec) -> bool {
     matches!(
         spec.name,
-        "MC_GearIn" | "MC_GearInPos" | "MC_GearInVelocity"
+        "MC_GearIn" | "MC_GearInPos" | "MC_GearInVelocity" | "MC_CamIn"
     )
+}
+
+/// Instructions that name a cam (`cam = "<name>"`).
+pub fn needs_cam(spec: &InstructionSpec) -> bool {
+    spec.name == "MC_CamIn"
+}
+
+/// The objects an instruction names, resolved by the caller.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct Refs {
+    /// The leader (`master`).
+    pub master: Option<LeaderId>,
+    /// The cam (`cam`).
+    pub cam: Option<CamId>,
 }
 
 fn normalize(s: &str) -> String {
@@ -262,11 +317,8 @@ impl Args<'_> {
 /// Builds a command. Unknown instructions and parameters, missing required parameters and
 /// values of the wrong type are errors naming what was wrong. `master` is the leader the
 /// instruction names (resolved by the caller), for the instructions that need one.
-pub fn parse(
-    instruction: &str,
-    params: &[(String, Value)],
-    master: Option<LeaderId>,
-) -> Result<Command, String> {
+pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Result<Command, String> {
+    let master: Option<LeaderId> = refs.master;
     let spec = find(instruction).ok_or_else(|| {
         let names: Vec<&str> = INSTRUCTIONS.iter().map(|i| i.name).collect();
         format!(
@@ -325,6 +377,38 @@ pub fn parse(
             },
         },
         "MC_GearOut" => Command::GearOut,
+        "MC_CamIn" => Command::CamIn {
+            master: leader()?,
+            cam: refs
+                .cam
+                .ok_or("MC_CamIn: parameter `cam` (the cam's name) is required")?,
+            master_offset: a.num("master_offset")?,
+            slave_offset: a.num("slave_offset")?,
+            master_scaling: a.num("master_scaling")?,
+            slave_scaling: a.num("slave_scaling")?,
+            master_sync_position: a.num("master_sync_position")?,
+            sync_profile_reference: match a.code("sync_profile_reference")? {
+                0 => SyncProfileReference::Dynamics,
+                1 => SyncProfileReference::MasterStartDistance,
+                2 => SyncProfileReference::Direct,
+                _ => return Err("MC_CamIn: sync_profile_reference must be 0, 1 or 2".into()),
+            },
+            master_start_distance: a.num("master_start_distance")?,
+            dynamics: a.dynamics("velocity")?,
+            application_mode: match a.code("application_mode")? {
+                0 => ApplicationMode::Once,
+                1 => ApplicationMode::Cyclic,
+                2 => ApplicationMode::CyclicAppending,
+                _ => return Err("MC_CamIn: application_mode must be 0, 1 or 2".into()),
+            },
+            sync_direction: match a.code("sync_direction")? {
+                1 => SyncDirection::Positive,
+                2 => SyncDirection::Negative,
+                3 => SyncDirection::Shortest,
+                _ => return Err("MC_CamIn: sync_direction must be 1, 2 or 3".into()),
+            },
+        },
+        "MC_CamOut" => Command::CamOut,
         "MC_GearInVelocity" => Command::GearInVelocity {
             master: leader()?,
             ratio_numerator: ratio("ratio_numerator")?,
@@ -451,7 +535,7 @@ mod tests {
                 p("position", Value::Num(40.0)),
                 p("direction", Value::Num(3.0)),
             ],
-            None,
+            Refs::default(),
         )
         .unwrap();
         assert_eq!(
@@ -462,20 +546,26 @@ mod tests {
                 direction: Direction::Shortest
             }
         );
-        assert!(parse("MoveAbsolute", &[], None)
+        assert!(parse("MoveAbsolute", &[], Refs::default())
             .unwrap_err()
             .contains("`position` is required"));
+        assert!(parse(
+            "MoveAbsolute",
+            &[p("postion", Value::Num(1.0))],
+            Refs::default()
+        )
+        .unwrap_err()
+        .contains("unknown parameter `postion`"));
         assert!(
-            parse("MoveAbsolute", &[p("postion", Value::Num(1.0))], None)
+            parse("MC_Power", &[p("enable", Value::Num(1.0))], Refs::default())
                 .unwrap_err()
-                .contains("unknown parameter `postion`")
+                .contains("true or false")
         );
-        assert!(parse("MC_Power", &[p("enable", Value::Num(1.0))], None)
-            .unwrap_err()
-            .contains("true or false"));
-        assert!(parse("MC_Home", &[p("mode", Value::Num(2.5))], None)
-            .unwrap_err()
-            .contains("integer"));
+        assert!(
+            parse("MC_Home", &[p("mode", Value::Num(2.5))], Refs::default())
+                .unwrap_err()
+                .contains("integer")
+        );
     }
 
     #[test]
@@ -487,7 +577,19 @@ mod tests {
                 .filter(|(_, d)| d.is_none())
                 .map(|(k, _)| p(k, Value::Num(1.0)))
                 .collect();
-            assert!(parse(spec.name, &given, Some(0)).is_ok(), "{}", spec.name);
+            assert!(
+                parse(
+                    spec.name,
+                    &given,
+                    Refs {
+                        master: Some(0),
+                        cam: Some(0)
+                    }
+                )
+                .is_ok(),
+                "{}",
+                spec.name
+            );
         }
     }
 }

@@ -134,6 +134,21 @@ pub struct EncoderEntry {
     pub source: EncoderSource,
 }
 
+/// A cam of the cell, interpolated.
+#[derive(Clone, Debug)]
+pub struct CamEntry {
+    /// Name.
+    pub name: String,
+    /// The interpolated cam, shared by every job that uses it.
+    pub cam: std::sync::Arc<tandem_motion::cam::Cam>,
+}
+
+impl PartialEq for CamEntry {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && std::sync::Arc::ptr_eq(&self.cam, &other.cam)
+    }
+}
+
 /// A validated cell.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
@@ -147,6 +162,8 @@ pub struct Cell {
     pub axes: Vec<AxisEntry>,
     /// External encoders, in name order. As leaders they are numbered after the axes.
     pub encoders: Vec<EncoderEntry>,
+    /// Cams, in name order (a cam's id is its index here).
+    pub cams: Vec<CamEntry>,
 }
 
 impl Cell {
@@ -181,7 +198,7 @@ fn line_of_toml_error(e: &toml::de::Error, src: &str) -> Option<usize> {
         .map(|s| src[..s.start.min(src.len())].matches('\n').count() + 1)
 }
 
-/// Loads and validates a cell file.
+/// Loads and validates a cell file (cam CSV files are read relative to it).
 pub fn load(path: &Path) -> Result<Cell, ConfigError> {
     let file = path.display().to_string();
     let src = std::fs::read_to_string(path).map_err(|e| ConfigError {
@@ -190,11 +207,16 @@ pub fn load(path: &Path) -> Result<Cell, ConfigError> {
         key: String::new(),
         message: format!("cannot read: {e}"),
     })?;
-    parse(&file, &src)
+    parse_in(&file, &src, path.parent())
 }
 
-/// Parses and validates cell source text; `file` is used in error messages.
+/// Parses and validates cell source text; `file` is used in error messages. Cam CSV files are
+/// read relative to the current directory.
 pub fn parse(file: &str, src: &str) -> Result<Cell, ConfigError> {
+    parse_in(file, src, None)
+}
+
+fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigError> {
     let raw: CellFile = toml::from_str(src).map_err(|e| ConfigError {
         file: file.into(),
         line: line_of_toml_error(&e, src),
@@ -425,16 +447,149 @@ pub fn parse(file: &str, src: &str) -> Result<Cell, ConfigError> {
             source,
         });
     }
+    let mut cams = Vec::new();
+    for (name, c) in &raw.cams {
+        let cam = cam_from(c, dir).map_err(|(key, message)| {
+            let mut path = vec!["cams", name.as_str()];
+            if !key.is_empty() {
+                path.push(key);
+            }
+            let mut e = err(&path, message);
+            if e.line.is_none() {
+                e.line = locate(src, &["cams", name]);
+            }
+            e
+        })?;
+        cams.push(CamEntry {
+            name: name.clone(),
+            cam: std::sync::Arc::new(cam),
+        });
+    }
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: base as i64 * 1000,
         nodes,
         axes,
         encoders,
+        cams,
     })
 }
 
 type FieldError = (&'static str, String);
+
+/// Builds and interpolates a cam (`MC_InterpolateCam` at load time).
+fn cam_from(
+    c: &schema::CamSection,
+    dir: Option<&Path>,
+) -> Result<tandem_motion::cam::Cam, FieldError> {
+    use tandem_motion::cam::{
+        BoundaryCondition, Cam, CamDefinition, Interpolation, MotionLaw, SegmentDef,
+    };
+    let interpolation = Interpolation::from_name(&c.interpolation).ok_or((
+        "interpolation",
+        format!(
+            "`{}` is not one of linear, cubic_spline, bezier",
+            c.interpolation
+        ),
+    ))?;
+    let boundary = BoundaryCondition::from_name(&c.boundary).ok_or((
+        "boundary",
+        format!(
+            "`{}` is not one of none, equal_first_derivative",
+            c.boundary
+        ),
+    ))?;
+    let mut points: Vec<(f64, f64)> = c.points.iter().map(|[x, y]| (*x, *y)).collect();
+    if let Some(csv) = &c.points_csv {
+        let path = dir
+            .map(|d| d.join(csv))
+            .unwrap_or_else(|| Path::new(csv).to_path_buf());
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| ("points_csv", format!("cannot read {}: {e}", path.display())))?;
+        let more = tandem_motion::cam::parse_csv(&text)
+            .map_err(|e| ("points_csv", format!("{}: {e}", path.display())))?;
+        points.extend(more);
+    }
+    let mut segments = Vec::new();
+    for (i, seg) in c.segments.iter().enumerate() {
+        let [x0, x1] = seg.x;
+        let def = match seg.kind.as_str() {
+            "law" => {
+                let name = seg
+                    .law
+                    .as_deref()
+                    .ok_or(("segments", format!("segment {i}: `law` is required")))?;
+                let law = MotionLaw::from_name(name, seg.parameter).ok_or((
+                    "segments",
+                    format!("segment {i}: unknown law `{name}` or bad parameter"),
+                ))?;
+                let [y0, y1] = seg.y.ok_or((
+                    "segments",
+                    format!("segment {i}: `y = [y0, y1]` is required"),
+                ))?;
+                SegmentDef::Law {
+                    law,
+                    x0,
+                    x1,
+                    y0,
+                    y1,
+                }
+            }
+            "polynomial" => {
+                let coeffs = seg
+                    .coeffs
+                    .as_deref()
+                    .filter(|c| !c.is_empty() && c.len() <= 8)
+                    .ok_or((
+                        "segments",
+                        format!("segment {i}: `coeffs` (1 to 8 numbers) is required"),
+                    ))?;
+                SegmentDef::polynomial(x0, x1, coeffs)
+            }
+            "s7_polynomial" => {
+                let a_in = seg.a.as_deref().unwrap_or(&[]);
+                if a_in.len() > 7 {
+                    return Err((
+                        "segments",
+                        format!("segment {i}: `a` has at most 7 coefficients"),
+                    ));
+                }
+                let mut a = [0.0; 7];
+                a[..a_in.len()].copy_from_slice(a_in);
+                let (amp, period, phase) = seg
+                    .sine
+                    .as_ref()
+                    .map(|s| (s.amplitude, s.period, s.phase))
+                    .unwrap_or((0.0, 1.0, 0.0));
+                SegmentDef::S7Polynomial {
+                    xmin: x0,
+                    xmax: x1,
+                    a,
+                    sine_amplitude: amp,
+                    sine_period: period,
+                    sine_phase: phase,
+                }
+            }
+            other => {
+                return Err((
+                    "segments",
+                    format!(
+                        "segment {i}: type `{other}` is not one of law, polynomial, s7_polynomial"
+                    ),
+                ))
+            }
+        };
+        segments.push(def);
+    }
+    let def = CamDefinition {
+        points,
+        segments,
+        interpolation,
+        boundary,
+    };
+    Cam::interpolate(&def)
+        .map_err(|e| ("", format!("cannot interpolate: {e:?} ({})", e.error_id())))
+}
 
 fn pick<T: Copy>(key: &'static str, value: &str, options: &[(&str, T)]) -> Result<T, FieldError> {
     options

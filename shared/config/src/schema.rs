@@ -19,6 +19,74 @@ pub struct CellFile {
     /// `[encoders.<name>]`.
     #[serde(default)]
     pub encoders: BTreeMap<String, EncoderSection>,
+    /// `[cams.<name>]`.
+    #[serde(default)]
+    pub cams: BTreeMap<String, CamSection>,
+}
+
+/// `[cams.<name>]`: a cam, interpolated when the cell is loaded.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CamSection {
+    /// `linear`, `cubic_spline` (default) or `bezier`.
+    #[serde(default = "d_interp")]
+    pub interpolation: String,
+    /// `none` (default) or `equal_first_derivative`.
+    #[serde(default = "d_boundary")]
+    pub boundary: String,
+    /// Interpolation points `[x, y]`.
+    #[serde(default)]
+    pub points: Vec<[f64; 2]>,
+    /// A CSV file of points (`x,y` lines), relative to the cell file.
+    pub points_csv: Option<String>,
+    /// `[[cams.<name>.segments]]`.
+    #[serde(default)]
+    pub segments: Vec<CamSegmentSection>,
+}
+
+fn d_interp() -> String {
+    "cubic_spline".into()
+}
+fn d_boundary() -> String {
+    "none".into()
+}
+
+/// One cam segment.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CamSegmentSection {
+    /// `law`, `polynomial` or `s7_polynomial`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// `[x0, x1]`.
+    pub x: [f64; 2],
+    /// `law`: `[y0, y1]`.
+    pub y: Option<[f64; 2]>,
+    /// `law`: the VDI 2143 law name (`poly5`, `cycloid`, ...).
+    pub law: Option<String>,
+    /// `law`: the parameter of `inclined_sine` (v) or `modified_acceleration_trapezoid` (lambda).
+    pub parameter: Option<f64>,
+    /// `polynomial`: coefficients in `u = (x - x0) / (x1 - x0)`, up to 8.
+    pub coeffs: Option<Vec<f64>>,
+    /// `s7_polynomial`: `a0..a6` in absolute x.
+    pub a: Option<Vec<f64>>,
+    /// `s7_polynomial`: the sine term.
+    pub sine: Option<SineSection>,
+}
+
+/// The sine term of an S7 polynomial segment.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineSection {
+    /// Amplitude.
+    #[serde(default)]
+    pub amplitude: f64,
+    /// Period (rad).
+    #[serde(default = "one")]
+    pub period: f64,
+    /// Phase (rad).
+    #[serde(default)]
+    pub phase: f64,
 }
 
 /// `[encoders.<name>]`: an external encoder with a simulated source.

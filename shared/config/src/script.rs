@@ -55,8 +55,10 @@ fn num(item: &toml_edit::Item) -> Option<f64> {
         .or_else(|| item.as_integer().map(|i| i as f64))
 }
 
-/// Parses a script; `file` names it in errors. `axes` are the names that exist in the cell.
-pub fn parse(file: &str, src: &str, axes: &[&str]) -> Result<Script, ConfigError> {
+/// Parses a script; `file` names it in errors. `axes` are the names of the cell's objects that
+/// can be addressed and lead (axes, then encoders: a leader's id is its index), `cams` the
+/// names of its cams (a cam's id is its index).
+pub fn parse(file: &str, src: &str, axes: &[&str], cams: &[&str]) -> Result<Script, ConfigError> {
     let e = |line: Option<usize>, key: &str, message: String| ConfigError {
         file: file.into(),
         line,
@@ -148,9 +150,25 @@ pub fn parse(file: &str, src: &str, axes: &[&str]) -> Result<Script, ConfigError
                     Some(idx as u32)
                 }
             };
+            let cam = match t.get("cam") {
+                None => None,
+                Some(c) => {
+                    let name = c
+                        .as_str()
+                        .ok_or_else(|| e(line, &key, "`cam` must be a cam name".into()))?;
+                    let idx = cams.iter().position(|c| *c == name).ok_or_else(|| {
+                        e(
+                            line,
+                            &key,
+                            format!("unknown cam `{name}`; the cell has: {}", cams.join(", ")),
+                        )
+                    })?;
+                    Some(idx as u32)
+                }
+            };
             let mut params = Vec::new();
             for (k, v) in t.iter() {
-                if matches!(k, "t" | "axis" | "instruction" | "master") {
+                if matches!(k, "t" | "axis" | "instruction" | "master" | "cam") {
                     continue;
                 }
                 let value = if let Some(b) = v.as_bool() {
@@ -166,7 +184,8 @@ pub fn parse(file: &str, src: &str, axes: &[&str]) -> Result<Script, ConfigError
                 };
                 params.push((k.to_string(), value));
             }
-            let command = command::parse(instr, &params, master).map_err(|m| e(line, &key, m))?;
+            let refs = command::Refs { master, cam };
+            let command = command::parse(instr, &params, refs).map_err(|m| e(line, &key, m))?;
             let name = command::find(instr).map(|s| s.name).unwrap_or("?");
             entries.push(ScriptEntry {
                 t_ns: time,
@@ -191,16 +210,16 @@ mod tests {
     #[test]
     fn parses_and_reports_lines() {
         let src = "[sim]\nduration = 1.5\n\n[[at]]\nt = 0.5\naxis = \"x\"\ninstruction = \"MoveRelative\"\ndistance = 10\n\n[[at]]\nt = 0\naxis = \"x\"\ninstruction = \"MC_Power\"\n";
-        let s = parse("s.toml", src, &["x"]).unwrap();
+        let s = parse("s.toml", src, &["x"], &[]).unwrap();
         assert_eq!(s.duration_ns, 1_500_000_000);
         assert_eq!(s.entries.len(), 2);
         assert_eq!(s.entries[0].instruction, "MC_Power");
         assert_eq!(s.entries[1].line, 4);
         let bad = src.replace("distance = 10", "distanc = 10");
-        let e = parse("s.toml", &bad, &["x"]).unwrap_err();
+        let e = parse("s.toml", &bad, &["x"], &[]).unwrap_err();
         assert_eq!(e.line, Some(4));
         assert!(e.message.contains("unknown parameter `distanc`"), "{e}");
-        let e = parse("s.toml", src, &["y"]).unwrap_err();
+        let e = parse("s.toml", src, &["y"], &[]).unwrap_err();
         assert!(e.message.contains("unknown axis `x`"));
     }
 }

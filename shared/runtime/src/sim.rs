@@ -238,9 +238,16 @@ pub fn run(
             let master = match e.command {
                 Command::GearIn { master, .. }
                 | Command::GearInPos { master, .. }
-                | Command::GearInVelocity { master, .. } => Some(master),
+                | Command::GearInVelocity { master, .. }
+                | Command::CamIn { master, .. } => Some(master),
                 _ => None,
             };
+            if let Command::CamIn { cam, .. } = e.command {
+                // The job takes its own reference to the interpolated cam.
+                if let Some(c) = usize::try_from(cam).ok().and_then(|c| cell.cams.get(c)) {
+                    axes[i].provide_cam(cam, std::sync::Arc::clone(&c.cam));
+                }
+            }
             let result = match master.and_then(|m| usize::try_from(m).ok()) {
                 Some(m) if recursive(&axes, i, m) => Err(ErrorId::RecursiveSyncChain),
                 // The leader must be one of the follower's configured leaders.
