@@ -370,3 +370,50 @@ proptest! {
         }
     }
 }
+
+/// A cam with f(50) = 70 (a line 0 -> 140 over 0..100).
+fn line_cam() -> Arc<Cam> {
+    let def = CamDefinition {
+        points: vec![],
+        segments: vec![SegmentDef::line(0.0, 0.0, 100.0, 140.0)],
+        interpolation: Interpolation::Linear,
+        boundary: Default::default(),
+    };
+    Arc::new(Cam::interpolate(&def).unwrap())
+}
+
+#[test]
+fn reference_examples_slave_offset_and_sync_window() {
+    // Seed 000 §3.9 example 7 (in S7-1500 terms: SlaveOffset): the cam gives 70 at master 50;
+    // with a slave offset of 80 the follower is synchronous at 150 when the master is at 50.
+    let mut p = pair();
+    leader_runs(&mut p, 50.0);
+    p.follower.provide_cam(1, line_cam());
+    let c = CamIn {
+        so: 80.0,
+        msp: 50.0,
+        reference: SyncProfileReference::MasterStartDistance,
+        msd: 30.0,
+        ..CamIn::direct(ApplicationMode::Once)
+    };
+    let id = p.f(c.command()).unwrap();
+    // Seed 000 §3.9 examples 4/5 (S7-1500 terms): synchronizing over the 30 before the sync
+    // position, i.e. while the master moves 20 -> 50.
+    let mut started = None;
+    for _ in 0..3000 {
+        p.step(1);
+        let x = p.lv().p;
+        if started.is_none() && p.has(id, JobEventKind::StartSync) {
+            started = Some(x);
+        }
+        if p.has(id, JobEventKind::InSync) {
+            assert!((50.0..50.06).contains(&x), "InSync at {x}");
+            let expect = 1.4 * x + 80.0;
+            assert!((p.fs().position_unwrapped - expect).abs() < 1e-9);
+            assert!((1.4f64 * 50.0 + 80.0 - 150.0).abs() < 1e-12);
+            break;
+        }
+    }
+    let s = started.unwrap();
+    assert!((20.0..20.06).contains(&s), "StartSync at {s}");
+}

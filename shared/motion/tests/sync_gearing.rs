@@ -559,3 +559,46 @@ fn velocity_gearing_ignores_a_leader_position_jump_and_offsets_shift_the_followe
     p.step(1);
     assert!((p.fs().position_unwrapped - (base + p.lv().p)).abs() < 1e-9);
 }
+
+#[test]
+fn superimposed_on_the_leader_moves_its_followers_and_exceedances_are_flagged() {
+    // Seed 001 §3.2 MC_MoveSuperimposed: on a leader it moves leader and followers.
+    let mut fc = AxisConfig::example(0.001);
+    fc.following_error.enable = false;
+    let mut p = Pair::new(AxisConfig::example(0.001), fc);
+    let g = p.f(gear_in(1, 1)).unwrap();
+    p.until(g, JobEventKind::InGear, 1000);
+    let before = p.fs().position_unwrapped;
+    let s = p
+        .leader
+        .command(&Command::MoveSuperimposed {
+            distance: 10.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    for _ in 0..2000 {
+        p.step(1);
+        if p.leader.status().superimposed_job.is_none() {
+            break;
+        }
+    }
+    let _ = s;
+    assert!((p.fs().position_unwrapped - before - 10.0).abs() < 1e-9);
+    // Synchronous followers are not clamped to their own limits: ratio 8 at leader 100/s is
+    // 800/s on a follower limited to 500/s: MaxVelocityExceeded, no alarm, exact coupling.
+    let g = p.f(gear_in(8, 1)).unwrap();
+    p.leader
+        .command(&Command::MoveVelocity {
+            dynamics: dynamics(100.0, 1000.0, 1000.0, 0.0),
+            direction: VelocityDirection::Positive,
+            current: false,
+            position_controlled: true,
+        })
+        .unwrap();
+    p.until(g, JobEventKind::InGear, 5000);
+    p.step(300);
+    let st = p.fs();
+    assert!((st.velocity - 800.0).abs() < 1e-9);
+    assert_eq!(st.sync_status_word & 1, 1, "MaxVelocityExceeded");
+    assert!(p.follower.alarms().next().is_none());
+}
