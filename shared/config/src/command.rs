@@ -215,6 +215,10 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         params: &[],
     },
     InstructionSpec {
+        name: "MC_SynchronizedMotionSimulation",
+        params: &[("enable", Some(Value::Bool(true)))],
+    },
+    InstructionSpec {
         name: "MC_PhasingAbsolute",
         params: &[("phase_shift", None), DYN[0], DYN[1], DYN[2], DYN[3]],
     },
@@ -409,6 +413,9 @@ pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Resul
             },
         },
         "MC_CamOut" => Command::CamOut,
+        "MC_SynchronizedMotionSimulation" => Command::SynchronizedMotionSimulation {
+            enable: a.flag("enable")?,
+        },
         "MC_GearInVelocity" => Command::GearInVelocity {
             master: leader()?,
             ratio_numerator: ratio("ratio_numerator")?,

@@ -51,6 +51,8 @@ pub enum Instruction {
     CamIn,
     /// `MC_CamOut`.
     CamOut,
+    /// `MC_SynchronizedMotionSimulation`.
+    SynchronizedMotionSimulation,
     /// `MC_OffsetAbsolute`.
     OffsetAbsolute,
     /// `MC_OffsetRelative`.
@@ -84,6 +86,7 @@ impl Instruction {
             Self::GearInVelocity => "MC_GearInVelocity",
             Self::CamIn => "MC_CamIn",
             Self::CamOut => "MC_CamOut",
+            Self::SynchronizedMotionSimulation => "MC_SynchronizedMotionSimulation",
             Self::OffsetAbsolute => "MC_OffsetAbsolute",
             Self::OffsetRelative => "MC_OffsetRelative",
             Self::PhasingAbsolute => "MC_PhasingAbsolute",
@@ -113,6 +116,8 @@ pub enum JobEventKind {
     InSync,
     /// `EndOfProfile` (MC_CamIn): the leading value passed an end of the cam.
     EndOfProfile,
+    /// `InSimulation` (MC_SynchronizedMotionSimulation): TRUE or FALSE.
+    InSimulation(bool),
     /// Aborted by another job or by an alarm reaction (`CommandAborted`).
     CommandAborted,
     /// Ended with an error (`Error`, `ErrorID`), e.g. 16#8001 when an alarm ended it.

@@ -5,8 +5,8 @@
 use proptest::prelude::*;
 use tandem_motion::alarm::{status_bit, AlarmId};
 use tandem_motion::axis::{
-    AxisConfig, AxisState, Command, Direction, SyncDirection, SyncProfileReference,
-    VelocityDirection,
+    AxisConfig, AxisState, Command, Direction, StartMode, StopMode, SyncDirection,
+    SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::error_id::ErrorId;
@@ -14,7 +14,7 @@ use tandem_motion::job::JobEventKind;
 use tandem_motion::modulo::Modulo;
 
 mod common;
-use common::{dynamics, Pair, LEADER};
+use common::{dynamics, power, Pair, LEADER};
 
 fn gear_in(num: i32, den: i32) -> Command {
     Command::GearIn {
@@ -601,4 +601,51 @@ fn superimposed_on_the_leader_moves_its_followers_and_exceedances_are_flagged() 
     assert!((st.velocity - 800.0).abs() < 1e-9);
     assert_eq!(st.sync_status_word & 1, 1, "MaxVelocityExceeded");
     assert!(p.follower.alarms().next().is_none());
+}
+
+#[test]
+fn synchronized_motion_simulation_keeps_the_coupling_through_a_disable() {
+    let mut fc = AxisConfig::example(0.001);
+    fc.following_error.enable = false;
+    fc.drive = tandem_motion::drive::DriveModel::Delay { delay: 0.002 };
+    let mut p = Pair::new(AxisConfig::example(0.001), fc);
+    let g = p.f(gear_in(1, 1)).unwrap();
+    p.until(g, JobEventKind::InGear, 1000);
+    let offset = p.fs().position_unwrapped - p.lv().p;
+    let sim = p
+        .f(Command::SynchronizedMotionSimulation { enable: true })
+        .unwrap();
+    assert!(p.has(sim, JobEventKind::InSimulation(true)));
+    assert_eq!(p.f(gear_in(2, 1)), Err(ErrorId::SyncSimulationActive));
+    // The safety door opens: the follower is disabled; the coupling stays.
+    p.f(Command::Power {
+        enable: false,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Immediate,
+    })
+    .unwrap();
+    assert!(!p.has(g, JobEventKind::CommandAborted));
+    let held = p.fs().position_unwrapped;
+    p.leader
+        .command(&Command::MoveRelative {
+            distance: 100.0,
+            dynamics: Dynamics::DEFAULT,
+        })
+        .unwrap();
+    p.step(3000);
+    assert!(
+        (p.fs().position_unwrapped - held).abs() < 1e-9,
+        "the follower stood still"
+    );
+    assert_eq!(p.fs().sync_status_word & 8, 8, "InSimulation");
+    p.f(power()).unwrap();
+    p.step(10);
+    assert!((p.fs().position_unwrapped - held).abs() < 1e-9);
+    // The end of the simulation outputs the coupling again: a step of the leader's 100.
+    p.f(Command::SynchronizedMotionSimulation { enable: false })
+        .unwrap();
+    assert!(p.has(sim, JobEventKind::InSimulation(false)));
+    p.step(1);
+    assert!((p.fs().position_unwrapped - (offset + p.lv().p)).abs() < 1e-9);
+    assert!((p.fs().position_unwrapped - held - 100.0).abs() < 1e-6);
 }

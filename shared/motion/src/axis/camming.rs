@@ -72,7 +72,7 @@ impl Axis {
         mode: ApplicationMode,
         direction: SyncDirection,
     ) -> Result<JobId, ErrorId> {
-        self.require_synchronous()?;
+        self.require_new_sync()?;
         self.check_motion_allowed()?;
         let cam = match &self.provided_cam {
             Some((id, cam)) if *id == cam_id => Arc::clone(cam),

@@ -302,6 +302,13 @@ pub enum Command {
     /// `MC_CamOut`: ends camming; the follower continues with its current velocity.
     #[doc(alias = "MC_CamOut")]
     CamOut,
+    /// `MC_SynchronizedMotionSimulation` (Enable-type): keeps a synchronous operation logically
+    /// active while the follower stands still or is disabled (a safety door is open).
+    #[doc(alias = "MC_SynchronizedMotionSimulation")]
+    SynchronizedMotionSimulation {
+        /// `Enable`.
+        enable: bool,
+    },
     /// `MC_GearOut`: ends gearing; the follower continues with its current velocity.
     #[doc(alias = "MC_GearOut")]
     GearOut,

@@ -247,6 +247,8 @@ pub struct Axis {
     /// Phase shift state (leading value units).
     phase: State,
     offset_job: Option<sync::PhasingJob>,
+    /// MC_SynchronizedMotionSimulation running (its job).
+    sync_sim: Option<JobId>,
     /// Cams of the active and the pending CamIn, with their mappings.
     cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
     cam_maps: [Option<camming::CamMap>; 2],
@@ -324,6 +326,7 @@ impl Axis {
             phasing: None,
             phase: State::default(),
             offset_job: None,
+            sync_sim: None,
             cams: [None, None],
             cam_maps: [None; 2],
             provided_cam: None,
@@ -631,8 +634,11 @@ impl Axis {
     }
 
     fn abort_all(&mut self, how: JobEventKind) {
-        self.abort_sync(how);
-        self.abort_pending(how);
+        // A simulated synchronous operation survives disables and alarms (seed 001 §1.6).
+        if self.sync_sim.is_none() {
+            self.abort_sync(how);
+            self.abort_pending(how);
+        }
         self.abort_main(how);
         self.abort_sup(how);
         self.abort_passive(how);
@@ -947,6 +953,7 @@ impl Axis {
                 sync_direction,
             ),
             Command::CamOut => self.cmd_cam_out(),
+            Command::SynchronizedMotionSimulation { enable } => self.cmd_sync_simulation(enable),
             Command::GearInVelocity {
                 master,
                 ratio_numerator,
@@ -1146,6 +1153,16 @@ impl Axis {
         let id = self.new_id();
         self.emit(id, Instruction::Reset, JobEventKind::Busy);
         if restart {
+            // A restart ends a simulated synchronous operation too.
+            if let Some(j) = self.sync_sim.take() {
+                self.emit(
+                    j,
+                    Instruction::SynchronizedMotionSimulation,
+                    JobEventKind::InSimulation(false),
+                );
+            }
+            self.abort_sync(JobEventKind::CommandAborted);
+            self.abort_pending(JobEventKind::CommandAborted);
             self.alarms = [None; MAX_ALARMS];
             self.homed = self.cfg.encoder == EncoderType::Absolute;
             self.offset = if self.homed {

@@ -165,6 +165,64 @@ impl Axis {
         }
     }
 
+    /// A new synchronous operation job: a synchronous axis, and no simulation running
+    /// (16#8076).
+    pub(super) fn require_new_sync(&self) -> Result<(), ErrorId> {
+        self.require_synchronous()?;
+        if self.sync_sim.is_some() {
+            return Err(ErrorId::SyncSimulationActive);
+        }
+        Ok(())
+    }
+
+    /// `MC_SynchronizedMotionSimulation` (seed 001 §1.6): enable while synchronous; the coupling
+    /// goes on logically while the follower's own setpoint stands (velocity 0) and survives a
+    /// disable; at the end the coupling is output again, without a new synchronization.
+    pub(super) fn cmd_sync_simulation(&mut self, enable: bool) -> Result<JobId, ErrorId> {
+        self.require_synchronous()?;
+        match (enable, self.sync_sim) {
+            (true, Some(id)) => Ok(id),
+            (true, None) => {
+                if !self.sync.is_some_and(|s| s.phase == SyncPhase::Synchronous) {
+                    return Err(ErrorId::NoSynchronousOperation);
+                }
+                let id = self.new_id();
+                self.sync_sim = Some(id);
+                self.emit(
+                    id,
+                    Instruction::SynchronizedMotionSimulation,
+                    JobEventKind::Busy,
+                );
+                self.emit(
+                    id,
+                    Instruction::SynchronizedMotionSimulation,
+                    JobEventKind::InSimulation(true),
+                );
+                Ok(id)
+            }
+            (false, Some(id)) => {
+                self.sync_sim = None;
+                self.emit(
+                    id,
+                    Instruction::SynchronizedMotionSimulation,
+                    JobEventKind::InSimulation(false),
+                );
+                self.emit(
+                    id,
+                    Instruction::SynchronizedMotionSimulation,
+                    JobEventKind::Done,
+                );
+                if self.sync.is_some() && self.enabled {
+                    // The coupling is output again (a step if the positions changed meanwhile).
+                    self.abort_main(JobEventKind::CommandAborted);
+                    self.goal = Goal::Sync;
+                }
+                Ok(id)
+            }
+            (false, None) => Ok(0),
+        }
+    }
+
     pub(super) fn require_synchronous(&self) -> Result<(), ErrorId> {
         if self.cfg.kind != AxisKind::Synchronous {
             return Err(ErrorId::IllegalObject);
@@ -196,7 +254,8 @@ impl Axis {
     /// Aborts the synchronous operation jobs that `new` overrides (seed 001 §3.3 table 2).
     pub(super) fn apply_table2(&mut self, new: NewJob) {
         let [active, pending, phasing] = self.running_sync();
-        if active.1 && table2(new, active.0).aborts() {
+        // A simulated synchronous operation is not aborted by single-axis jobs.
+        if active.1 && table2(new, active.0).aborts() && self.sync_sim.is_none() {
             self.abort_sync(JobEventKind::CommandAborted);
         }
         if pending.1 && table2(new, pending.0).aborts() {
@@ -275,7 +334,7 @@ impl Axis {
         dynamics: &Dynamics,
         velocity: bool,
     ) -> Result<JobId, ErrorId> {
-        self.require_synchronous()?;
+        self.require_new_sync()?;
         self.check_motion_allowed()?;
         let ratio = ratio_of(num, den)?;
         let d = Dynamics {
@@ -325,7 +384,7 @@ impl Axis {
         dynamics: &Dynamics,
         direction: SyncDirection,
     ) -> Result<JobId, ErrorId> {
-        self.require_synchronous()?;
+        self.require_new_sync()?;
         self.check_motion_allowed()?;
         let ratio = ratio_of(num, den)?;
         if !msp.is_finite() {
@@ -593,6 +652,8 @@ impl Axis {
         }
         let mut events = [None; 2];
         let mut cam_step = None;
+        // With a simulated synchronous operation the coupling runs logically only.
+        let own = self.basic;
         match &mut job.law {
             SyncLaw::Gear { offset, prev } => {
                 let velocity = job.instr == Instruction::GearInVelocity;
@@ -668,6 +729,22 @@ impl Axis {
             }
         }
         self.sync = Some(job);
+        if self.sync_sim.is_some() {
+            self.basic = if self.goal == Goal::Sync {
+                State {
+                    v: 0.0,
+                    a: 0.0,
+                    ..own
+                }
+            } else {
+                own
+            };
+            self.sync_flags = 8;
+            for e in events.into_iter().flatten() {
+                self.emit(job.id, job.instr, e);
+            }
+            return;
+        }
         for e in events.into_iter().flatten() {
             self.emit(job.id, job.instr, e);
         }
