@@ -554,4 +554,247 @@ mod follower_step {
         assert!(axis.alarms().next().is_none());
         assert!((axis.status().velocity - 150.0).abs() < 1e-9);
     }
+
+    use std::sync::Arc;
+    use tandem_motion::alarm::status_bit;
+    use tandem_motion::axis::{ApplicationMode, AxisState, SyncDirection, SyncProfileReference};
+    use tandem_motion::cam::Cam;
+
+    /// A follower in MC_CamIn (cyclic, direct: synchronous at once) on `cam`, its leader at
+    /// constant velocity `v` from 0; returns the follower, the next cycle and the follower
+    /// position at the sync point.
+    fn cammed(cam: Cam, v: f64) -> (Axis, i64, f64) {
+        let mut cfg = AxisConfig::example(0.001);
+        cfg.kind = AxisKind::Synchronous;
+        cfg.following_error.enable = false;
+        cfg.limits.max_velocity = 5000.0;
+        let mut axis = Axis::new(cfg).unwrap();
+        axis.step(0);
+        axis.command(&Command::Power {
+            enable: true,
+            start_mode: StartMode::PositionControlled,
+            stop_mode: StopMode::Emergency,
+        })
+        .unwrap();
+        axis.provide_cam(1, Arc::new(cam));
+        let id = axis
+            .command(&Command::CamIn {
+                master: 1,
+                cam: 1,
+                master_offset: 0.0,
+                slave_offset: 0.0,
+                master_scaling: 1.0,
+                slave_scaling: 1.0,
+                master_sync_position: 0.0,
+                sync_profile_reference: SyncProfileReference::Direct,
+                master_start_distance: 1.0,
+                dynamics: Dynamics::DEFAULT,
+                application_mode: ApplicationMode::Cyclic,
+                sync_direction: SyncDirection::Shortest,
+            })
+            .unwrap();
+        let y0 = axis.status().position_unwrapped;
+        let mut k = 1;
+        let mut in_sync = false;
+        while k < 5000 {
+            axis.set_leading_value(1, Some(lv_at(v, k)));
+            axis.step(k * MS);
+            while let Some(e) = axis.pop_event() {
+                in_sync |= e.job == id && e.kind == JobEventKind::InSync;
+            }
+            k += 1;
+        }
+        assert!(in_sync);
+        (axis, k, y0)
+    }
+
+    fn lv_at(v: f64, k: i64) -> LeadingValue {
+        LeadingValue {
+            p: v * k as f64 * 1e-3,
+            v,
+            a: 0.0,
+            modulo: None,
+        }
+    }
+
+    fn bench_cam(bencher: divan::Bencher, cam: Cam, v: f64) {
+        let f = cam.clone();
+        let (mut axis, mut k, y0) = cammed(cam, v);
+        bencher.bench_local(|| {
+            let a = black_box(&mut axis);
+            a.set_leading_value(1, Some(lv_at(v, k)));
+            a.step(black_box(k * MS));
+            k += 1;
+        });
+        // Still synchronous, without alarms, and on the cam: the sync point was the cam start
+        // with the leader at `v` ms, so the follower is at f(x mod range) - f(start) + y0.
+        assert!(axis.alarms().next().is_none(), "an alarm came up");
+        let s = axis.status();
+        assert_eq!(s.state, AxisState::SynchronizedMotion);
+        assert!(s.has(status_bit::SYNCHRONOUS));
+        assert_eq!(s.sync_function, 3);
+        let (c0, c1) = f.leading_range();
+        let x = lv_at(v, k - 1).p - lv_at(v, 1).p;
+        let expect = f.following(c0 + x.rem_euclid(c1 - c0)).unwrap().value - f.start().value + y0;
+        assert!(
+            (s.position_unwrapped - expect).abs() < 1e-6,
+            "{} vs {expect}",
+            s.position_unwrapped
+        );
+    }
+
+    /// MC_CamIn cyclic on a 1,000-point cubic-spline cam (range 0..999), leader at 500/s
+    /// (a cam cycle every 2 s, half a spline piece per cycle).
+    #[divan::bench]
+    fn cam_spline_1000(bencher: divan::Bencher) {
+        bench_cam(bencher, spline_1000_cam(), 500.0);
+    }
+
+    /// MC_CamIn cyclic on a 16-segment polynomial cam (degree 7, range 0..360), leader at
+    /// 90/s (a cam cycle every 4 s).
+    #[divan::bench]
+    fn cam_poly_16(bencher: divan::Bencher) {
+        bench_cam(bencher, poly_16_cam(), 90.0);
+    }
+}
+
+/// A cyclic cam through 1,000 points `x = 0, 1, …, 999` with `y` a smooth periodic function
+/// (`y(0) = y(999)`), cubic spline with equal first derivatives at the ends. Not monotonic.
+fn spline_1000_cam() -> tandem_motion::cam::Cam {
+    use tandem_motion::cam::{BoundaryCondition, Cam, CamDefinition, Interpolation};
+    let points = (0..1000)
+        .map(|i| {
+            let x = f64::from(i);
+            let w = std::f64::consts::TAU * x / 999.0;
+            (
+                x,
+                40.0 * w.sin() + 15.0 * (3.0 * w).sin() + 5.0 * (7.0 * w).cos(),
+            )
+        })
+        .collect();
+    let cam = Cam::interpolate(&CamDefinition {
+        points,
+        segments: vec![],
+        interpolation: Interpolation::CubicSpline,
+        boundary: BoundaryCondition::EqualFirstDerivative,
+    })
+    .unwrap();
+    assert_eq!(cam.piece_count(), 999);
+    cam
+}
+
+/// A cyclic cam of 16 explicit degree-7 polynomial segments of 22.5 over 0..360: alternating
+/// rises 0 -> h and returns h -> 0 (the 4-5-6-7 law, joined C3 at rest), h = 10, 14, …, 38.
+fn poly_16_cam() -> tandem_motion::cam::Cam {
+    use tandem_motion::cam::{Cam, CamDefinition, Interpolation, SegmentDef};
+    let segments = (0..16)
+        .map(|i| {
+            let h = 10.0 + 4.0 * f64::from(i / 2);
+            let (x0, x1) = (22.5 * f64::from(i), 22.5 * f64::from(i + 1));
+            let coeffs = if i % 2 == 0 {
+                [0.0, 0.0, 0.0, 0.0, 35.0 * h, -84.0 * h, 70.0 * h, -20.0 * h]
+            } else {
+                [h, 0.0, 0.0, 0.0, -35.0 * h, 84.0 * h, -70.0 * h, 20.0 * h]
+            };
+            SegmentDef::Polynomial { x0, x1, coeffs }
+        })
+        .collect();
+    let cam = Cam::interpolate(&CamDefinition {
+        points: vec![],
+        segments,
+        interpolation: Interpolation::CubicSpline,
+        boundary: Default::default(),
+    })
+    .unwrap();
+    assert_eq!(cam.piece_count(), 16);
+    assert_eq!(cam.continuity(), tandem_motion::cam::Continuity::C2);
+    cam
+}
+
+/// The cams of the cam benches and their fixed corpora: `(y, approach)` for `leading`, `x` for
+/// `following`, uniform over the cam's ranges.
+struct CamCorpora {
+    spline: tandem_motion::cam::Cam,
+    poly: tandem_motion::cam::Cam,
+    spline_leading: Vec<(f64, f64)>,
+    poly_leading: Vec<(f64, f64)>,
+    spline_following: Vec<f64>,
+}
+
+fn cam_corpora() -> &'static CamCorpora {
+    static C: OnceLock<CamCorpora> = OnceLock::new();
+    C.get_or_init(|| {
+        let leading = |cam: &tandem_motion::cam::Cam, seed: u64| {
+            let mut rng = Rng::new(seed);
+            let (x0, x1) = cam.leading_range();
+            let (y0, y1) = cam.following_range();
+            (0..CORPUS)
+                .map(|_| {
+                    let y = rng.uniform(y0, y1);
+                    let approach = rng.uniform(x0, x1);
+                    // Every case has a solution (y is inside the range of a continuous cam).
+                    cam.leading(y, approach).unwrap();
+                    (y, approach)
+                })
+                .collect::<Vec<_>>()
+        };
+        let spline = spline_1000_cam();
+        let poly = poly_16_cam();
+        let spline_leading = leading(&spline, 0x1ead_0001_cafe_2025);
+        let poly_leading = leading(&poly, 0x1ead_0002_cafe_2025);
+        let mut rng = Rng::new(0xf011_0001_cafe_2025);
+        let (x0, x1) = spline.leading_range();
+        let spline_following = (0..CORPUS).map(|_| rng.uniform(x0, x1)).collect();
+        CamCorpora {
+            spline,
+            poly,
+            spline_leading,
+            poly_leading,
+            spline_following,
+        }
+    })
+}
+
+/// One `Cam::leading` (MC_GetCamLeadingValue) for a random `y` with a random approach value,
+/// over the corpus. Both cams are non-monotonic, so every monotonic run is considered.
+#[divan::bench_group(sample_count = 1000, sample_size = 1000)]
+mod cam_leading_value {
+    use super::*;
+
+    #[divan::bench]
+    fn spline_1000(bencher: divan::Bencher) {
+        let c = cam_corpora();
+        let mut k = Cycle::new(c.spline_leading.len());
+        bencher.bench_local(|| {
+            let (y, approach) = c.spline_leading[k.next()];
+            black_box(&c.spline).leading(black_box(y), black_box(approach))
+        });
+    }
+
+    #[divan::bench]
+    fn poly_16(bencher: divan::Bencher) {
+        let c = cam_corpora();
+        let mut k = Cycle::new(c.poly_leading.len());
+        bencher.bench_local(|| {
+            let (y, approach) = c.poly_leading[k.next()];
+            black_box(&c.poly).leading(black_box(y), black_box(approach))
+        });
+    }
+}
+
+/// One `Cam::following` (MC_GetCamFollowingValue, no hint: binary search over the pieces) at a
+/// random `x`, over the corpus.
+#[divan::bench_group(sample_count = 1000, sample_size = 1000)]
+mod cam_following_value {
+    use super::*;
+
+    #[divan::bench]
+    fn spline_1000(bencher: divan::Bencher) {
+        let c = cam_corpora();
+        let mut k = Cycle::new(c.spline_following.len());
+        bencher.bench_local(|| {
+            let x = c.spline_following[k.next()];
+            black_box(&c.spline).following(black_box(x))
+        });
+    }
 }

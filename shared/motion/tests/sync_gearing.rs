@@ -649,3 +649,57 @@ fn synchronized_motion_simulation_keeps_the_coupling_through_a_disable() {
     assert!((p.fs().position_unwrapped - (offset + p.lv().p)).abs() < 1e-9);
     assert!((p.fs().position_unwrapped - held - 100.0).abs() < 1e-6);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 20, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(0x5e_ed_d7_a1), ..ProptestConfig::default() })]
+
+    /// SyncProfileReference 0: behind a constant-speed leader the follower keeps the given
+    /// velocity (or the synchronous one, if higher) and acceleration while synchronizing (to
+    /// 1e-4: the synchronization starts within a cycle of the computed start, which lengthens
+    /// it by up to one cycle of leader travel), and is synchronous exactly at the sync positions.
+    #[test]
+    fn gear_in_pos_by_dynamics_respects_them(
+        num in prop_oneof![-3i32..-1, 1i32..4], den in 1i32..3,
+        v_lead in 100.0f64..300.0, acc in 500.0f64..5000.0, ssp in -200.0f64..200.0,
+        start_v in -50.0f64..50.0,
+    ) {
+        let g = f64::from(num) / f64::from(den);
+        let mut fc = AxisConfig::example(0.001);
+        fc.limits.max_velocity = 5000.0;
+        fc.limits.max_acceleration = 50000.0;
+        fc.limits.max_deceleration = 50000.0;
+        fc.limits.max_jerk = 1e7;
+        fc.following_error.enable = false;
+        let mut p = Pair::new(AxisConfig::example(0.001), fc);
+        p.leader.command(&Command::MoveVelocity { dynamics: dynamics(v_lead, 50000.0, 50000.0, 0.0), direction: VelocityDirection::Positive, current: false, position_controlled: true }).unwrap();
+        if start_v != 0.0 {
+            p.f(Command::MoveVelocity { dynamics: dynamics(start_v.abs(), 5000.0, 5000.0, 0.0), direction: if start_v > 0.0 { VelocityDirection::Positive } else { VelocityDirection::Negative }, current: false, position_controlled: true }).unwrap();
+        }
+        p.step(100);
+        let msp = p.lv().p + 8000.0;
+        let vel = 400.0;
+        let gp = p.f(Command::GearInPos {
+            master: LEADER, ratio_numerator: num, ratio_denominator: den,
+            master_sync_position: msp, slave_sync_position: ssp,
+            sync_profile_reference: SyncProfileReference::Dynamics, master_start_distance: -1.0,
+            dynamics: dynamics(vel, acc, acc, 0.0), sync_direction: SyncDirection::Shortest,
+        }).unwrap();
+        let mut started = false;
+        for _ in 0..100_000 {
+            p.step(1);
+            let x = p.lv().p;
+            let s = p.fs();
+            if p.has(gp, JobEventKind::StartSync) && !p.has(gp, JobEventKind::InSync) {
+                started = true;
+                prop_assert!(s.velocity.abs() <= vel.max((g * v_lead).abs()).max(start_v.abs()) * (1.0 + 1e-4) + 1e-9, "v {}", s.velocity);
+                prop_assert!(s.acceleration.abs() <= acc * (1.0 + 1e-4), "a {} > {acc}", s.acceleration);
+            }
+            if x >= msp {
+                prop_assert!(p.has(gp, JobEventKind::InSync));
+                prop_assert!((s.position_unwrapped - (ssp + g * (x - msp))).abs() < 1e-9 * 1000.0);
+                break;
+            }
+        }
+        prop_assert!(started);
+    }
+}

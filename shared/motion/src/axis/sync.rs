@@ -49,6 +49,91 @@ impl Quintic {
         Self { x0, len, c }
     }
 
+    /// The exact maxima of `|y''|` and `|y'''|` (in x) over the quintic: `y''` is a cubic in `u`
+    /// with its extremes at the ends or where the quadratic `y'''` vanishes; `y'''` a quadratic.
+    fn peak_curvature_and_jerk(&self) -> [f64; 2] {
+        let c = &self.c;
+        let l = self.len;
+        let ddu = |u: f64| 2.0 * c[2] + u * (6.0 * c[3] + u * (12.0 * c[4] + u * 20.0 * c[5]));
+        let dddu = |u: f64| 6.0 * c[3] + u * (24.0 * c[4] + u * 60.0 * c[5]);
+        let mut a = ddu(0.0).abs().max(ddu(1.0).abs());
+        // Roots of y''' = 60 c5 u^2 + 24 c4 u + 6 c3.
+        let (qa, qb, qc) = (60.0 * c[5], 24.0 * c[4], 6.0 * c[3]);
+        let mut roots = [f64::NAN; 2];
+        if qa.abs() > 1e-300 {
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc >= 0.0 {
+                let r = disc.sqrt();
+                roots = [(-qb + r) / (2.0 * qa), (-qb - r) / (2.0 * qa)];
+            }
+        } else if qb.abs() > 1e-300 {
+            roots[0] = -qc / qb;
+        }
+        for u in roots.into_iter().filter(|u| (0.0..=1.0).contains(u)) {
+            a = a.max(ddu(u).abs());
+        }
+        // y'''' = 120 c5 u + 24 c4 vanishes at one point.
+        let mut j = dddu(0.0).abs().max(dddu(1.0).abs());
+        if c[5].abs() > 1e-300 {
+            let u = -24.0 * c[4] / (120.0 * c[5]);
+            if (0.0..=1.0).contains(&u) {
+                j = j.max(dddu(u).abs());
+            }
+        }
+        [a / (l * l), j / (l * l * l).abs()]
+    }
+
+    /// The exact maximum of `|y'|` (in x): the quartic `y'` has its extremes at the ends or
+    /// where the cubic `y''` vanishes; `y''` is monotonic between the roots of `y'''`, so each
+    /// of its roots is bracketed and found by bisection.
+    fn peak_slope(&self) -> f64 {
+        let c = &self.c;
+        let du =
+            |u: f64| c[1] + u * (2.0 * c[2] + u * (3.0 * c[3] + u * (4.0 * c[4] + u * 5.0 * c[5])));
+        let ddu = |u: f64| 2.0 * c[2] + u * (6.0 * c[3] + u * (12.0 * c[4] + u * 20.0 * c[5]));
+        let (qa, qb, qc) = (60.0 * c[5], 24.0 * c[4], 6.0 * c[3]);
+        let mut cuts = [0.0, 1.0, 1.0, 1.0];
+        let mut n = 1;
+        if qa.abs() > 1e-300 {
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc >= 0.0 {
+                let r = disc.sqrt();
+                let (r1, r2) = ((-qb - r) / (2.0 * qa), (-qb + r) / (2.0 * qa));
+                for u in [r1.min(r2), r1.max(r2)] {
+                    if u > 0.0 && u < 1.0 {
+                        cuts[n] = u;
+                        n += 1;
+                    }
+                }
+            }
+        } else if qb.abs() > 1e-300 {
+            let u = -qc / qb;
+            if u > 0.0 && u < 1.0 {
+                cuts[n] = u;
+                n += 1;
+            }
+        }
+        cuts[n] = 1.0;
+        let mut m = du(0.0).abs().max(du(1.0).abs());
+        for w in cuts[..=n].windows(2) {
+            let (mut a, mut b) = (w[0], w[1]);
+            let (fa, fb) = (ddu(a), ddu(b));
+            if fa * fb > 0.0 {
+                continue;
+            }
+            for _ in 0..36 {
+                let mid = 0.5 * (a + b);
+                if ddu(mid) * fa > 0.0 {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+            m = m.max(du(0.5 * (a + b)).abs());
+        }
+        m / self.len.abs()
+    }
+
     /// Value, first, second and third derivative with respect to x.
     #[inline]
     fn eval(&self, x: f64) -> [f64; 4] {
@@ -855,15 +940,32 @@ impl Axis {
                 if lv.v == 0.0 {
                     return None;
                 }
-                sync_length(follower, (g, curv), lv, &job.lim, |l| {
-                    target_rep(
-                        *ssp,
-                        cfg_mod,
-                        *direction,
-                        follower.p,
-                        follower.p + g * l * dir,
-                    )
-                })
+                // While the leader is far from the start the length is recomputed every 32nd
+                // cycle only; on the approach every cycle (it depends on both axes' state).
+                let last = dir * (*x_sync - *x_start);
+                let far =
+                    dir * (*x_sync - lv.p) > 4.0 * last + 40.0 * (lv.v * self.cfg.cycle).abs();
+                let cycle_ns = (self.cfg.cycle * 1e9).round() as i64;
+                let tick = cycle_ns > 0 && (self.now / cycle_ns) % 32 == 0;
+                if job.ready && last > 0.0 && far && !tick {
+                    return None;
+                }
+                sync_length(
+                    follower,
+                    (g, curv),
+                    lv,
+                    &job.lim,
+                    (self.cfg.cycle, last),
+                    |l| {
+                        target_rep(
+                            *ssp,
+                            cfg_mod,
+                            *direction,
+                            follower.p,
+                            follower.p + g * l * dir,
+                        )
+                    },
+                )
             }
         };
         // The next sync position ahead of the leader with room for the synchronization, fixed
@@ -971,6 +1073,7 @@ fn sync_length(
     (g, curv): (f64, f64),
     lv: LeadingValue,
     lim: &Limits,
+    (cycle, hint): (f64, f64),
     target: impl Fn(f64) -> f64,
 ) -> f64 {
     let v = lv.v.abs();
@@ -981,27 +1084,44 @@ fn sync_length(
         (follower.a - follower.v / lv.v * lv.a) / (lv.v * lv.v),
     );
     let dir = lv.v.signum();
-    let feasible = |l: f64| -> bool {
+    let jmax = lim.jerk;
+    let within = |l: f64| -> bool {
         let q = Quintic::hermite(0.0, dir * l, (follower.p, d1, d2), (target(l), g, curv));
-        (0..=64).all(|i| {
-            let [_, y1, y2, y3] = q.eval(dir * l * f64::from(i) / 64.0);
-            (y1 * v).abs() <= vmax * (1.0 + 1e-9)
-                && (y2 * v * v).abs() <= amax * (1.0 + 1e-9)
-                && (lim.jerk == 0.0 || (y3 * v * v * v).abs() <= lim.jerk * (1.0 + 1e-9))
-        })
+        let [y2max, y3max] = q.peak_curvature_and_jerk();
+        (y2max * v * v) <= amax * (1.0 + 1e-9)
+            && (jmax == 0.0 || y3max * v * v * v <= jmax * (1.0 + 1e-9))
+            && q.peak_slope() * v <= vmax * (1.0 + 1e-9)
     };
-    // Grow until feasible, then bisect (feasibility is monotonic in practice).
-    let mut hi = (v * v / amax).max(v * 1e-3).max(1e-9);
-    let mut n = 0;
-    while !feasible(hi) && n < 60 {
-        hi *= 2.0;
-        n += 1;
+    // The synchronization starts in the cycle before the leader reaches the start, so the
+    // length used is up to one cycle of leader travel longer; check that end too (the peak of
+    // the quintic is not monotonic in its length).
+    let step = v * cycle;
+    let feasible = |l: f64| within(l) && within(l + step);
+    // From the last length (a warm start, 1/4 around it) or by growing from a small one until
+    // feasible; then bisection. The result is always a feasible length (slightly above the
+    // shortest one, to 1/2^16 of the bracket).
+    let (mut lo, mut hi) = (0.0, 0.0);
+    if hint > 0.0 && feasible(hint * 1.25) {
+        hi = hint * 1.25;
+        lo = if feasible(hint * 0.8) {
+            0.0
+        } else {
+            hint * 0.8
+        };
+        if lo == 0.0 {
+            hi = hint * 0.8;
+        }
     }
-    let mut lo = hi / 2.0;
-    if n == 0 {
-        lo = 0.0;
+    if hi == 0.0 {
+        hi = (v * v / amax).max(v * 1e-3).max(1e-9);
+        let mut n = 0;
+        while !feasible(hi) && n < 60 {
+            hi *= 2.0;
+            n += 1;
+        }
+        lo = if n == 0 { 0.0 } else { hi / 2.0 };
     }
-    for _ in 0..40 {
+    for _ in 0..16 {
         let mid = 0.5 * (lo + hi);
         if feasible(mid) {
             hi = mid;
