@@ -148,10 +148,13 @@ impl Cam {
         if !(x > lo && x < hi) {
             x = 0.5 * (lo + hi);
         }
+        let mut prev_step = f64::INFINITY;
         for _ in 0..200 {
             let v = p.eval(x);
             let g = (v.value - y) * sg;
-            if g == 0.0 {
+            // Within the rounding noise of the evaluation: as exact as it gets.
+            let noise = 2.0 * f64::EPSILON * (y.abs() + v.value.abs());
+            if g.abs() <= noise {
                 return x;
             }
             if g < 0.0 {
@@ -160,12 +163,19 @@ impl Cam {
                 hi = x;
             }
             let mut nx = x - g / (v.first_derivative * sg);
-            if !(nx > lo && nx < hi) {
+            let newton = nx > lo && nx < hi;
+            if !newton {
                 nx = 0.5 * (lo + hi);
             }
-            if (nx - x).abs() <= 2.0 * f64::EPSILON * scale || nx <= lo || nx >= hi {
+            let step = (nx - x).abs();
+            if step <= 2.0 * f64::EPSILON * scale || nx <= lo || nx >= hi {
                 return nx;
             }
+            // Newton that no longer shrinks its step is bouncing in the noise.
+            if newton && step >= prev_step {
+                return x;
+            }
+            prev_step = if newton { step } else { f64::INFINITY };
             x = nx;
         }
         x
