@@ -5,10 +5,7 @@
 // The allocation check needs `unsafe impl GlobalAlloc`; it only forwards to `System`.
 #![allow(unsafe_code)]
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::f64::consts::PI;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -885,45 +882,8 @@ fn csv_to_cam() {
 
 // --- No allocation on the query path ----------------------------------------------------------
 
-/// Allocations made by a thread that armed the counter (as in `no_alloc.rs`).
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-
-thread_local! {
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-}
-
-fn armed() -> bool {
-    ARMED.try_with(Cell::get).unwrap_or(false)
-}
-
-struct Counting;
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+mod common;
+use common::counting::{arm, disarm, Counting};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -935,8 +895,7 @@ fn queries_do_not_allocate() {
         .map(|i| (i as f64 * 0.1, (i as f64 * 0.1).sin()))
         .collect();
     let wavy = build(&pts, Interpolation::Bezier, BoundaryCondition::None);
-    ALLOCS.store(0, Ordering::SeqCst);
-    ARMED.with(|a| a.set(true));
+    arm();
     let mut sum = 0.0;
     let mut hint = 0;
     for k in 0..=10_000 {
@@ -949,11 +908,7 @@ fn queries_do_not_allocate() {
         sum += wavy.leading(w.value, xw).unwrap();
         sum += wavy.following(1e9).map_or(0.0, |v| v.value);
     }
-    ARMED.with(|a| a.set(false));
+    let (allocs, _) = disarm();
     assert!(sum.is_finite());
-    assert_eq!(
-        ALLOCS.load(Ordering::SeqCst),
-        0,
-        "allocations on the query path"
-    );
+    assert_eq!(allocs, 0, "allocations on the query path");
 }

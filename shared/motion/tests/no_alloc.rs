@@ -3,12 +3,6 @@
 //! software limits, a modulo axis and a speed axis) run 10,000 cycles of 1 ms with a script of
 //! commands and with their events drained every cycle.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
-// A global allocator needs `unsafe impl GlobalAlloc`; it only forwards to `System`.
-#![allow(unsafe_code)]
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use tandem_motion::alarm::AlarmId;
 use tandem_motion::axis::{
@@ -20,70 +14,11 @@ use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::JobEventKind;
 use tandem_motion::modulo::Modulo;
 
-/// Allocations (alloc, alloc_zeroed, realloc) made by an armed thread.
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-/// Deallocations made by an armed thread (for the report only).
-static DEALLOCS: AtomicU64 = AtomicU64::new(0);
-
-thread_local! {
-    /// Counting is armed on this thread. Const-initialised and without destructor, so reading
-    /// it inside the allocator never allocates or recurses.
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-}
-
-fn armed() -> bool {
-    ARMED.try_with(Cell::get).unwrap_or(false)
-}
-
-struct Counting;
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        if armed() {
-            DEALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+mod common;
+use common::counting::{arm, disarm, Counting};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
-
-/// Arms the counter on this thread and zeroes it; returns the counts when disarmed.
-fn arm() {
-    ALLOCS.store(0, Ordering::SeqCst);
-    DEALLOCS.store(0, Ordering::SeqCst);
-    ARMED.with(|a| a.set(true));
-}
-
-fn disarm() -> (u64, u64) {
-    ARMED.with(|a| a.set(false));
-    (
-        ALLOCS.load(Ordering::SeqCst),
-        DEALLOCS.load(Ordering::SeqCst),
-    )
-}
 
 const MS: i64 = 1_000_000;
 const CYCLES: u32 = 10_000;

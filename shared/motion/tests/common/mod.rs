@@ -2,6 +2,8 @@
 //! collected.
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+pub mod counting;
+
 use tandem_motion::axis::{Axis, AxisConfig, AxisKind, AxisStatus, Command, StartMode, StopMode};
 use tandem_motion::dynamics::Dynamics;
 use tandem_motion::error_id::ErrorId;
