@@ -120,20 +120,14 @@ impl Axis {
             ratio: slope,
             lim: r.limits,
             phase: SyncPhase::Pending,
-            law: SyncLaw::GearPos {
-                msp: mo + ms * (c0 + msp),
+            law: SyncLaw::absolute(
+                mo + ms * (c0 + msp),
                 ssp,
-                slope,
-                curv,
+                (slope, curv),
                 reference,
                 msd,
                 direction,
-                lead_dir: 0.0,
-                x_sync: 0.0,
-                x_start: 0.0,
-                y_sync: 0.0,
-                quintic: None,
-            },
+            ),
             ready: false,
         };
         self.apply_override_table(NewJob::CamInPending);

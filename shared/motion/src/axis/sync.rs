@@ -195,6 +195,34 @@ pub(super) struct SyncJob {
     pub ready: bool,
 }
 
+impl SyncLaw {
+    /// The absolute synchronization (MC_GearInPos, MC_CamIn) to the follower value `ssp` with
+    /// `(slope, curvature)` when the leader is at `msp`.
+    pub(super) fn absolute(
+        msp: f64,
+        ssp: f64,
+        (slope, curv): (f64, f64),
+        reference: SyncProfileReference,
+        msd: f64,
+        direction: SyncDirection,
+    ) -> Self {
+        SyncLaw::GearPos {
+            msp,
+            ssp,
+            slope,
+            curv,
+            reference,
+            msd,
+            direction,
+            lead_dir: 0.0,
+            x_sync: 0.0,
+            x_start: 0.0,
+            y_sync: 0.0,
+            quintic: None,
+        }
+    }
+}
+
 impl SyncJob {
     /// The follower's coordinates moved by `delta` (homing): the coupling moves with them.
     pub(super) fn shift_follower(&mut self, delta: f64) {
@@ -500,20 +528,7 @@ impl Axis {
             ratio,
             lim: r.limits,
             phase: SyncPhase::Pending,
-            law: SyncLaw::GearPos {
-                msp,
-                ssp,
-                slope: ratio,
-                curv: 0.0,
-                reference,
-                msd,
-                direction,
-                lead_dir: 0.0,
-                x_sync: 0.0,
-                x_start: 0.0,
-                y_sync: 0.0,
-                quintic: None,
-            },
+            law: SyncLaw::absolute(msp, ssp, (ratio, 0.0), reference, msd, direction),
             ready: false,
         };
         // A pending job aborts nothing but an older pending one (tables 1 and 2, "pending").
@@ -573,33 +588,42 @@ impl Axis {
         if s.phase != SyncPhase::Synchronous {
             return Err(ErrorId::SynchronizingActive);
         }
+        let mut job = self.plan_shift(
+            self.phase,
+            (shift, absolute),
+            dynamics,
+            (Instruction::PhasingAbsolute, Instruction::PhasingRelative),
+        )?;
+        self.apply_table2(NewJob::Phasing);
+        job.id = self.new_id();
+        self.emit(job.id, job.instr, JobEventKind::Busy);
+        self.phasing = Some(job);
+        Ok(job.id)
+    }
+
+    /// A shift profile (phasing or offset) from `current` to the value (absolute) or by it.
+    fn plan_shift(
+        &mut self,
+        current: State,
+        (value, absolute): (f64, bool),
+        dynamics: &Dynamics,
+        (abs_instr, rel_instr): (Instruction, Instruction),
+    ) -> Result<PhasingJob, ErrorId> {
         let r = self
             .cfg
             .limits
             .resolve(&self.cfg.defaults, dynamics, false)?;
         self.warn_clamped(r.clamped);
-        self.apply_table2(NewJob::Phasing);
-        let instr = if absolute {
-            Instruction::PhasingAbsolute
-        } else {
-            Instruction::PhasingRelative
-        };
-        let target = if absolute {
-            shift
-        } else {
-            self.phase.p + shift
-        };
+        let target = if absolute { value } else { current.p + value };
         let prof =
-            plan_position(self.phase, target, &r.limits).map_err(|_| ErrorId::IllegalPhaseShift)?;
-        let id = self.new_id();
-        self.emit(id, instr, JobEventKind::Busy);
-        self.phasing = Some(PhasingJob {
-            id,
+            plan_position(current, target, &r.limits).map_err(|_| ErrorId::IllegalDistance)?;
+        let instr = if absolute { abs_instr } else { rel_instr };
+        Ok(PhasingJob {
+            id: 0,
             instr,
             prof,
             t0: self.now,
-        });
-        Ok(id)
+        })
     }
 
     pub(super) fn cmd_offset(
@@ -618,35 +642,17 @@ impl Axis {
         if s.phase != SyncPhase::Synchronous {
             return Err(ErrorId::SynchronizingActive);
         }
-        let r = self
-            .cfg
-            .limits
-            .resolve(&self.cfg.defaults, dynamics, false)?;
-        self.warn_clamped(r.clamped);
-        if let Some(o) = self.offset_job.take() {
-            self.emit(o.id, o.instr, JobEventKind::CommandAborted);
-        }
-        let instr = if absolute {
-            Instruction::OffsetAbsolute
-        } else {
-            Instruction::OffsetRelative
-        };
-        let target = if absolute {
-            offset
-        } else {
-            self.shift_out.p + offset
-        };
-        let prof = plan_position(self.shift_out, target, &r.limits)
-            .map_err(|_| ErrorId::IllegalSlaveOffset)?;
-        let id = self.new_id();
-        self.emit(id, instr, JobEventKind::Busy);
-        self.offset_job = Some(PhasingJob {
-            id,
-            instr,
-            prof,
-            t0: self.now,
-        });
-        Ok(id)
+        let mut job = self.plan_shift(
+            self.shift_out,
+            (offset, absolute),
+            dynamics,
+            (Instruction::OffsetAbsolute, Instruction::OffsetRelative),
+        )?;
+        self.abort_offset(JobEventKind::CommandAborted);
+        job.id = self.new_id();
+        self.emit(job.id, job.instr, JobEventKind::Busy);
+        self.offset_job = Some(job);
+        Ok(job.id)
     }
 
     /// The cyclic part: pending start conditions, set-up, the coupling law, job events.
