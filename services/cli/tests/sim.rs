@@ -333,3 +333,43 @@ fn cross_cutter_follows_its_cam_exactly_through_a_speed_change() {
     assert!(ends >= 9, "{ends}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_cam_is_interpolated_again_at_run_time_only_when_no_job_uses_it() {
+    let dir = std::env::temp_dir().join(format!("tandem-icam-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let src = std::fs::read_to_string(root().join("config/cross-cutter.toml")).unwrap();
+    // A second cam: 600 mm sheets (a line, for the test).
+    let cell = dir.join("cell.toml");
+    std::fs::write(
+        &cell,
+        format!("{src}\n[cams.spare]\ninterpolation = \"linear\"\npoints = [[0.0, 0.0], [600.0, 360.0]]\n"),
+    )
+    .unwrap();
+    let script = dir.join("script.toml");
+    let base = std::fs::read_to_string(root().join("config/cross-cutter-script.toml")).unwrap();
+    std::fs::write(
+        &script,
+        format!(
+            "{base}\n[[at]]\nt = 2.0\naxis = \"cut\"\ninstruction = \"MC_InterpolateCam\"\n\n[[at]]\nt = 2.0\naxis = \"spare\"\ninstruction = \"MC_InterpolateCam\"\nfrom = \"cut\"\n"
+        ),
+    )
+    .unwrap();
+    let trace = dir.join("t.csv");
+    let (code, log, err) = run(&[
+        "sim",
+        cell.to_str().unwrap(),
+        "--script",
+        script.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The running job holds `cut`: refused. `spare` is free: replaced by cut's definition.
+    assert!(
+        log.contains("cut MC_InterpolateCam rejected: 16#80AB"),
+        "{log}"
+    );
+    assert!(log.contains("spare MC_InterpolateCam: Done"), "{log}");
+    std::fs::remove_dir_all(&dir).ok();
+}

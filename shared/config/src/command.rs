@@ -250,7 +250,8 @@ pub struct Refs {
     pub cam: Option<CamId>,
 }
 
-fn normalize(s: &str) -> String {
+/// An instruction name without `MC_`, underscores, dashes or case.
+pub fn normalize(s: &str) -> String {
     let s = s.to_ascii_lowercase().replace(['_', '-'], "");
     s.strip_prefix("mc").map(str::to_string).unwrap_or(s)
 }

@@ -141,6 +141,8 @@ pub struct CamEntry {
     pub name: String,
     /// The interpolated cam, shared by every job that uses it.
     pub cam: std::sync::Arc<tandem_motion::cam::Cam>,
+    /// Its definition (for MC_InterpolateCam at run time).
+    pub definition: tandem_motion::cam::CamDefinition,
 }
 
 impl PartialEq for CamEntry {
@@ -449,7 +451,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     }
     let mut cams = Vec::new();
     for (name, c) in &raw.cams {
-        let cam = cam_from(c, dir).map_err(|(key, message)| {
+        let (cam, definition) = cam_from(c, dir).map_err(|(key, message)| {
             let mut path = vec!["cams", name.as_str()];
             if !key.is_empty() {
                 path.push(key);
@@ -463,6 +465,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         cams.push(CamEntry {
             name: name.clone(),
             cam: std::sync::Arc::new(cam),
+            definition,
         });
     }
     Ok(Cell {
@@ -481,7 +484,7 @@ type FieldError = (&'static str, String);
 fn cam_from(
     c: &schema::CamSection,
     dir: Option<&Path>,
-) -> Result<tandem_motion::cam::Cam, FieldError> {
+) -> Result<(tandem_motion::cam::Cam, tandem_motion::cam::CamDefinition), FieldError> {
     use tandem_motion::cam::{
         BoundaryCondition, Cam, CamDefinition, Interpolation, MotionLaw, SegmentDef,
     };
@@ -587,8 +590,9 @@ fn cam_from(
         interpolation,
         boundary,
     };
-    Cam::interpolate(&def)
-        .map_err(|e| ("", format!("cannot interpolate: {e:?} ({})", e.error_id())))
+    let cam = Cam::interpolate(&def)
+        .map_err(|e| ("", format!("cannot interpolate: {e:?} ({})", e.error_id())))?;
+    Ok((cam, def))
 }
 
 fn pick<T: Copy>(key: &'static str, value: &str, options: &[(&str, T)]) -> Result<T, FieldError> {

@@ -16,19 +16,34 @@
 
 use crate::command::{self, Value};
 use crate::ConfigError;
-use tandem_motion::axis::Command;
+use tandem_motion::axis::{CamId, Command};
+
+/// What a script entry does.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Action {
+    /// An instruction for an axis or an external encoder.
+    Command(Command),
+    /// `MC_InterpolateCam`: interpolate the cam `cam` again from the definition of the cam
+    /// `from` (itself by default); refused while a job uses the cam (16#80AB).
+    InterpolateCam {
+        /// The cam replaced.
+        cam: CamId,
+        /// The cam whose definition is interpolated.
+        from: CamId,
+    },
+}
 
 /// One timed command.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScriptEntry {
     /// When (ns of virtual time).
     pub t_ns: i64,
-    /// Target axis name.
+    /// Target object name (axis, encoder, or cam for MC_InterpolateCam).
     pub axis: String,
     /// The instruction as written (for the log).
     pub instruction: &'static str,
-    /// The command.
-    pub command: Command,
+    /// What it does.
+    pub action: Action,
     /// Line in the script file.
     pub line: usize,
 }
@@ -115,6 +130,51 @@ pub fn parse(file: &str, src: &str, axes: &[&str], cams: &[&str]) -> Result<Scri
                 .and_then(num)
                 .and_then(seconds_to_ns)
                 .ok_or_else(|| e(line, &key, "`t` (seconds >= 0) is required".into()))?;
+            let instr_name = t.get("instruction").and_then(|x| x.as_str()).unwrap_or("");
+            if command::normalize(instr_name) == "interpolatecam" {
+                // A cam technology object: `axis` names the cam, `from` another cam's definition.
+                let target = t
+                    .get("axis")
+                    .and_then(|x| x.as_str())
+                    .ok_or_else(|| e(line, &key, "`axis` (the cam's name) is required".into()))?;
+                let find = |name: &str| {
+                    cams.iter().position(|c| *c == name).ok_or_else(|| {
+                        e(
+                            line,
+                            &key,
+                            format!("unknown cam `{name}`; the cell has: {}", cams.join(", ")),
+                        )
+                    })
+                };
+                let cam = find(target)?;
+                let from = match t.get("from") {
+                    None => cam,
+                    Some(f) => find(
+                        f.as_str()
+                            .ok_or_else(|| e(line, &key, "`from` must be a cam name".into()))?,
+                    )?,
+                };
+                for (k, _) in t.iter() {
+                    if !matches!(k, "t" | "axis" | "instruction" | "from") {
+                        return Err(e(
+                            line,
+                            &key,
+                            format!("MC_InterpolateCam: unknown parameter `{k}`; parameters: from"),
+                        ));
+                    }
+                }
+                entries.push(ScriptEntry {
+                    t_ns: time,
+                    axis: target.to_string(),
+                    instruction: "MC_InterpolateCam",
+                    action: Action::InterpolateCam {
+                        cam: cam as u32,
+                        from: from as u32,
+                    },
+                    line: line.unwrap_or(0),
+                });
+                continue;
+            }
             let axis = t
                 .get("axis")
                 .and_then(|x| x.as_str())
@@ -191,7 +251,7 @@ pub fn parse(file: &str, src: &str, axes: &[&str], cams: &[&str]) -> Result<Scri
                 t_ns: time,
                 axis: axis.to_string(),
                 instruction: name,
-                command,
+                action: Action::Command(command),
                 line: line.unwrap_or(0),
             });
         }

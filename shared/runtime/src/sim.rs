@@ -3,9 +3,11 @@
 //! axis is written to CSV every base tick. The same inputs give byte-identical output.
 
 use std::io::{self, Write};
-use tandem_config::script::Script;
+use std::sync::Arc;
+use tandem_config::script::{Action, Script};
 use tandem_config::{Cell, Coupling, EncoderSource};
-use tandem_motion::axis::{Axis, AxisStatus, Command};
+use tandem_motion::axis::{Axis, AxisStatus, CamId, Command};
+use tandem_motion::cam::{Cam, CamDefinition};
 use tandem_motion::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::JobEventKind;
@@ -117,6 +119,38 @@ fn write_row(
     writeln!(out)
 }
 
+/// MC_InterpolateCam: the definition of `from` interpolated into `cam`, refused while a job
+/// holds the cam (16#80AB). In a node this runs off the cyclic path; the swap of the reference is
+/// the atomic switch, and running jobs keep the cam they started with.
+fn interpolate_cam(
+    cell: &Cell,
+    cams: &mut [(Arc<Cam>, CamDefinition)],
+    cam: CamId,
+    from: CamId,
+) -> Result<(), ErrorId> {
+    let (Ok(c), Ok(f)) = (usize::try_from(cam), usize::try_from(from)) else {
+        return Err(ErrorId::IllegalObject);
+    };
+    let def = cams
+        .get(f)
+        .map(|x| x.1.clone())
+        .ok_or(ErrorId::IllegalObject)?;
+    let slot = cams.get_mut(c).ok_or(ErrorId::IllegalObject)?;
+    // The table holds one reference (and the cell a second while the cam is the loaded one);
+    // any other is a job's.
+    let held = 1 + usize::from(
+        cell.cams
+            .get(c)
+            .is_some_and(|x| Arc::ptr_eq(&x.cam, &slot.0)),
+    );
+    if Arc::strong_count(&slot.0) > held {
+        return Err(ErrorId::CamInUse);
+    }
+    let new = Cam::interpolate(&def).map_err(|e| e.error_id())?;
+    *slot = (Arc::new(new), def);
+    Ok(())
+}
+
 /// Whether `follower` appears in the leader chain of `leader` (a recursive coupling).
 fn recursive(axes: &[Axis], follower: usize, leader: usize) -> bool {
     let mut stack = vec![leader];
@@ -175,6 +209,12 @@ pub fn run(
         encoders.push(enc);
     }
     let n_axes = axes.len();
+    // The cams as the jobs see them: MC_InterpolateCam replaces one (a job keeps its own).
+    let mut cams: Vec<(Arc<Cam>, CamDefinition)> = cell
+        .cams
+        .iter()
+        .map(|c| (Arc::clone(&c.cam), c.definition.clone()))
+        .collect();
     let cycles: Vec<i64> = cell
         .axes
         .iter()
@@ -216,9 +256,31 @@ pub fn run(
         }
         while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
             next += 1;
+            let command = match e.action {
+                Action::Command(c) => c,
+                Action::InterpolateCam { cam, from } => {
+                    summary.commands += 1;
+                    match interpolate_cam(cell, &mut cams, cam, from) {
+                        Ok(()) => {
+                            writeln!(log, "t={} {} MC_InterpolateCam: Done", seconds(t), e.axis)?
+                        }
+                        Err(id) => {
+                            summary.rejected += 1;
+                            writeln!(
+                                log,
+                                "t={} {} MC_InterpolateCam rejected: {id} ({})",
+                                seconds(t),
+                                e.axis,
+                                id.description()
+                            )?;
+                        }
+                    }
+                    continue;
+                }
+            };
             if let Some(k) = cell.encoders.iter().position(|x| x.name == e.axis) {
                 summary.commands += 1;
-                if let Err(id) = encoders[k].command(&e.command) {
+                if let Err(id) = encoders[k].command(&command) {
                     summary.rejected += 1;
                     writeln!(
                         log,
@@ -235,24 +297,24 @@ pub fn run(
                 continue;
             };
             summary.commands += 1;
-            let master = match e.command {
+            let master = match command {
                 Command::GearIn { master, .. }
                 | Command::GearInPos { master, .. }
                 | Command::GearInVelocity { master, .. }
                 | Command::CamIn { master, .. } => Some(master),
                 _ => None,
             };
-            if let Command::CamIn { cam, .. } = e.command {
+            if let Command::CamIn { cam, .. } = command {
                 // The job takes its own reference to the interpolated cam.
-                if let Some(c) = usize::try_from(cam).ok().and_then(|c| cell.cams.get(c)) {
-                    axes[i].provide_cam(cam, std::sync::Arc::clone(&c.cam));
+                if let Some((c, _)) = usize::try_from(cam).ok().and_then(|c| cams.get(c)) {
+                    axes[i].provide_cam(cam, std::sync::Arc::clone(c));
                 }
             }
             let result = match master.and_then(|m| usize::try_from(m).ok()) {
                 Some(m) if recursive(&axes, i, m) => Err(ErrorId::RecursiveSyncChain),
                 // The leader must be one of the follower's configured leaders.
                 Some(m) if cell.axes[i].coupling(m).is_none() => Err(ErrorId::IllegalObject),
-                _ => axes[i].command(&e.command),
+                _ => axes[i].command(&command),
             };
             if let Err(id) = result {
                 summary.rejected += 1;

@@ -74,6 +74,7 @@ impl Axis {
     ) -> Result<JobId, ErrorId> {
         self.require_new_sync()?;
         self.check_motion_allowed()?;
+        // The job takes the provided reference once accepted (the runtime's table keeps its own).
         let cam = match &self.provided_cam {
             Some((id, cam)) if *id == cam_id => Arc::clone(cam),
             _ => return Err(ErrorId::IllegalObject),
@@ -131,6 +132,7 @@ impl Axis {
             ready: false,
         };
         self.apply_override_table(NewJob::CamInPending);
+        self.provided_cam = None;
         self.sync_pending = Some(job);
         self.lead[1] = None;
         self.cams[1] = Some(cam);
