@@ -466,7 +466,7 @@ fn actual_value_coupling_compensates_the_leader_delay() {
     lc.extrapolation.velocity_t1 = 0.005;
     lc.extrapolation.following_time = 0.003;
     let mut p = Pair::new(lc, AxisConfig::example(0.001));
-    p.actual = true;
+    p.use_actual();
     p.leader
         .command(&Command::MoveVelocity {
             dynamics: dynamics(120.0, 1000.0, 1000.0, 0.0),

@@ -209,6 +209,16 @@ pub fn run(
         encoders.push(enc);
     }
     let n_axes = axes.len();
+    // Axes that lead by actual value run the extrapolation of their actual value.
+    for a in &cell.axes {
+        for (j, c) in a.leaders.iter().flatten() {
+            if *c == Coupling::Actual {
+                if let Some(leader) = axes.get_mut(*j) {
+                    leader.set_actual_value_output(true);
+                }
+            }
+        }
+    }
     // The cams as the jobs see them: MC_InterpolateCam replaces one (a job keeps its own).
     let mut cams: Vec<(Arc<Cam>, CamDefinition)> = cell
         .cams

@@ -112,7 +112,10 @@ impl Axis {
         let slope = ss * at_sync.first_derivative / ms;
         let curv = ss * at_sync.second_derivative / (ms * ms);
         // A new cam while a cyclic cam runs: it takes over at the end of the current cycle.
-        let at_cycle_end = self.sync.is_some_and(|s| s.instr == Instruction::CamIn)
+        let at_cycle_end = self
+            .sync
+            .as_ref()
+            .is_some_and(|s| s.instr == Instruction::CamIn)
             && self.cam_maps[0].is_some_and(|m| m.mode != ApplicationMode::Once);
         let job = SyncJob {
             id,

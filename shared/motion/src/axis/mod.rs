@@ -259,8 +259,10 @@ pub struct Axis {
     /// Leading values for this cycle: of the active and of the pending job's leader.
     lead: [Option<crate::leading::LeadingValue>; 2],
     sync_flags: u8,
-    /// The actual value prepared for actual-value coupling.
+    /// The actual value prepared for actual-value coupling (run only while a follower may use
+    /// it: [`Axis::set_actual_value_output`]).
     extrapolator: Extrapolator,
+    actual_output: bool,
     alarms: [Option<AlarmInstance>; MAX_ALARMS],
     hw_trigger: Option<(Sense, f64)>,
     sw_active: Option<Sense>,
@@ -334,6 +336,7 @@ impl Axis {
             lead: [None; 2],
             sync_flags: 0,
             extrapolator: Extrapolator::new(cfg.extrapolation, cfg.cycle),
+            actual_output: false,
             alarms: [None; MAX_ALARMS],
             hw_trigger: None,
             sw_active: None,
@@ -410,9 +413,27 @@ impl Axis {
         }
     }
 
+    /// Runs the extrapolation of the actual value every cycle (for followers coupled by actual
+    /// value); switched on by the runtime for the axes that lead that way.
+    pub fn set_actual_value_output(&mut self, on: bool) {
+        if on && !self.actual_output {
+            self.extrapolator.reset(self.actual_p, self.actual_v);
+        }
+        self.actual_output = on;
+    }
+
     /// This axis as a leader with actual-value coupling: its actual value filtered and
-    /// extrapolated (`StatusExtrapolation`, see [`crate::extrapolation`]).
+    /// extrapolated (`StatusExtrapolation`, see [`crate::extrapolation`]); the plain actual
+    /// value while [`Axis::set_actual_value_output`] is off.
     pub fn actual_leading_value(&self) -> LeadingValue {
+        if !self.actual_output {
+            return LeadingValue {
+                p: self.actual_p,
+                v: self.actual_v,
+                a: 0.0,
+                modulo: self.cfg.modulo,
+            };
+        }
         let e = self.extrapolator.last();
         LeadingValue {
             p: e.position,
@@ -583,7 +604,7 @@ impl Axis {
     }
 
     fn running_classes(&self) -> [(RunningMotion, bool); 3] {
-        let main = self.main.map(|m| match m.instr {
+        let main = self.main.as_ref().map(|m| match m.instr {
             Instruction::Home => RunningMotion::HomingActive,
             Instruction::MotionInPosition | Instruction::MotionInVelocity => {
                 RunningMotion::MotionIn

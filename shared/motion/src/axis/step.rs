@@ -19,7 +19,9 @@ impl Axis {
         self.prev_phys = phys;
         self.actual_p = phys + self.offset;
         self.actual_v = act.v;
-        self.extrapolator.step(self.actual_p, self.actual_v);
+        if self.actual_output {
+            self.extrapolator.step(self.actual_p, self.actual_v);
+        }
 
         self.check_hw_limits(phys);
         self.active_homing(prev, phys);
@@ -576,13 +578,17 @@ impl Axis {
         let mut sw = 0u32;
         let mut ew = 0u32;
         let mut ww = 0u32;
-        for a in self.alarms() {
-            let spec = a.spec();
-            ew |= spec.error_mask();
-            ww |= spec.warning_mask();
-        }
-        let detail = ErrorDetail::from_pending(self.alarms());
-        let main = self.main.map(|m| m.instr);
+        let detail = if self.alarms.iter().any(Option::is_some) {
+            for a in self.alarms() {
+                let spec = a.spec();
+                ew |= spec.error_mask();
+                ww |= spec.warning_mask();
+            }
+            ErrorDetail::from_pending(self.alarms())
+        } else {
+            ErrorDetail::NONE
+        };
+        let main = self.main.as_ref().map(|m| m.instr);
         let set = |sw: &mut u32, bit: u32, on: bool| {
             if on {
                 *sw |= bit;
@@ -675,7 +681,7 @@ impl Axis {
                 Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
             ),
         );
-        let sync_phase = self.sync.map(|j| j.phase);
+        let sync_phase = self.sync.as_ref().map(|j| j.phase);
         set(
             &mut sw,
             status_bit::SYNCHRONIZING,
@@ -732,10 +738,13 @@ impl Axis {
             override_velocity: self.override_pct,
             position_unwrapped: tot.p,
             actual_position_unwrapped: self.actual_p,
-            motion_job: self.main.map(|m| (m.id, m.instr)),
-            superimposed_job: self.sup_job.map(|s| (s.id, Instruction::MoveSuperimposed)),
-            sync_job: self.sync.map(|s| (s.id, s.instr)),
-            sync_function: match self.sync.map(|s| s.instr) {
+            motion_job: self.main.as_ref().map(|m| (m.id, m.instr)),
+            superimposed_job: self
+                .sup_job
+                .as_ref()
+                .map(|s| (s.id, Instruction::MoveSuperimposed)),
+            sync_job: self.sync.as_ref().map(|s| (s.id, s.instr)),
+            sync_function: match self.sync.as_ref().map(|s| s.instr) {
                 Some(Instruction::GearIn) => 1,
                 Some(Instruction::GearInPos) => 2,
                 Some(Instruction::CamIn) => 3,

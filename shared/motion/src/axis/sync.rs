@@ -263,17 +263,17 @@ impl Axis {
     /// The leaders this axis needs leading values for in the next cycle (active job first).
     pub fn leaders(&self) -> [Option<LeaderId>; 2] {
         [
-            self.sync.map(|s| s.master),
-            self.sync_pending.map(|s| s.master),
+            self.sync.as_ref().map(|s| s.master),
+            self.sync_pending.as_ref().map(|s| s.master),
         ]
     }
 
     /// Hands the axis the value of leader `id` for its next cycle (`None`: not available).
     pub fn set_leading_value(&mut self, id: LeaderId, lv: Option<LeadingValue>) {
-        if self.sync.map(|s| s.master) == Some(id) {
+        if self.sync.as_ref().map(|s| s.master) == Some(id) {
             self.lead[0] = lv;
         }
-        if self.sync_pending.map(|s| s.master) == Some(id) {
+        if self.sync_pending.as_ref().map(|s| s.master) == Some(id) {
             self.lead[1] = lv;
         }
     }
@@ -296,7 +296,11 @@ impl Axis {
         match (enable, self.sync_sim) {
             (true, Some(id)) => Ok(id),
             (true, None) => {
-                if !self.sync.is_some_and(|s| s.phase == SyncPhase::Synchronous) {
+                if !self
+                    .sync
+                    .as_ref()
+                    .is_some_and(|s| s.phase == SyncPhase::Synchronous)
+                {
                     return Err(ErrorId::NoSynchronousOperation);
                 }
                 let id = self.new_id();
@@ -345,12 +349,12 @@ impl Axis {
 
     /// The table-2 classes of the running synchronous operation jobs.
     fn running_sync(&self) -> [(RunningSync, bool); 3] {
-        let active = self.sync.map(|s| match s.instr {
+        let active = self.sync.as_ref().map(|s| match s.instr {
             Instruction::GearInPos => RunningSync::GearInPosActive,
             Instruction::CamIn => RunningSync::CamInActive,
             _ => RunningSync::GearIn,
         });
-        let pending = self.sync_pending.map(|s| match s.instr {
+        let pending = self.sync_pending.as_ref().map(|s| match s.instr {
             Instruction::CamIn => RunningSync::CamInPending,
             _ => RunningSync::GearInPosPending,
         });

@@ -156,6 +156,12 @@ impl Pair {
         p
     }
 
+    /// Couples by actual value from now on.
+    pub fn use_actual(&mut self) {
+        self.actual = true;
+        self.leader.set_actual_value_output(true);
+    }
+
     pub fn lv(&self) -> LeadingValue {
         let s = self.leader.status();
         LeadingValue {
