@@ -9,6 +9,7 @@
 pub mod alarm;
 pub mod axis;
 pub mod cam;
+pub mod cam_track;
 pub mod drive;
 pub mod dynamics;
 pub mod encoder;
@@ -16,6 +17,8 @@ pub mod error_id;
 pub mod extrapolation;
 pub mod job;
 pub mod leading;
+pub mod measuring;
 pub mod modulo;
+pub mod output_cam;
 pub mod override_table;
 pub mod profile;
