@@ -798,3 +798,140 @@ mod cam_following_value {
         });
     }
 }
+
+/// One cycle (1 ms) of the position-based objects on a modulo axis (360): the axis' motion of
+/// the cycle is built (`AxisMotion`, p/v/a at both cycle ends) and the object stepped with it.
+/// The figure includes building the motion. Targets (issue 4): at most 150 ns each.
+#[divan::bench_group(sample_count = 3000, sample_size = 1000)]
+mod cams_and_measuring {
+    use super::*;
+    use tandem_motion::cam_track::{
+        CamTrack, CamTrackConfig, CamTrackData, CamTrackMode, CamTrackType, McCamTrack, TrackCam,
+    };
+    use tandem_motion::measuring::{
+        AxisMotion, CyclicMode, InputEdge, MeasuringContext, MeasuringInput, MeasuringInputConfig,
+    };
+    use tandem_motion::modulo::Modulo;
+    use tandem_motion::output_cam::CamEdges;
+
+    const MS: i64 = 1_000_000;
+    const MODULO: Option<Modulo> = Some(Modulo {
+        start: 0.0,
+        length: 360.0,
+    });
+
+    /// Cycles in one period of the velocity swing (4 Hz at 1 ms).
+    const PERIOD: usize = 250;
+
+    /// Velocity 1000/s plus `swing` * sin(2π·4 Hz·t): the exact p, v, a over one swing period
+    /// (`PERIOD + 1` cycle boundaries; a later period is the same shifted by 250 in p), so
+    /// that the timed loop reads a table instead of evaluating sin and cos.
+    fn table(swing: f64) -> Vec<State> {
+        let w = 2.0 * std::f64::consts::PI * 4.0;
+        (0..=PERIOD)
+            .map(|k| {
+                let t = k as f64 * 1e-3;
+                State {
+                    p: 1000.0 * t + swing / w * (1.0 - (w * t).cos()),
+                    v: 1000.0 + swing * (w * t).sin(),
+                    a: swing * w * (w * t).cos(),
+                }
+            })
+            .collect()
+    }
+
+    fn motion(tab: &[State], k: usize) -> AxisMotion {
+        let (q, r) = (k / PERIOD, k % PERIOD);
+        let shift = |s: State| State {
+            p: s.p + (q * PERIOD) as f64,
+            ..s
+        };
+        let t0 = (k as i64) * MS;
+        AxisMotion::new(t0, t0 + MS, shift(tab[r]), shift(tab[r + 1])).with_modulo(MODULO)
+    }
+
+    /// 32 distance cams (0.9 wide, every 1.4) on a track of length 45 from 5, with hysteresis
+    /// and on/off compensation: at 1000/s about 1.4 track edges per cycle.
+    fn track() -> CamTrack {
+        let mut data = CamTrackData::new(5.0, 45.0);
+        for i in 0..32 {
+            let on = i as f64 * 1.4;
+            data = data.with_cam(i, TrackCam::distance(on, on + 0.9));
+        }
+        data.parameters.hysteresis = 0.05;
+        data.parameters.on_compensation = 0.3e-3;
+        data.parameters.off_compensation = 0.1e-3;
+        CamTrack::new(CamTrackConfig::new(CamTrackType::Distance), data).unwrap()
+    }
+
+    fn bench_track(bencher: divan::Bencher, swing: f64) {
+        let tab = table(swing);
+        let mut track = track();
+        let mut edges = CamEdges::default();
+        let enable = McCamTrack::enabled(CamTrackMode::EndOfCycle);
+        let mut k = 0;
+        let mut n = 0usize;
+        bencher.bench_local(|| {
+            let m = motion(&tab, black_box(k));
+            track.call(1, &enable);
+            track.step(&m, &mut edges);
+            n += edges.len();
+            k += 1;
+        });
+        // About 64 edges per 45 of travel: the track really switched.
+        assert!(
+            n as f64 > 0.9 * 64.0 / 45.0 * k as f64,
+            "{n} edges in {k} cycles"
+        );
+        assert_eq!(edges.dropped(), 0);
+    }
+
+    /// MC_CamTrack, 32 cams, constant velocity.
+    #[divan::bench]
+    fn cam_track_32_constant_velocity(bencher: divan::Bencher) {
+        bench_track(bencher, 0.0);
+    }
+
+    /// MC_CamTrack, 32 cams, velocity swinging 1000 ± 600/s (acceleration in every cycle).
+    #[divan::bench]
+    fn cam_track_32_varying_velocity(bencher: divan::Bencher) {
+        bench_track(bencher, 600.0);
+    }
+
+    /// MC_MeasuringInputCyclic (Mode 2, both edges) with two edges in every cycle: the measured
+    /// position of each is interpolated at its time, with a correction time.
+    #[divan::bench]
+    fn measuring_cyclic_two_edges(bencher: divan::Bencher) {
+        let mut mi = MeasuringInput::new(MeasuringInputConfig {
+            apply_activation_time: false,
+            correction_time: 0.2e-3,
+            ..MeasuringInputConfig::timer_di(MS)
+        })
+        .unwrap();
+        let job = mi
+            .measuring_input_cyclic(CyclicMode::Both, None, MeasuringContext::OK)
+            .unwrap();
+        let tab = table(600.0);
+        let mut k = 0;
+        bencher.bench_local(|| {
+            let m = motion(&tab, black_box(k));
+            let t0 = k as i64 * MS;
+            let two = [
+                InputEdge {
+                    time_ns: t0 + 200_000,
+                    rising: true,
+                },
+                InputEdge {
+                    time_ns: t0 + 700_000,
+                    rising: false,
+                },
+            ];
+            mi.step(&m, black_box(&two));
+            k += 1;
+        });
+        let s = mi.job_status(job).unwrap();
+        assert_eq!(s.counter1 as usize, k);
+        assert_eq!(s.counter2 as usize, k);
+        assert_eq!(s.lost_edge_counter1, 0);
+    }
+}

@@ -373,6 +373,11 @@ struct Core {
     /// Continuous axis position of a track start (`MatchPosition = anchor + k L`).
     anchor: f64,
     sets: [RangeSet; MAX_CAMS],
+    /// The boundaries of the periodic `sets` in one track period, ascending by position (then
+    /// by cam): `(position, cam, is the on position)`. Built with the geometry, so a cycle
+    /// finds the crossed boundaries by binary search instead of visiting every cam.
+    bounds: [(f64, u8, bool); 2 * MAX_CAMS],
+    n_bounds: usize,
     starts: [Option<f64>; MAX_CAMS],
     bits: u32,
     /// Time cams: end of the logical on time (ns).
@@ -442,6 +447,19 @@ impl Core {
                     .then_some(self.anchor + c.on_position);
             }
         }
+        self.n_bounds = 0;
+        for (i, set) in self.sets.iter().enumerate() {
+            if let RangeSet::Periodic { lo, hi, .. } = *set {
+                for b in [(lo, i as u8, true), (hi, i as u8, false)] {
+                    if let Some(slot) = self.bounds.get_mut(self.n_bounds) {
+                        *slot = b;
+                        self.n_bounds += 1;
+                    }
+                }
+            }
+        }
+        let n = self.n_bounds.min(self.bounds.len());
+        self.bounds[..n].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     }
 
     /// The anchor for an (re)activation at continuous position `x`.
@@ -569,15 +587,85 @@ impl Core {
         self.cams_between(from, to, time_of);
     }
 
+    /// The crossings of the distance cams from `from` to `to`, in motion order, found in the
+    /// sorted boundaries: the same positions (`on/off + k * length`, computed as
+    /// [`RangeSet::crossings`] does) and the same half-open test, without visiting every cam.
+    /// Equal positions go in cam order. Returns false (nothing done) for a stretch over more
+    /// than a few track lengths; the caller then takes the cams one by one.
+    fn sorted_crossings(&mut self, from: f64, to: f64, time_of: &dyn Fn(f64) -> f64) -> bool {
+        const MAX_PERIODS: i64 = 8;
+        let n = self.n_bounds.min(self.bounds.len());
+        let (Some(first), Some(last)) = (self.bounds[..n].first(), self.bounds[..n].last()) else {
+            return true;
+        };
+        let len = self.data.track_length;
+        let up = to > from;
+        let (min, max) = if up { (from, to) } else { (to, from) };
+        if to == from || !from.is_finite() || !to.is_finite() {
+            return true;
+        }
+        let k0 = ((min - last.0) / len).floor();
+        let k1 = ((max - first.0) / len).ceil();
+        let span = k1 - k0;
+        if span.is_nan() || span > MAX_PERIODS as f64 {
+            return false;
+        }
+        let (k0, k1) = (k0 as i64, k1 as i64);
+        let bounds = self.bounds;
+        let b = &bounds[..n];
+        let hit = |core: &mut Self, j: usize, base: f64| {
+            if let Some(&(x, cam, is_on)) = b.get(j) {
+                let c = x + base;
+                core.set_bit(usize::from(cam), is_on == up, time_of(c), true);
+            }
+        };
+        if up {
+            for k in k0..=k1 {
+                let base = k as f64 * len;
+                let mut j = b.partition_point(|e| e.0 + base <= from);
+                while j < n && b[j].0 + base <= to {
+                    hit(self, j, base);
+                    j += 1;
+                }
+            }
+        } else {
+            for k in (k0..=k1).rev() {
+                let base = k as f64 * len;
+                // The last boundary below `from`, then down while at or above `to`; a group
+                // at one position goes in cam order.
+                let mut end = b.partition_point(|e| e.0 + base < from);
+                while end > 0 && b[end - 1].0 + base >= to {
+                    let x = b[end - 1].0;
+                    let mut start = end - 1;
+                    while start > 0 && b[start - 1].0 == x {
+                        start -= 1;
+                    }
+                    for j in start..end {
+                        hit(self, j, base);
+                    }
+                    end = start;
+                }
+            }
+        }
+        true
+    }
+
+    /// The crossings of the distance cams from `from` to `to`, cam by cam (any distance).
+    fn cam_by_cam_crossings(&mut self, from: f64, to: f64, time_of: &dyn Fn(f64) -> f64) {
+        for i in 0..MAX_CAMS {
+            let set = self.sets.get(i).copied().unwrap_or(RangeSet::Empty);
+            set.crossings(from, to, |c, entering| {
+                self.set_bit(i, entering, time_of(c), true);
+                true
+            });
+        }
+    }
+
     fn cams_between(&mut self, from: f64, to: f64, time_of: &dyn Fn(f64) -> f64) {
         match self.track_type {
             CamTrackType::Distance => {
-                for i in 0..MAX_CAMS {
-                    let set = self.sets.get(i).copied().unwrap_or(RangeSet::Empty);
-                    set.crossings(from, to, |c, entering| {
-                        self.set_bit(i, entering, time_of(c), true);
-                        true
-                    });
+                if !self.sorted_crossings(from, to, time_of) {
+                    self.cam_by_cam_crossings(from, to, time_of);
                 }
             }
             CamTrackType::Time => self.time_cams(from, to, time_of),
@@ -621,6 +709,8 @@ impl CamTrack {
                 track_type: config.track_type,
                 anchor: data.reference_position,
                 sets: [RangeSet::Empty; MAX_CAMS],
+                bounds: [(0.0, 0, false); 2 * MAX_CAMS],
+                n_bounds: 0,
                 starts: [None; MAX_CAMS],
                 bits: 0,
                 running: [None; MAX_CAMS],
@@ -976,7 +1066,9 @@ impl CamTrack {
                 } else {
                     bits &= !m;
                 }
-                cause = e.cam;
+                // Several cams at one time: the highest index is the cause (independent of
+                // the order the crossings were found in).
+                cause = cause.max(e.cam);
                 comp |= e.comp;
                 floor = floor.max(e.floor);
                 i += 1;
@@ -1116,4 +1208,91 @@ pub fn match_on_enable(
     let anchor = enable_anchor(position, reference, length, modulo);
     let m = anchor + cycle_index(position, anchor, length) * length;
     (modulo.map_or(m, |md| md.wrap(m)), position - m)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+
+    /// xorshift64*, uniform in [0, 1).
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            let mut x = self.0;
+            x ^= x >> 12;
+            x ^= x << 25;
+            x ^= x >> 27;
+            self.0 = x;
+            (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The cam events of a stretch by time; events at one time are merged by the output, so
+    /// their order does not matter (they are sorted by cam).
+    fn ordered(core: &Core) -> Vec<(f64, u8, bool)> {
+        let mut v: Vec<(f64, u8, bool)> = core.events[..core.n_events]
+            .iter()
+            .map(|e| (e.dt, e.cam, e.on))
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        v
+    }
+
+    /// The binary search over the sorted boundaries finds exactly the events of the cam-by-cam
+    /// walk, at the same times, on random tracks (shared boundaries, cams ending at the track
+    /// length) and random stretches in both directions up to several track lengths.
+    #[test]
+    fn sorted_crossings_match_the_cam_by_cam_walk() {
+        let mut rng = Rng(0x7a3d_0004_c0ff_ee01);
+        let mut events = 0usize;
+        for case in 0..4000 {
+            let len = 5.0 + 95.0 * rng.next();
+            let n_cams = 1 + (rng.next() * 32.0) as usize;
+            let grid = len / 16.0;
+            let mut data = CamTrackData::new(0.0, len);
+            for i in 0..n_cams {
+                // Half the cams on a coarse grid, so that boundaries coincide.
+                let (on, off) = if rng.next() < 0.5 {
+                    let a = (rng.next() * 16.0).floor() * grid;
+                    (a, a + (1.0 + (rng.next() * 16.0).floor()) * grid)
+                } else {
+                    let a = rng.next() * len;
+                    (a, a + rng.next() * len)
+                };
+                data = data.with_cam(i, TrackCam::distance(on, off.min(len)));
+            }
+            let Ok(track) = CamTrack::new(CamTrackConfig::new(CamTrackType::Distance), data) else {
+                continue;
+            };
+            let mut a = track.core.clone();
+            a.anchor = (rng.next() - 0.5) * 1000.0;
+            a.geometry();
+            a.bits = (rng.next() * f64::from(u32::MAX)) as u32;
+            let mut b = a.clone();
+            let from = a.anchor + (rng.next() - 0.5) * 4.0 * len;
+            let from = if rng.next() < 0.2 {
+                // Start on a boundary.
+                a.anchor + (rng.next() * 16.0).floor() * grid
+            } else {
+                from
+            };
+            let span = (rng.next() - 0.5) * 2.0 * len * [0.05, 1.0, 9.0][case % 3];
+            let to = from + span;
+            let time_of = |c: f64| (c - from) / span;
+            if !a.sorted_crossings(from, to, &time_of) {
+                a.cam_by_cam_crossings(from, to, &time_of);
+            }
+            b.cam_by_cam_crossings(from, to, &time_of);
+            if b.dropped == 0 {
+                assert_eq!(ordered(&a), ordered(&b), "case {case}: {from} -> {to}");
+            } else {
+                // Beyond the capacity the two keep different events (by time, by cam).
+                assert_eq!(a.n_events as u64 + a.dropped, b.n_events as u64 + b.dropped);
+            }
+            assert_eq!(a.bits, b.bits, "case {case}");
+            events += a.n_events;
+        }
+        assert!(events > 20_000, "the stretches crossed {events} boundaries");
+    }
 }

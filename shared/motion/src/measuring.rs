@@ -283,31 +283,56 @@ impl Run {
     /// Time (s after the cycle start) at which the run reaches `x` (which must lie between
     /// `xa` and `xb`).
     pub fn time_of(&self, x: f64) -> f64 {
+        // Newton's method inside a shrinking bracket (the run is monotone, so the bracket
+        // always holds the crossing); a step that leaves the bracket is replaced by bisection.
+        // Ends at a zero, at a step below rounding noise, or when the bracket cannot shrink.
         let pc = &self.piece;
         let target = x - pc.p0;
-        let f = |s: f64| pc.q(s) - target;
         let (mut lo, mut hi) = (self.sa, self.sb);
-        let mut flo = f(lo);
-        if flo == 0.0 {
+        let flo0 = pc.q(lo) - target;
+        if flo0 == 0.0 {
             return pc.time(lo);
         }
+        let fhi = pc.q(hi) - target;
+        if fhi == 0.0 {
+            return pc.time(hi);
+        }
+        let mut flo = flo0;
+        // First guess: the secant through the run's ends.
+        let mut s = lo - flo * (hi - lo) / (fhi - flo);
+        if !(s > lo && s < hi) {
+            s = 0.5 * (lo + hi);
+        }
         for _ in 0..100 {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
+            let (q, ds) = pc.q_dq(s);
+            let fs = q - target;
+            if fs == 0.0 {
                 break;
             }
-            let fm = f(mid);
-            if fm == 0.0 {
-                return pc.time(mid);
-            }
-            if (fm < 0.0) == (flo < 0.0) {
-                lo = mid;
-                flo = fm;
+            if (fs < 0.0) == (flo < 0.0) {
+                lo = s;
+                flo = fs;
             } else {
-                hi = mid;
+                hi = s;
             }
+            // Steps below 1e-15 of the run (1e-18 s on a 1 ms cycle) are rounding noise.
+            let step = fs / ds;
+            if step.abs() <= 1e-15 {
+                s = (s - step).clamp(lo, hi);
+                break;
+            }
+            let newton = s - step;
+            let next = if newton >= lo && newton <= hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if next == s {
+                break;
+            }
+            s = next;
         }
-        pc.time(0.5 * (lo + hi))
+        pc.time(s)
     }
 }
 
@@ -331,6 +356,16 @@ impl Piece {
 
     fn q(&self, s: f64) -> f64 {
         horner(&self.c, s)
+    }
+
+    /// `q(s)` and `q'(s)` together (Horner on the value and its derivative).
+    fn q_dq(&self, s: f64) -> (f64, f64) {
+        let (mut v, mut d) = (0.0, 0.0);
+        for &k in self.c.iter().rev() {
+            d = d * s + v;
+            v = v * s + k;
+        }
+        (v, d)
     }
 
     fn time(&self, s: f64) -> f64 {
@@ -387,6 +422,15 @@ fn sign_change_roots(c: &[f64], out: &mut [f64; 5]) -> usize {
     let c = &c[..=deg.min(c.len().saturating_sub(1))];
     if deg == 0 {
         return 0;
+    }
+    // On [0, 1], |c[1] s + c[2] s^2 + ...| <= |c[1]| + |c[2]| + ...: a constant term larger
+    // than that (with a margin for rounding) keeps the sign, so there is no root (the common
+    // case: an axis that does not reverse within the cycle).
+    if let Some((&c0, rest)) = c.split_first() {
+        let bound: f64 = rest.iter().map(|k| k.abs()).sum();
+        if c0.abs() > bound * (1.0 + 1e-12) {
+            return 0;
+        }
     }
     let mut crit = [0.0; 5];
     let nc = if deg >= 2 {

@@ -4,13 +4,9 @@
 //! simulated sensor and two cyclic measuring inputs (one with two edges in every cycle) run
 //! 10,000 cycles of 1 ms on a modulo axis moving back and forth.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
-// A global allocator needs `unsafe impl GlobalAlloc`; it only forwards to `System`.
-#![allow(unsafe_code)]
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
-
+mod common;
+use common::counting::{arm, disarm, Counting};
 use tandem_motion::cam_track::{
     CamTrack, CamTrackConfig, CamTrackData, CamTrackMode, CamTrackType, McCamTrack, TrackCam,
     TrackOutputInterface,
@@ -24,45 +20,6 @@ use tandem_motion::output_cam::{
     CamDirection, CamEdges, McOutputCam, OutputCam, OutputCamConfig, OutputCamType,
 };
 use tandem_motion::profile::{plan_position, Limits, Profile, State};
-
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-
-thread_local! {
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-}
-
-fn armed() -> bool {
-    ARMED.try_with(Cell::get).unwrap_or(false)
-}
-
-struct Counting;
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -146,8 +103,7 @@ fn ten_thousand_cycles_without_allocation() {
     let mut n_sensor = 0usize;
     let mut seg = 0usize;
 
-    ALLOCS.store(0, Ordering::SeqCst);
-    ARMED.with(|a| a.set(true));
+    arm();
     for k in 0..CYCLES {
         let (t0, t1) = (k * MS, (k + 1) * MS);
         while seg + 1 < moves.len() && moves[seg + 1].0 <= t0 {
@@ -187,8 +143,7 @@ fn ten_thousand_cycles_without_allocation() {
         n_sensor += sensor_edges.len();
         mi2.step(&motion, sensor_edges.as_slice());
     }
-    ARMED.with(|a| a.set(false));
-    let allocs = ALLOCS.load(Ordering::SeqCst);
+    let (allocs, _) = disarm();
     assert_eq!(allocs, 0, "{allocs} allocations in {CYCLES} cycles");
 
     // The run did something.
