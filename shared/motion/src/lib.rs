@@ -22,3 +22,4 @@ pub mod modulo;
 pub mod output_cam;
 pub mod override_table;
 pub mod profile;
+pub mod timed_list;

@@ -68,6 +68,7 @@ use crate::job::JobId;
 use crate::modulo::Modulo;
 use crate::override_table::{table3, NewMeasuringJob, RunningMeasuring};
 use crate::profile::{Profile, State};
+use crate::timed_list::{Timed, TimedList};
 
 // ---------------------------------------------------------------------------------------------
 // Axis motion over one cycle
@@ -708,69 +709,11 @@ pub struct InputEdge {
 pub const INPUT_EDGE_CAPACITY: usize = 32;
 
 /// A fixed-capacity list of input edges (what a [`SimulatedSensor`] produces in one cycle).
-#[derive(Copy, Clone, Debug)]
-pub struct InputEdges {
-    buf: [InputEdge; INPUT_EDGE_CAPACITY],
-    len: usize,
-    dropped: u64,
-}
+pub type InputEdges = TimedList<InputEdge, INPUT_EDGE_CAPACITY>;
 
-impl Default for InputEdges {
-    fn default() -> Self {
-        Self {
-            buf: [InputEdge::default(); INPUT_EDGE_CAPACITY],
-            len: 0,
-            dropped: 0,
-        }
-    }
-}
-
-impl InputEdges {
-    /// Appends an edge; when full the edge is dropped and counted.
-    pub fn push(&mut self, e: InputEdge) {
-        if let Some(slot) = self.buf.get_mut(self.len) {
-            *slot = e;
-            self.len += 1;
-        } else {
-            self.dropped += 1;
-        }
-    }
-
-    /// The edges.
-    pub fn as_slice(&self) -> &[InputEdge] {
-        &self.buf[..self.len.min(INPUT_EDGE_CAPACITY)]
-    }
-
-    /// Removes all edges (the dropped count stays).
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// Number of edges.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// No edges.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// Edges dropped because the buffer was full.
-    pub fn dropped(&self) -> u64 {
-        self.dropped
-    }
-
-    fn sort(&mut self) {
-        // Insertion sort: stable and allocation-free (n <= 32).
-        let n = self.len.min(INPUT_EDGE_CAPACITY);
-        for i in 1..n {
-            let mut j = i;
-            while j > 0 && self.buf[j - 1].time_ns > self.buf[j].time_ns {
-                self.buf.swap(j - 1, j);
-                j -= 1;
-            }
-        }
+impl Timed for InputEdge {
+    fn time_ns(&self) -> i64 {
+        self.time_ns
     }
 }
 

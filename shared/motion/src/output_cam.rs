@@ -58,6 +58,7 @@ use crate::alarm::{supplement, AlarmId, AlarmInstance};
 use crate::error_id::ErrorId;
 pub use crate::measuring::AxisMotion;
 use crate::measuring::{RangeSet, Run};
+use crate::timed_list::{Timed, TimedList};
 
 // ---------------------------------------------------------------------------------------------
 // Edges
@@ -79,70 +80,11 @@ pub struct Edge {
 pub const EDGE_CAPACITY: usize = 16;
 
 /// The edges of one output in one cycle, sorted by time (fixed capacity; the excess is counted).
-#[derive(Copy, Clone, Debug)]
-pub struct CamEdges {
-    buf: [Edge; EDGE_CAPACITY],
-    len: usize,
-    dropped: u64,
-}
+pub type CamEdges = TimedList<Edge, EDGE_CAPACITY>;
 
-impl Default for CamEdges {
-    fn default() -> Self {
-        Self {
-            buf: [Edge::default(); EDGE_CAPACITY],
-            len: 0,
-            dropped: 0,
-        }
-    }
-}
-
-impl CamEdges {
-    /// Appends an edge (counted as dropped when full).
-    pub fn push(&mut self, e: Edge) {
-        if let Some(slot) = self.buf.get_mut(self.len) {
-            *slot = e;
-            self.len += 1;
-        } else {
-            self.dropped += 1;
-        }
-    }
-
-    /// The edges.
-    pub fn as_slice(&self) -> &[Edge] {
-        &self.buf[..self.len.min(EDGE_CAPACITY)]
-    }
-
-    /// Number of edges.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// No edges.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// Removes the edges (the dropped count stays).
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// Edges dropped because the list was full (since creation).
-    pub fn dropped(&self) -> u64 {
-        self.dropped
-    }
-
-    /// Stable sort by time.
-    pub(crate) fn sort(&mut self) {
-        let n = self.len.min(EDGE_CAPACITY);
-        // Insertion sort: stable, no allocation, n <= 16.
-        for i in 1..n {
-            let mut j = i;
-            while j > 0 && self.buf[j - 1].time_ns > self.buf[j].time_ns {
-                self.buf.swap(j - 1, j);
-                j -= 1;
-            }
-        }
+impl Timed for Edge {
+    fn time_ns(&self) -> i64 {
+        self.time_ns
     }
 }
 

@@ -2,6 +2,9 @@
 //! and property tests of the measured positions and the cyclic counters.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+#[path = "common/machine_limits.rs"]
+mod machine_limits;
+use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tandem_motion::alarm::AlarmId;
@@ -674,21 +677,6 @@ impl Moves {
             self.b.at(t_s - tb).p
         }
     }
-}
-
-fn limits() -> impl Strategy<Value = Limits> {
-    (
-        50.0f64..400.0,
-        500.0f64..5000.0,
-        500.0f64..5000.0,
-        5_000.0f64..200_000.0,
-    )
-        .prop_map(|(vel, acc, dec, jerk)| Limits {
-            vel,
-            acc,
-            dec,
-            jerk,
-        })
 }
 
 proptest! {

@@ -2,6 +2,9 @@
 //! their ids, and property tests of the edge times against exact crossings of the profile.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+#[path = "common/machine_limits.rs"]
+mod machine_limits;
+use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tandem_motion::alarm::AlarmId;
@@ -708,21 +711,6 @@ fn check_edges(
         );
     }
     Ok(())
-}
-
-fn limits() -> impl Strategy<Value = Limits> {
-    (
-        50.0f64..400.0,
-        500.0f64..5000.0,
-        500.0f64..5000.0,
-        5_000.0f64..200_000.0,
-    )
-        .prop_map(|(vel, acc, dec, jerk)| Limits {
-            vel,
-            acc,
-            dec,
-            jerk,
-        })
 }
 
 /// A move from rest at 0 to `d1`, a pause, and a move to `d1 + d2`.
