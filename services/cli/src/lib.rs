@@ -80,12 +80,15 @@ pub fn run(args: Vec<OsString>, out: &mut impl Write, err: &mut impl Write) -> E
                 Ok(cell) => {
                     let _ = writeln!(
                         out,
-                        "{}: cell `{}` is valid: {} node(s), {} axis/axes, {} external encoder(s)",
+                        "{}: cell `{}` is valid: {} node(s), {} axis/axes, {} external encoder(s), {} output cam(s), {} cam track(s), {} measuring input(s)",
                         path.display(),
                         cell.name,
                         cell.nodes.len(),
                         cell.axes.len(),
-                        cell.encoders.len()
+                        cell.encoders.len(),
+                        cell.output_cams.len(),
+                        cell.cam_tracks.len(),
+                        cell.measuring_inputs.len()
                     );
                     ExitCode::SUCCESS
                 }
@@ -122,20 +125,14 @@ fn sim(m: &clap::ArgMatches, out: &mut impl Write, err: &mut impl Write) -> Exit
             return ExitCode::from(2);
         }
     };
-    let names: Vec<&str> = cell.object_names();
-    let cam_names: Vec<&str> = cell.cams.iter().map(|c| c.name.as_str()).collect();
-    let script = match tandem_config::script::parse(
-        &script_path.display().to_string(),
-        &src,
-        &names,
-        &cam_names,
-    ) {
-        Ok(s) => s,
-        Err(e) => {
-            let _ = writeln!(err, "error: {e}");
-            return ExitCode::from(2);
-        }
-    };
+    let script =
+        match tandem_config::script::parse_cell(&script_path.display().to_string(), &src, &cell) {
+            Ok(s) => s,
+            Err(e) => {
+                let _ = writeln!(err, "error: {e}");
+                return ExitCode::from(2);
+            }
+        };
     let file = match std::fs::File::create(trace_path) {
         Ok(f) => f,
         Err(e) => {

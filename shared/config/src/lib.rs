@@ -151,6 +151,91 @@ impl PartialEq for CamEntry {
     }
 }
 
+/// An output cam of the cell (`[[output_cams]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputCamEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// Index into [`Cell::axes`].
+    pub axis: usize,
+    /// Engine configuration.
+    pub config: tandem_motion::output_cam::OutputCamConfig,
+}
+
+/// A cam track of the cell (`[[cam_tracks]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CamTrackEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// Index into [`Cell::axes`].
+    pub axis: usize,
+    /// Engine configuration.
+    pub config: tandem_motion::cam_track::CamTrackConfig,
+    /// Track data (reference, length, cams).
+    pub data: tandem_motion::cam_track::CamTrackData,
+}
+
+/// A simulated mark sensor on a measuring input.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SensorEntry {
+    /// The axis that carries the mark (index into [`Cell::axes`]).
+    pub axis: usize,
+    /// Mark start.
+    pub position: f64,
+    /// Mark width.
+    pub width: f64,
+    /// Dead time (s).
+    pub dead_time: f64,
+    /// Jitter (ns, uniform in ±).
+    pub jitter_ns: i64,
+    /// Seed of the jitter.
+    pub seed: u64,
+    /// Direction that produces edges.
+    pub direction: tandem_motion::measuring::SensorDirection,
+}
+
+impl SensorEntry {
+    /// The engine's simulated sensor.
+    pub fn sensor(&self) -> tandem_motion::measuring::SimulatedSensor {
+        tandem_motion::measuring::SimulatedSensor::new(
+            self.position,
+            self.width,
+            self.dead_time,
+            self.jitter_ns,
+            self.seed,
+            self.direction,
+        )
+    }
+}
+
+/// A measuring input of the cell (`[[measuring_inputs]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeasuringInputEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// Index into [`Cell::axes`].
+    pub axis: usize,
+    /// Engine configuration.
+    pub config: tandem_motion::measuring::MeasuringInputConfig,
+    /// Optional simulated sensor producing the input's edges.
+    pub sensor: Option<SensorEntry>,
+    /// Optional register correction.
+    pub registration: Option<Registration>,
+}
+
+/// Register correction of a measuring input: each new `MeasuredValue1` of a cyclic job moves
+/// `axis` by `gain * (target - measured)`, reduced to ±half the measured axis' modulo length,
+/// with `MC_MoveSuperimposed`.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Registration {
+    /// The corrected axis (index into [`Cell::axes`]).
+    pub axis: usize,
+    /// The register target.
+    pub target: f64,
+    /// Share of the error corrected per mark.
+    pub gain: f64,
+}
+
 /// A validated cell.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
@@ -166,6 +251,12 @@ pub struct Cell {
     pub encoders: Vec<EncoderEntry>,
     /// Cams, in name order (a cam's id is its index here).
     pub cams: Vec<CamEntry>,
+    /// Output cams, in file order.
+    pub output_cams: Vec<OutputCamEntry>,
+    /// Cam tracks, in file order.
+    pub cam_tracks: Vec<CamTrackEntry>,
+    /// Measuring inputs, in file order.
+    pub measuring_inputs: Vec<MeasuringInputEntry>,
 }
 
 impl Cell {
@@ -178,6 +269,22 @@ impl Cell {
             .chain(self.encoders.iter().map(|e| e.name.as_str()))
             .collect()
     }
+}
+
+/// Finds the 1-based line of `key` in table `index` of the array of tables `array` (or of the
+/// table itself when `key` is empty), best effort.
+pub fn locate_in_array(src: &str, array: &str, index: usize, key: &str) -> Option<usize> {
+    let doc = toml_edit::ImDocument::parse(src).ok()?;
+    let table = doc.get(array)?.as_array_of_tables()?.get(index)?;
+    let span = if key.is_empty() {
+        table.span()
+    } else {
+        match table.get_key_value(key) {
+            Some((k, _)) => k.span(),
+            None => table.span(),
+        }
+    }?;
+    Some(src[..span.start.min(src.len())].matches('\n').count() + 1)
 }
 
 /// Finds the 1-based line of a dotted key path in TOML source (best effort).
@@ -468,6 +575,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
             definition,
         });
     }
+    let objects = objects(file, src, &raw, &axes, &nodes)?;
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: base as i64 * 1000,
@@ -475,7 +583,356 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         axes,
         encoders,
         cams,
+        output_cams: objects.0,
+        cam_tracks: objects.1,
+        measuring_inputs: objects.2,
     })
+}
+
+type Objects = (
+    Vec<OutputCamEntry>,
+    Vec<CamTrackEntry>,
+    Vec<MeasuringInputEntry>,
+);
+
+fn position_type(v: &str) -> Result<tandem_motion::output_cam::PositionType, FieldError> {
+    use tandem_motion::output_cam::PositionType;
+    pick(
+        "position",
+        v,
+        &[
+            ("setpoint", PositionType::Setpoint),
+            ("actual", PositionType::Actual),
+        ],
+    )
+}
+
+fn range(r: Option<[f64; 2]>) -> Result<Option<(f64, f64)>, FieldError> {
+    match r {
+        None => Ok(None),
+        Some([lo, hi]) if lo.is_finite() && hi.is_finite() && lo < hi => Ok(Some((lo, hi))),
+        Some(_) => Err((
+            "working_range",
+            "must be [min, max] with finite min < max".into(),
+        )),
+    }
+}
+
+fn parameters(
+    on: f64,
+    off: f64,
+    h: f64,
+) -> Result<tandem_motion::output_cam::OutputCamParameters, FieldError> {
+    if !(0.0..=1e9).contains(&on) {
+        return Err(("on_compensation", "must be 0..1e9 seconds".into()));
+    }
+    if !(0.0..=1e9).contains(&off) {
+        return Err(("off_compensation", "must be 0..1e9 seconds".into()));
+    }
+    if !(0.0..=1e12).contains(&h) {
+        return Err(("hysteresis", "must be 0..1e12".into()));
+    }
+    Ok(tandem_motion::output_cam::OutputCamParameters {
+        on_compensation: on,
+        off_compensation: off,
+        hysteresis: h,
+    })
+}
+
+/// The output cams, cam tracks and measuring inputs (after the axes and encoders).
+fn objects(
+    file: &str,
+    src: &str,
+    raw: &CellFile,
+    axes: &[AxisEntry],
+    nodes: &[Node],
+) -> Result<Objects, ConfigError> {
+    use tandem_motion::cam_track::{
+        CamTrackConfig, CamTrackData, CamTrackType, TrackCam, TrackOutputInterface, MAX_CAMS,
+    };
+    use tandem_motion::measuring::{MeasuringInputConfig, MeasuringRoute, SensorDirection};
+    use tandem_motion::output_cam::{OutputCamConfig, OutputCamType};
+    let err = |array: &str, i: usize, key: &str, message: String| ConfigError {
+        file: file.into(),
+        line: locate_in_array(src, array, i, key),
+        key: if key.is_empty() {
+            format!("{array}[{i}]")
+        } else {
+            format!("{array}[{i}].{key}")
+        },
+        message,
+    };
+    let mut names: Vec<String> = axes
+        .iter()
+        .map(|a| a.name.clone())
+        .chain(raw.encoders.keys().cloned())
+        .collect();
+    let mut unique = |array: &str, i: usize, name: &str| -> Result<(), ConfigError> {
+        if name.is_empty() || names.iter().any(|n| n == name) {
+            return Err(err(
+                array,
+                i,
+                "name",
+                format!("`{name}` is empty or already used: names must be unique"),
+            ));
+        }
+        names.push(name.to_string());
+        Ok(())
+    };
+    let axis_of = |array: &str, i: usize, name: &str| {
+        axes.iter().position(|a| a.name == name).ok_or_else(|| {
+            err(
+                array,
+                i,
+                "axis",
+                format!(
+                    "unknown axis `{name}`; the cell has: {}",
+                    axes.iter()
+                        .map(|a| a.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
+        })
+    };
+    let kinds = [("distance", 0u8), ("time", 1u8)];
+    let mut output_cams = Vec::new();
+    for (i, c) in raw.output_cams.iter().enumerate() {
+        let a = "output_cams";
+        unique(a, i, &c.name)?;
+        let axis = axis_of(a, i, &c.axis)?;
+        let f = |(k, m): FieldError| err(a, i, k, m);
+        let cam_type = match pick("type", &c.kind, &kinds).map_err(f)? {
+            0 => OutputCamType::Distance,
+            _ => OutputCamType::Time,
+        };
+        let mut config = OutputCamConfig::new(cam_type);
+        config.position_type = position_type(&c.position).map_err(f)?;
+        config.parameters =
+            parameters(c.on_compensation, c.off_compensation, c.hysteresis).map_err(f)?;
+        config.working_range = range(c.working_range).map_err(f)?;
+        config.arming_cycles = c.arming_cycles;
+        output_cams.push(OutputCamEntry {
+            name: c.name.clone(),
+            axis,
+            config,
+        });
+    }
+    let mut cam_tracks = Vec::new();
+    for (i, c) in raw.cam_tracks.iter().enumerate() {
+        let a = "cam_tracks";
+        unique(a, i, &c.name)?;
+        let axis = axis_of(a, i, &c.axis)?;
+        let f = |(k, m): FieldError| err(a, i, k, m);
+        let track_type = match pick("type", &c.kind, &kinds).map_err(f)? {
+            0 => CamTrackType::Distance,
+            _ => CamTrackType::Time,
+        };
+        let mut config = CamTrackConfig::new(track_type);
+        config.position_type = position_type(&c.position).map_err(f)?;
+        config.working_range = range(c.working_range).map_err(f)?;
+        config.interface = pick(
+            "interface",
+            &c.interface,
+            &[
+                ("software", TrackOutputInterface::Software),
+                ("timer_dq", TrackOutputInterface::TimerDq),
+                ("dq_module", TrackOutputInterface::DqModule),
+            ],
+        )
+        .map_err(f)?;
+        if !(c.track_length.is_finite() && (0.001..=1e12).contains(&c.track_length)) {
+            return Err(err(a, i, "track_length", "must be 0.001..1e12".into()));
+        }
+        if !(c.reference_position.is_finite() && c.reference_position.abs() <= 1e12) {
+            return Err(err(
+                a,
+                i,
+                "reference_position",
+                "must be within ±1e12".into(),
+            ));
+        }
+        if c.cams.len() > MAX_CAMS {
+            return Err(err(a, i, "cams", format!("at most {MAX_CAMS} cams")));
+        }
+        let mut data = CamTrackData::new(c.reference_position, c.track_length);
+        data.masking = c.masking;
+        data.parameters =
+            parameters(c.on_compensation, c.off_compensation, c.hysteresis).map_err(f)?;
+        for (j, cam) in c.cams.iter().enumerate() {
+            let bad = |m: &str| err(a, i, "cams", format!("cam {}: {m}", j + 1));
+            if !(cam.on.is_finite() && (0.0..=1e12).contains(&cam.on)) {
+                return Err(bad("`on` must be 0..1e12 (relative to the track start)"));
+            }
+            let tc = match track_type {
+                CamTrackType::Distance => {
+                    let off = cam
+                        .off
+                        .ok_or_else(|| bad("`off` is required on a distance track"))?;
+                    if cam.duration.is_some() {
+                        return Err(bad("`duration` is for time tracks"));
+                    }
+                    if !(off.is_finite() && off >= cam.on && off <= 1e12) {
+                        return Err(bad("`off` must be >= `on`"));
+                    }
+                    TrackCam::distance(cam.on, off)
+                }
+                CamTrackType::Time => {
+                    let d = cam
+                        .duration
+                        .ok_or_else(|| bad("`duration` (s) is required on a time track"))?;
+                    if cam.off.is_some() {
+                        return Err(bad("`off` is for distance tracks"));
+                    }
+                    if !(1e-6..=1e9).contains(&d) {
+                        return Err(bad("`duration` must be 1e-6..1e9 s"));
+                    }
+                    TrackCam::time(cam.on, d)
+                }
+            };
+            data = data.with_cam(j, tc);
+        }
+        if let Err(e) = tandem_motion::cam_track::CamTrack::new(config, data) {
+            return Err(err(a, i, "", format!("rejected by the cam track: {e}")));
+        }
+        cam_tracks.push(CamTrackEntry {
+            name: c.name.clone(),
+            axis,
+            config,
+            data,
+        });
+    }
+    let mut measuring_inputs = Vec::new();
+    for (i, m) in raw.measuring_inputs.iter().enumerate() {
+        let a = "measuring_inputs";
+        unique(a, i, &m.name)?;
+        let axis = axis_of(a, i, &m.axis)?;
+        let f = |(k, msg): FieldError| err(a, i, k, msg);
+        let cycle_ns = nodes[axes[axis].node].cycle_ns;
+        let mut config = MeasuringInputConfig::timer_di(cycle_ns);
+        config.route = pick(
+            "route",
+            &m.route,
+            &[
+                ("timer_di", MeasuringRoute::TimerDi),
+                ("central_probe", MeasuringRoute::CentralProbe),
+                ("profidrive", MeasuringRoute::Profidrive),
+            ],
+        )
+        .map_err(f)?;
+        if !(m.correction_time.is_finite() && m.correction_time.abs() <= 1.0) {
+            return Err(err(a, i, "correction_time", "must be within ±1 s".into()));
+        }
+        if !(m.additional_activation_time.is_finite()
+            && (0.0..=1.0).contains(&m.additional_activation_time))
+        {
+            return Err(err(
+                a,
+                i,
+                "additional_activation_time",
+                "must be 0..1 s".into(),
+            ));
+        }
+        config.correction_time = m.correction_time;
+        config.additional_activation_time = m.additional_activation_time;
+        config.apply_activation_time = m.apply_activation_time;
+        let sensor = match &m.sensor {
+            None => None,
+            Some(s) => {
+                let k = |key: &str| format!("sensor.{key}");
+                if !(s.position.is_finite() && s.position.abs() <= 1e12) {
+                    return Err(err(a, i, &k("position"), "must be within ±1e12".into()));
+                }
+                if !(s.width.is_finite() && s.width > 0.0) {
+                    return Err(err(a, i, &k("width"), "must be a positive number".into()));
+                }
+                if !(s.dead_time.is_finite() && (0.0..=1.0).contains(&s.dead_time)) {
+                    return Err(err(a, i, &k("dead_time"), "must be 0..1 s".into()));
+                }
+                if !(s.jitter.is_finite() && (0.0..=1.0).contains(&s.jitter)) {
+                    return Err(err(a, i, &k("jitter"), "must be 0..1 s".into()));
+                }
+                let direction = pick(
+                    "sensor.direction",
+                    &s.direction,
+                    &[
+                        ("positive", SensorDirection::Positive),
+                        ("negative", SensorDirection::Negative),
+                        ("both", SensorDirection::Both),
+                    ],
+                )
+                .map_err(f)?;
+                let axis = match &s.axis {
+                    None => axis,
+                    Some(n) => {
+                        let j = axis_of(a, i, n).map_err(|mut e| {
+                            e.key = format!("{a}[{i}].sensor.axis");
+                            e
+                        })?;
+                        if axes[j].node != axes[axis].node {
+                            return Err(err(
+                                a,
+                                i,
+                                &k("axis"),
+                                format!("`{n}` must be on the node of `{}`", m.axis),
+                            ));
+                        }
+                        j
+                    }
+                };
+                Some(SensorEntry {
+                    axis,
+                    position: s.position,
+                    width: s.width,
+                    dead_time: s.dead_time,
+                    jitter_ns: (s.jitter * 1e9).round() as i64,
+                    seed: s.seed,
+                    direction,
+                })
+            }
+        };
+        let registration = match &m.registration {
+            None => None,
+            Some(r) => {
+                let j = axis_of(a, i, &r.axis).map_err(|mut e| {
+                    e.key = format!("{a}[{i}].registration.axis");
+                    e
+                })?;
+                if !(r.target.is_finite() && r.target.abs() <= 1e12) {
+                    return Err(err(
+                        a,
+                        i,
+                        "registration.target",
+                        "must be within ±1e12".into(),
+                    ));
+                }
+                if !(r.gain > 0.0 && r.gain <= 1.0) {
+                    return Err(err(a, i, "registration.gain", "must be in (0, 1]".into()));
+                }
+                Some(Registration {
+                    axis: j,
+                    target: r.target,
+                    gain: r.gain,
+                })
+            }
+        };
+        if let Err(e) = tandem_motion::measuring::MeasuringInput::new(config) {
+            return Err(err(
+                a,
+                i,
+                "",
+                format!("rejected by the measuring input: {e}"),
+            ));
+        }
+        measuring_inputs.push(MeasuringInputEntry {
+            name: m.name.clone(),
+            axis,
+            config,
+            sensor,
+            registration,
+        });
+    }
+    Ok((output_cams, cam_tracks, measuring_inputs))
 }
 
 type FieldError = (&'static str, String);
@@ -819,5 +1276,95 @@ emergency_deceleration = 2000.0
         assert!(e
             .message
             .contains("`servo` is not one of speed, positioning"));
+    }
+
+    #[test]
+    fn output_cams_cam_tracks_and_measuring_inputs_are_validated_by_key() {
+        let objects = format!(
+            "{GOOD}\n[[output_cams]]\nname = \"cam\"\naxis = \"x\"\ntype = \"time\"\n\n[[cam_tracks]]\nname = \"track\"\naxis = \"x\"\ntrack_length = 100.0\ncams = [{{ on = 10.0, off = 20.0 }}]\n\n[[measuring_inputs]]\nname = \"mark\"\naxis = \"x\"\ncorrection_time = 0.001\n\n[measuring_inputs.sensor]\nposition = 5.0\nwidth = 1.0\njitter = 0.000002\n"
+        );
+        let c = parse("cell.toml", &objects).unwrap();
+        assert_eq!(c.output_cams.len(), 1);
+        assert_eq!(
+            c.output_cams[0].config.cam_type,
+            tandem_motion::output_cam::OutputCamType::Time
+        );
+        assert_eq!(c.cam_tracks[0].data.cams[0].off_position, 20.0);
+        assert!(!c.cam_tracks[0].data.cams[1].existent);
+        assert_eq!(c.measuring_inputs[0].config.correction_time, 0.001);
+        assert_eq!(c.measuring_inputs[0].config.servo_cycle_ns, 1_000_000);
+        assert_eq!(c.measuring_inputs[0].sensor.unwrap().jitter_ns, 2000);
+        let line_of =
+            |src: &str, pat: &str| src.lines().position(|l| l.starts_with(pat)).unwrap() + 1;
+        // A misspelt key names itself.
+        let bad = objects.replace("type = \"time\"", "tipe = \"time\"");
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert!(e.message.contains("unknown field `tipe`"), "{e}");
+        assert_eq!(e.line, Some(line_of(&bad, "tipe")));
+        // Bad values name the array entry and the key, with its line.
+        for (from, to, key, msg) in [
+            (
+                "type = \"time\"",
+                "type = \"switch\"",
+                "output_cams[0].type",
+                "`switch` is not one of distance, time",
+            ),
+            (
+                "axis = \"x\"\ntype",
+                "axis = \"y\"\ntype",
+                "output_cams[0].axis",
+                "unknown axis `y`",
+            ),
+            (
+                "track_length = 100.0",
+                "track_length = 0.0",
+                "cam_tracks[0].track_length",
+                "must be 0.001..1e12",
+            ),
+            (
+                "off = 20.0",
+                "off = 5.0",
+                "cam_tracks[0].cams",
+                "cam 1: `off` must be >= `on`",
+            ),
+            (
+                "width = 1.0",
+                "width = 0.0",
+                "measuring_inputs[0].sensor.width",
+                "must be a positive number",
+            ),
+            (
+                "name = \"mark\"",
+                "name = \"x\"",
+                "measuring_inputs[0].name",
+                "names must be unique",
+            ),
+        ] {
+            let bad = objects.replacen(from, to, 1);
+            let e = parse("cell.toml", &bad).unwrap_err();
+            assert_eq!(e.key, key, "{e}");
+            assert!(e.message.contains(msg), "{e}");
+            assert!(e.to_string().contains(&format!("{key}: ")), "{e}");
+            assert!(e.line.is_some(), "{e}");
+        }
+        let bad = objects.replacen("track_length = 100.0", "track_length = 0.0", 1);
+        let e = parse("cell.toml", &bad).unwrap_err();
+        assert_eq!(e.line, Some(line_of(&bad, "track_length")));
+        // Register correction.
+        let reg = format!(
+            "{objects}\n[measuring_inputs.registration]\naxis = \"x\"\ntarget = 5.0\ngain = 0.5\n"
+        );
+        let c = parse("cell.toml", &reg).unwrap();
+        let r = c.measuring_inputs[0].registration.unwrap();
+        assert_eq!((r.axis, r.target, r.gain), (0, 5.0, 0.5));
+        let e = parse("cell.toml", &reg.replace("gain = 0.5", "gain = 2.0")).unwrap_err();
+        assert_eq!(e.key, "measuring_inputs[0].registration.gain", "{e}");
+        let e = parse(
+            "cell.toml",
+            &reg.replace("axis = \"x\"\ntarget", "axis = \"w\"\ntarget"),
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "measuring_inputs[0].registration.axis", "{e}");
+        assert!(e.message.contains("unknown axis `w`"), "{e}");
     }
 }

@@ -22,6 +22,193 @@ pub struct CellFile {
     /// `[cams.<name>]`.
     #[serde(default)]
     pub cams: BTreeMap<String, CamSection>,
+    /// `[[output_cams]]`.
+    #[serde(default)]
+    pub output_cams: Vec<OutputCamSection>,
+    /// `[[cam_tracks]]`.
+    #[serde(default)]
+    pub cam_tracks: Vec<CamTrackSection>,
+    /// `[[measuring_inputs]]`.
+    #[serde(default)]
+    pub measuring_inputs: Vec<MeasuringInputSection>,
+}
+
+fn d_distance() -> String {
+    "distance".into()
+}
+fn d_setpoint() -> String {
+    "setpoint".into()
+}
+fn d_arming() -> u32 {
+    2
+}
+
+/// `[[output_cams]]`: an output cam technology object (MC_OutputCam).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputCamSection {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose position it refers to.
+    pub axis: String,
+    /// `distance` (default) or `time`.
+    #[serde(rename = "type", default = "d_distance")]
+    pub kind: String,
+    /// `setpoint` (default) or `actual`.
+    #[serde(default = "d_setpoint")]
+    pub position: String,
+    /// Lead time of the on edge (s).
+    #[serde(default)]
+    pub on_compensation: f64,
+    /// Lead time of the off edge (s).
+    #[serde(default)]
+    pub off_compensation: f64,
+    /// Hysteresis (position units).
+    #[serde(default)]
+    pub hysteresis: f64,
+    /// `[min, max]` operating range of a linear axis (hysteresis cap).
+    pub working_range: Option<[f64; 2]>,
+    /// Time cams: cycles after the enable before a start crossing switches (default 2).
+    #[serde(default = "d_arming")]
+    pub arming_cycles: u32,
+}
+
+fn d_software() -> String {
+    "software".into()
+}
+fn d_masking() -> u32 {
+    0xFFFF_FFFF
+}
+
+/// `[[cam_tracks]]`: a cam track technology object (MC_CamTrack).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CamTrackSection {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose position it refers to.
+    pub axis: String,
+    /// `distance` (default) or `time`.
+    #[serde(rename = "type", default = "d_distance")]
+    pub kind: String,
+    /// `setpoint` (default) or `actual`.
+    #[serde(default = "d_setpoint")]
+    pub position: String,
+    /// `ReferencePosition`.
+    #[serde(default)]
+    pub reference_position: f64,
+    /// `CamTrackLength`.
+    pub track_length: f64,
+    /// `CamMasking` (bit i = cam i + 1; default all).
+    #[serde(default = "d_masking")]
+    pub masking: u32,
+    /// `software` (default), `timer_dq` or `dq_module`.
+    #[serde(default = "d_software")]
+    pub interface: String,
+    /// Lead time of the on edge (s).
+    #[serde(default)]
+    pub on_compensation: f64,
+    /// Lead time of the off edge (s).
+    #[serde(default)]
+    pub off_compensation: f64,
+    /// Hysteresis (position units).
+    #[serde(default)]
+    pub hysteresis: f64,
+    /// `[min, max]` operating range of a linear axis (hysteresis cap).
+    pub working_range: Option<[f64; 2]>,
+    /// The cams (up to 32), relative to the track start.
+    #[serde(default)]
+    pub cams: Vec<TrackCamSection>,
+}
+
+/// One cam of a track.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackCamSection {
+    /// `OnPosition`.
+    pub on: f64,
+    /// `OffPosition` (distance tracks).
+    pub off: Option<f64>,
+    /// `Duration` (s, time tracks).
+    pub duration: Option<f64>,
+}
+
+fn d_timer_di() -> String {
+    "timer_di".into()
+}
+fn t() -> bool {
+    true
+}
+fn d_both() -> String {
+    "both".into()
+}
+
+/// `[[measuring_inputs]]`: a measuring input technology object.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeasuringInputSection {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose actual position is measured.
+    pub axis: String,
+    /// `timer_di` (default), `central_probe` or `profidrive`.
+    #[serde(default = "d_timer_di")]
+    pub route: String,
+    /// `CorrectionTime` (s): the position is taken at the edge time minus this.
+    #[serde(default)]
+    pub correction_time: f64,
+    /// `AdditionalActivationTime` (s).
+    #[serde(default)]
+    pub additional_activation_time: f64,
+    /// Apply the activation time after a job start (default true).
+    #[serde(default = "t")]
+    pub apply_activation_time: bool,
+    /// `[measuring_inputs.sensor]`: a simulated sensor.
+    pub sensor: Option<SensorSection>,
+    /// `[measuring_inputs.registration]`: register correction from each new measured value.
+    pub registration: Option<RegistrationSection>,
+}
+
+/// Register correction: each new MeasuredValue1 of a cyclic job moves `axis` by
+/// `gain * (target - measured)` (reduced to ±half the modulo length) with MC_MoveSuperimposed.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegistrationSection {
+    /// The corrected axis.
+    pub axis: String,
+    /// The register target (the measured value when in register).
+    pub target: f64,
+    /// Share of the error corrected per mark (0 < gain <= 1, default 1).
+    #[serde(default = "one")]
+    pub gain: f64,
+}
+
+/// A simulated mark sensor.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSection {
+    /// The axis that carries the mark (default: the input's axis; same node).
+    pub axis: Option<String>,
+    /// Start of the mark (position units; every revolution on a modulo axis).
+    pub position: f64,
+    /// Width of the mark (> 0).
+    pub width: f64,
+    /// `positive`, `negative` or `both` (default).
+    #[serde(default = "d_both")]
+    pub direction: String,
+    /// Dead time (s) from the crossing to the edge.
+    #[serde(default)]
+    pub dead_time: f64,
+    /// Jitter (s): uniform in `[-jitter, jitter]`.
+    #[serde(default)]
+    pub jitter: f64,
+    /// Seed of the jitter generator.
+    #[serde(default = "one_u64")]
+    pub seed: u64,
+}
+
+fn one_u64() -> u64 {
+    1
 }
 
 /// `[cams.<name>]`: a cam, interpolated when the cell is loaded.

@@ -13,6 +13,13 @@
 //!
 //! Synchronous operation names its leader: `master = "<axis>"` (the leader's id is its index
 //! in the cell's axis list, in name order).
+//!
+//! Output cams, cam tracks and measuring inputs are addressed by name in `axis`:
+//! `MC_OutputCam` (`enable`, `on_position`, `off_position`, `duration`, `mode`, `direction`),
+//! `MC_CamTrack` (`enable`, `mode`, `invert_output`), `MC_MeasuringInput` and
+//! `MC_MeasuringInputCyclic` (`mode`, `measuring_range`, `start_position`, `end_position`),
+//! `MC_AbortMeasuringInput`, and `InputEdge` (`rising`): an input edge at the entry's `t`.
+//! Use [`parse_cell`] to address them.
 
 use crate::command::{self, Value};
 use crate::ConfigError;
@@ -31,6 +38,59 @@ pub enum Action {
         /// The cam whose definition is interpolated.
         from: CamId,
     },
+    /// `MC_OutputCam` on the output cam named by the entry (Enable-type: the inputs hold until
+    /// a later entry changes them). Codes are checked when applied (16#800A, 16#8007...).
+    OutputCam {
+        /// `Enable`.
+        enable: bool,
+        /// `OnPosition`.
+        on_position: f64,
+        /// `OffPosition`.
+        off_position: f64,
+        /// `Duration` (s).
+        duration: f64,
+        /// `Mode` (1, 2, 3).
+        mode: i32,
+        /// `Direction` (1, 2, 3).
+        direction: i32,
+    },
+    /// `MC_CamTrack` on the cam track named by the entry (Enable-type).
+    CamTrack {
+        /// `Enable`.
+        enable: bool,
+        /// `Mode` (0, 1, 2).
+        mode: i32,
+        /// `InvertOutput`.
+        invert_output: bool,
+    },
+    /// `MC_MeasuringInput` (one-time) or `MC_MeasuringInputCyclic` on the measuring input
+    /// named by the entry.
+    MeasuringInput {
+        /// Cyclic measuring.
+        cyclic: bool,
+        /// `Mode`.
+        mode: i32,
+        /// `MeasuringRange`: `(StartPosition, EndPosition)`.
+        window: Option<(f64, f64)>,
+    },
+    /// `MC_AbortMeasuringInput` on the measuring input named by the entry.
+    AbortMeasuringInput,
+    /// An edge of the measuring input named by the entry, at the entry's time exactly.
+    InputEdge {
+        /// Rising (true) or falling edge.
+        rising: bool,
+    },
+}
+
+/// The names of the cell's output cams, cam tracks and measuring inputs (script targets).
+#[derive(Clone, Debug, Default)]
+pub struct ObjectNames<'a> {
+    /// `[[output_cams]]`.
+    pub output_cams: Vec<&'a str>,
+    /// `[[cam_tracks]]`.
+    pub cam_tracks: Vec<&'a str>,
+    /// `[[measuring_inputs]]`.
+    pub measuring_inputs: Vec<&'a str>,
 }
 
 /// One timed command.
@@ -74,6 +134,142 @@ fn num(item: &toml_edit::Item) -> Option<f64> {
 /// can be addressed and lead (axes, then encoders: a leader's id is its index), `cams` the
 /// names of its cams (a cam's id is its index).
 pub fn parse(file: &str, src: &str, axes: &[&str], cams: &[&str]) -> Result<Script, ConfigError> {
+    parse_with(file, src, axes, cams, &ObjectNames::default())
+}
+
+/// Parses a script for `cell`: its axes, encoders, cams, output cams, cam tracks and measuring
+/// inputs can be addressed.
+pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, ConfigError> {
+    let names = cell.object_names();
+    let cams: Vec<&str> = cell.cams.iter().map(|c| c.name.as_str()).collect();
+    let objects = ObjectNames {
+        output_cams: cell.output_cams.iter().map(|c| c.name.as_str()).collect(),
+        cam_tracks: cell.cam_tracks.iter().map(|c| c.name.as_str()).collect(),
+        measuring_inputs: cell
+            .measuring_inputs
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect(),
+    };
+    parse_with(file, src, &names, &cams, &objects)
+}
+
+/// The instructions of output cams, cam tracks and measuring inputs: name, the kind of object
+/// it addresses (0 output cam, 1 cam track, 2 measuring input) and parameters with defaults.
+type ObjectInstruction = (&'static str, u8, &'static [(&'static str, Value)]);
+
+const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
+    (
+        "MC_OutputCam",
+        0,
+        &[
+            ("enable", Value::Bool(true)),
+            ("on_position", Value::Num(0.0)),
+            ("off_position", Value::Num(0.0)),
+            ("duration", Value::Num(0.0)),
+            ("mode", Value::Num(1.0)),
+            ("direction", Value::Num(3.0)),
+        ],
+    ),
+    (
+        "MC_CamTrack",
+        1,
+        &[
+            ("enable", Value::Bool(true)),
+            ("mode", Value::Num(1.0)),
+            ("invert_output", Value::Bool(false)),
+        ],
+    ),
+    (
+        "MC_MeasuringInput",
+        2,
+        &[
+            ("mode", Value::Num(0.0)),
+            ("measuring_range", Value::Bool(false)),
+            ("start_position", Value::Num(0.0)),
+            ("end_position", Value::Num(0.0)),
+        ],
+    ),
+    (
+        "MC_MeasuringInputCyclic",
+        2,
+        &[
+            ("mode", Value::Num(0.0)),
+            ("measuring_range", Value::Bool(false)),
+            ("start_position", Value::Num(0.0)),
+            ("end_position", Value::Num(0.0)),
+        ],
+    ),
+    ("MC_AbortMeasuringInput", 2, &[]),
+    ("InputEdge", 2, &[("rising", Value::Bool(true))]),
+];
+
+/// An entry for an output cam, cam track or measuring input.
+fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action, String> {
+    let (name, _, params) = *spec;
+    let mut vals: Vec<Value> = params.iter().map(|(_, v)| *v).collect();
+    for (k, v) in t.iter() {
+        if matches!(k, "t" | "axis" | "instruction") {
+            continue;
+        }
+        let Some(i) = params.iter().position(|(p, _)| *p == k) else {
+            let names: Vec<&str> = params.iter().map(|(p, _)| *p).collect();
+            return Err(format!(
+                "{name}: unknown parameter `{k}`; parameters: {}",
+                names.join(", ")
+            ));
+        };
+        vals[i] = match (params[i].1, v.as_bool(), num(v)) {
+            (Value::Bool(_), Some(b), _) => Value::Bool(b),
+            (Value::Num(_), _, Some(x)) if x.is_finite() => Value::Num(x),
+            (Value::Bool(_), _, _) => return Err(format!("`{k}` must be true or false")),
+            (Value::Num(_), _, _) => return Err(format!("`{k}` must be a number")),
+        };
+    }
+    let b = |i: usize| matches!(vals.get(i), Some(Value::Bool(true)));
+    let x = |i: usize| match vals.get(i) {
+        Some(Value::Num(x)) => *x,
+        _ => 0.0,
+    };
+    let code = |i: usize| -> Result<i32, String> {
+        let v = x(i);
+        if v.fract() == 0.0 && v.abs() < 1e6 {
+            Ok(v as i32)
+        } else {
+            Err(format!("`{}` must be an integer", params[i].0))
+        }
+    };
+    Ok(match name {
+        "MC_OutputCam" => Action::OutputCam {
+            enable: b(0),
+            on_position: x(1),
+            off_position: x(2),
+            duration: x(3),
+            mode: code(4)?,
+            direction: code(5)?,
+        },
+        "MC_CamTrack" => Action::CamTrack {
+            enable: b(0),
+            mode: code(1)?,
+            invert_output: b(2),
+        },
+        "MC_MeasuringInput" | "MC_MeasuringInputCyclic" => Action::MeasuringInput {
+            cyclic: name == "MC_MeasuringInputCyclic",
+            mode: code(0)?,
+            window: b(1).then(|| (x(2), x(3))),
+        },
+        "MC_AbortMeasuringInput" => Action::AbortMeasuringInput,
+        _ => Action::InputEdge { rising: b(0) },
+    })
+}
+
+fn parse_with(
+    file: &str,
+    src: &str,
+    axes: &[&str],
+    cams: &[&str],
+    objects: &ObjectNames<'_>,
+) -> Result<Script, ConfigError> {
     let e = |line: Option<usize>, key: &str, message: String| ConfigError {
         file: file.into(),
         line,
@@ -131,6 +327,39 @@ pub fn parse(file: &str, src: &str, axes: &[&str], cams: &[&str]) -> Result<Scri
                 .and_then(seconds_to_ns)
                 .ok_or_else(|| e(line, &key, "`t` (seconds >= 0) is required".into()))?;
             let instr_name = t.get("instruction").and_then(|x| x.as_str()).unwrap_or("");
+            if let Some(spec) = OBJECT_INSTRUCTIONS
+                .iter()
+                .find(|s| command::normalize(s.0) == command::normalize(instr_name))
+            {
+                let target = t.get("axis").and_then(|x| x.as_str()).ok_or_else(|| {
+                    e(line, &key, "`axis` (the object's name) is required".into())
+                })?;
+                let (list, what) = match spec.1 {
+                    0 => (&objects.output_cams, "output cam"),
+                    1 => (&objects.cam_tracks, "cam track"),
+                    _ => (&objects.measuring_inputs, "measuring input"),
+                };
+                if !list.contains(&target) {
+                    return Err(e(
+                        line,
+                        &key,
+                        format!(
+                            "{}: unknown {what} `{target}`; the cell has: {}",
+                            spec.0,
+                            list.join(", ")
+                        ),
+                    ));
+                }
+                let action = object_entry(t, spec).map_err(|m| e(line, &key, m))?;
+                entries.push(ScriptEntry {
+                    t_ns: time,
+                    axis: target.to_string(),
+                    instruction: spec.0,
+                    action,
+                    line: line.unwrap_or(0),
+                });
+                continue;
+            }
             if command::normalize(instr_name) == "interpolatecam" {
                 // A cam technology object: `axis` names the cam, `from` another cam's definition.
                 let target = t
