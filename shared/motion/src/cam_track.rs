@@ -595,7 +595,9 @@ impl Core {
     fn sorted_crossings(&mut self, from: f64, to: f64, time_of: &dyn Fn(f64) -> f64) -> bool {
         const MAX_PERIODS: i64 = 8;
         let n = self.n_bounds.min(self.bounds.len());
-        let (Some(first), Some(last)) = (self.bounds[..n].first(), self.bounds[..n].last()) else {
+        let (Some(&(first, ..)), Some(&(last, ..))) =
+            (self.bounds[..n].first(), self.bounds[..n].last())
+        else {
             return true;
         };
         let len = self.data.track_length;
@@ -604,8 +606,8 @@ impl Core {
         if to == from || !from.is_finite() || !to.is_finite() {
             return true;
         }
-        let k0 = ((min - last.0) / len).floor();
-        let k1 = ((max - first.0) / len).ceil();
+        let k0 = ((min - last) / len).floor();
+        let k1 = ((max - first) / len).ceil();
         let span = k1 - k0;
         if span.is_nan() || span > MAX_PERIODS as f64 {
             return false;
@@ -622,6 +624,12 @@ impl Core {
         if up {
             for k in k0..=k1 {
                 let base = k as f64 * len;
+                if last + base <= from {
+                    continue;
+                }
+                if first + base > to {
+                    break;
+                }
                 let mut j = b.partition_point(|e| e.0 + base <= from);
                 while j < n && b[j].0 + base <= to {
                     hit(self, j, base);
@@ -631,6 +639,12 @@ impl Core {
         } else {
             for k in (k0..=k1).rev() {
                 let base = k as f64 * len;
+                if first + base >= from {
+                    continue;
+                }
+                if last + base < to {
+                    break;
+                }
                 // The last boundary below `from`, then down while at or above `to`; a group
                 // at one position goes in cam order.
                 let mut end = b.partition_point(|e| e.0 + base < from);
