@@ -884,6 +884,61 @@ velocity = 100.0
     assert_eq!(rows.last().unwrap()[s], "MEASURING_ERROR");
 }
 
+/// MC_Reset addressed to a measuring input acknowledges its alarm; a new measurement then runs.
+#[test]
+fn mc_reset_on_a_measuring_input_acknowledges_its_alarm() {
+    let cell = one_axis_cell("\n[[measuring_inputs]]\nname = \"probe\"\naxis = \"x\"\n");
+    let script = r#"
+[sim]
+duration = 1.0
+
+[[at]]
+t = 0.0
+axis = "x"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "probe"
+instruction = "MC_MeasuringInput"
+measuring_range = true
+start_position = 10.0
+end_position = 20.0
+
+[[at]]
+t = 0.0
+axis = "x"
+instruction = "MC_MoveVelocity"
+velocity = 100.0
+
+[[at]]
+t = 0.6
+axis = "probe"
+instruction = "MC_Reset"
+
+[[at]]
+t = 0.7
+axis = "probe"
+instruction = "MC_MeasuringInput"
+
+[[at]]
+t = 0.8
+axis = "probe"
+instruction = "InputEdge"
+"#;
+    let (log, trace) = sim_text("reset", &cell, script);
+    assert!(log.contains("probe alarm 752"), "{log}");
+    assert!(log.contains("t=0.600000000 probe MC_Reset: Done"), "{log}");
+    assert!(!log.contains("rejected"), "{log}");
+    let (h, rows) = table(&trace);
+    let s = h.iter().position(|x| x == "probe.state").unwrap();
+    let at = |t: &str| rows.iter().find(|r| r[0] == t).unwrap()[s].clone();
+    assert_eq!(at("0.599000000"), "MEASURING_ERROR");
+    assert_eq!(at("0.650000000"), "INACTIVE");
+    assert_eq!(at("0.750000000"), "WAITING_FOR_TRIGGER");
+    assert_eq!(rows.last().unwrap()[s], "TRIGGER_OCCURRED");
+}
+
 #[test]
 fn the_object_examples_pass_check() {
     for f in ["glue-dot.toml", "print-mark-registration.toml"] {

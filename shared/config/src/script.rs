@@ -54,6 +54,12 @@ pub enum Action {
         /// `Direction` (1, 2, 3).
         direction: i32,
     },
+    /// `MC_Reset` on the output cam, cam track or measuring input named by the entry:
+    /// acknowledges its alarms; `Restart` also clears a measuring input's data block.
+    ResetObject {
+        /// `Restart`.
+        restart: bool,
+    },
     /// `MC_CamTrack` on the cam track named by the entry (Enable-type).
     CamTrack {
         /// `Enable`.
@@ -327,6 +333,42 @@ fn parse_with(
                 .and_then(seconds_to_ns)
                 .ok_or_else(|| e(line, &key, "`t` (seconds >= 0) is required".into()))?;
             let instr_name = t.get("instruction").and_then(|x| x.as_str()).unwrap_or("");
+            let object = t.get("axis").and_then(|x| x.as_str()).filter(|a| {
+                objects.output_cams.contains(a)
+                    || objects.cam_tracks.contains(a)
+                    || objects.measuring_inputs.contains(a)
+            });
+            if let (Some(target), true) = (
+                object,
+                command::normalize(instr_name) == command::normalize("MC_Reset"),
+            ) {
+                // MC_Reset addressed to an output cam, cam track or measuring input.
+                let mut restart = false;
+                for (k, v) in t.iter() {
+                    match (k, v.as_bool()) {
+                        ("t" | "axis" | "instruction", _) => {}
+                        ("restart", Some(b)) => restart = b,
+                        ("restart", None) => {
+                            return Err(e(line, &key, "`restart` must be true or false".into()))
+                        }
+                        _ => {
+                            return Err(e(
+                                line,
+                                &key,
+                                format!("MC_Reset: unknown parameter `{k}`; parameters: restart"),
+                            ))
+                        }
+                    }
+                }
+                entries.push(ScriptEntry {
+                    t_ns: time,
+                    axis: target.to_string(),
+                    instruction: "MC_Reset",
+                    action: Action::ResetObject { restart },
+                    line: line.unwrap_or(0),
+                });
+                continue;
+            }
             if let Some(spec) = OBJECT_INSTRUCTIONS
                 .iter()
                 .find(|s| command::normalize(s.0) == command::normalize(instr_name))

@@ -306,9 +306,14 @@ pub fn run(
                 | Action::CamTrack { .. }
                 | Action::MeasuringInput { .. }
                 | Action::AbortMeasuringInput
+                | Action::ResetObject { .. }
                 | Action::InputEdge { .. } => {
                     summary.commands += 1;
-                    if let Err(id) = objects.apply(cell, &e.axis, e.t_ns, e.action) {
+                    let applied = objects.apply(cell, &e.axis, e.t_ns, e.action);
+                    if applied.is_ok() && matches!(e.action, Action::ResetObject { .. }) {
+                        writeln!(log, "t={} {} MC_Reset: Done", seconds(t), e.axis)?;
+                    }
+                    if let Err(id) = applied {
                         summary.rejected += 1;
                         writeln!(
                             log,
@@ -886,6 +891,19 @@ impl Objects {
                     time_ns: t_ns,
                     rising,
                 });
+                Ok(())
+            }
+            Action::ResetObject { restart } => {
+                if let Some(i) = cell.output_cams.iter().position(|c| c.name == target) {
+                    self.cams[i].reset();
+                } else if let Some(i) = cell.cam_tracks.iter().position(|c| c.name == target) {
+                    self.tracks[i].reset();
+                } else if let Some(i) = cell.measuring_inputs.iter().position(|c| c.name == target)
+                {
+                    self.inputs[i].input.reset(restart);
+                } else {
+                    return Err(ErrorId::IllegalObject);
+                }
                 Ok(())
             }
             Action::Command(_) | Action::InterpolateCam { .. } => Err(ErrorId::IllegalObject),
