@@ -844,10 +844,9 @@ fn glue_dots_three_per_blank_with_the_valve_lead() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-#[test]
-fn a_one_time_measurement_that_leaves_its_window_logs_alarm_752() {
-    let cell = one_axis_cell("\n[[measuring_inputs]]\nname = \"probe\"\naxis = \"x\"\n");
-    let script = r#"
+/// A one-time measurement with the window 10..20 on an axis that moves through it at 100/s
+/// without an edge.
+const PROBE_LEAVES_ITS_WINDOW: &str = r#"
 [sim]
 duration = 1.0
 
@@ -870,7 +869,11 @@ axis = "x"
 instruction = "MC_MoveVelocity"
 velocity = 100.0
 "#;
-    let (log, trace) = sim_text("win", &cell, script);
+
+#[test]
+fn a_one_time_measurement_that_leaves_its_window_logs_alarm_752() {
+    let cell = one_axis_cell("\n[[measuring_inputs]]\nname = \"probe\"\naxis = \"x\"\n");
+    let (log, trace) = sim_text("win", &cell, PROBE_LEAVES_ITS_WINDOW);
     assert!(
         log.contains("probe alarm 752 MeasuringRangeNotRecognized"),
         "{log}"
@@ -888,29 +891,9 @@ velocity = 100.0
 #[test]
 fn mc_reset_on_a_measuring_input_acknowledges_its_alarm() {
     let cell = one_axis_cell("\n[[measuring_inputs]]\nname = \"probe\"\naxis = \"x\"\n");
-    let script = r#"
-[sim]
-duration = 1.0
-
-[[at]]
-t = 0.0
-axis = "x"
-instruction = "MC_Power"
-
-[[at]]
-t = 0.0
-axis = "probe"
-instruction = "MC_MeasuringInput"
-measuring_range = true
-start_position = 10.0
-end_position = 20.0
-
-[[at]]
-t = 0.0
-axis = "x"
-instruction = "MC_MoveVelocity"
-velocity = 100.0
-
+    let script = format!(
+        "{PROBE_LEAVES_ITS_WINDOW}{}",
+        r#"
 [[at]]
 t = 0.6
 axis = "probe"
@@ -925,8 +908,9 @@ instruction = "MC_MeasuringInput"
 t = 0.8
 axis = "probe"
 instruction = "InputEdge"
-"#;
-    let (log, trace) = sim_text("reset", &cell, script);
+"#
+    );
+    let (log, trace) = sim_text("reset", &cell, &script);
     assert!(log.contains("probe alarm 752"), "{log}");
     assert!(log.contains("t=0.600000000 probe MC_Reset: Done"), "{log}");
     assert!(!log.contains("rejected"), "{log}");

@@ -334,6 +334,19 @@ mod axis_step_in_motion {
     }
 }
 
+/// `Ruckig::<1, ThrowErrorHandler>::calculate` over a corpus, one case per iteration.
+fn bench_rsruckig_calculate(bencher: divan::Bencher, cases: &[Case]) {
+    let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
+    let mut traj = Trajectory::new(None);
+    let mut k = Cycle::new(cases.len());
+    bencher.bench_local(|| {
+        let c = &cases[k.next()];
+        let r = otg.calculate(black_box(&c.ruckig), &mut traj);
+        black_box(&traj);
+        black_box(r)
+    });
+}
+
 /// One `plan_position` from a random moving state to a random target (rest), over the corpus.
 #[divan::bench_group(sample_count = 1000, sample_size = 1000)]
 mod replan_position {
@@ -353,16 +366,7 @@ mod replan_position {
     /// `Ruckig::<1, ThrowErrorHandler>::calculate` on the same cases (target v = a = 0).
     #[divan::bench]
     fn rsruckig(bencher: divan::Bencher) {
-        let cases = &corpora().position;
-        let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
-        let mut traj = Trajectory::new(None);
-        let mut k = Cycle::new(cases.len());
-        bencher.bench_local(|| {
-            let c = &cases[k.next()];
-            let r = otg.calculate(black_box(&c.ruckig), &mut traj);
-            black_box(&traj);
-            black_box(r)
-        });
+        bench_rsruckig_calculate(bencher, &corpora().position);
     }
 }
 
@@ -385,16 +389,7 @@ mod replan_velocity {
     /// rsruckig with `ControlInterface::Velocity` on the same cases (target a = 0).
     #[divan::bench]
     fn rsruckig(bencher: divan::Bencher) {
-        let cases = &corpora().velocity;
-        let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
-        let mut traj = Trajectory::new(None);
-        let mut k = Cycle::new(cases.len());
-        bencher.bench_local(|| {
-            let c = &cases[k.next()];
-            let r = otg.calculate(black_box(&c.ruckig), &mut traj);
-            black_box(&traj);
-            black_box(r)
-        });
+        bench_rsruckig_calculate(bencher, &corpora().velocity);
     }
 }
 
