@@ -269,6 +269,21 @@ impl Cell {
             .chain(self.encoders.iter().map(|e| e.name.as_str()))
             .collect()
     }
+
+    /// The index of the output cam named `name`.
+    pub fn output_cam(&self, name: &str) -> Option<usize> {
+        self.output_cams.iter().position(|c| c.name == name)
+    }
+
+    /// The index of the cam track named `name`.
+    pub fn cam_track(&self, name: &str) -> Option<usize> {
+        self.cam_tracks.iter().position(|c| c.name == name)
+    }
+
+    /// The index of the measuring input named `name`.
+    pub fn measuring_input(&self, name: &str) -> Option<usize> {
+        self.measuring_inputs.iter().position(|c| c.name == name)
+    }
 }
 
 /// Finds the 1-based line of `key` in table `index` of the array of tables `array` (or of the

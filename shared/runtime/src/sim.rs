@@ -805,11 +805,7 @@ impl Objects {
                 mode,
                 direction,
             } => {
-                let i = cell
-                    .output_cams
-                    .iter()
-                    .position(|c| c.name == target)
-                    .ok_or(ErrorId::IllegalObject)?;
+                let i = cell.output_cam(target).ok_or(ErrorId::IllegalObject)?;
                 let input = McOutputCam {
                     enable,
                     on_position,
@@ -829,11 +825,7 @@ impl Objects {
                 mode,
                 invert_output,
             } => {
-                let i = cell
-                    .cam_tracks
-                    .iter()
-                    .position(|c| c.name == target)
-                    .ok_or(ErrorId::IllegalObject)?;
+                let i = cell.cam_track(target).ok_or(ErrorId::IllegalObject)?;
                 let input = McCamTrack {
                     enable,
                     mode: CamTrackMode::from_code(mode)?,
@@ -850,11 +842,7 @@ impl Objects {
                 mode,
                 window,
             } => {
-                let i = cell
-                    .measuring_inputs
-                    .iter()
-                    .position(|c| c.name == target)
-                    .ok_or(ErrorId::IllegalObject)?;
+                let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
                 let window = window.map(|(start, end)| MeasuringWindow { start, end });
                 let ctx = MeasuringContext {
                     encoder_valid: true,
@@ -873,20 +861,12 @@ impl Objects {
                 Ok(())
             }
             Action::AbortMeasuringInput => {
-                let i = cell
-                    .measuring_inputs
-                    .iter()
-                    .position(|c| c.name == target)
-                    .ok_or(ErrorId::IllegalObject)?;
+                let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
                 self.inputs[i].input.abort_measuring_input()?;
                 Ok(())
             }
             Action::InputEdge { rising } => {
-                let i = cell
-                    .measuring_inputs
-                    .iter()
-                    .position(|c| c.name == target)
-                    .ok_or(ErrorId::IllegalObject)?;
+                let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
                 self.inputs[i].edges.push(InputEdge {
                     time_ns: t_ns,
                     rising,
@@ -894,12 +874,11 @@ impl Objects {
                 Ok(())
             }
             Action::ResetObject { restart } => {
-                if let Some(i) = cell.output_cams.iter().position(|c| c.name == target) {
+                if let Some(i) = cell.output_cam(target) {
                     self.cams[i].reset();
-                } else if let Some(i) = cell.cam_tracks.iter().position(|c| c.name == target) {
+                } else if let Some(i) = cell.cam_track(target) {
                     self.tracks[i].reset();
-                } else if let Some(i) = cell.measuring_inputs.iter().position(|c| c.name == target)
-                {
+                } else if let Some(i) = cell.measuring_input(target) {
                     self.inputs[i].input.reset(restart);
                 } else {
                     return Err(ErrorId::IllegalObject);
