@@ -211,19 +211,7 @@ macro_rules! alarms {
 
         /// Every technology alarm of seed 001 §5.2 with its reaction, ErrorWord/WarningWord bit,
         /// restart flag and text, sorted by number.
-        pub const ALARMS: &[AlarmSpec] = &[
-            $(
-                AlarmSpec {
-                    id: AlarmId::$name,
-                    number: $num,
-                    reaction: Reaction::$reaction,
-                    error_bit: $ebit,
-                    warning_bit: $wbit,
-                    restart: $restart,
-                    text: $text,
-                },
-            )*
-        ];
+        pub const ALARMS: &[AlarmSpec] = &[$(*AlarmId::$name.spec(),)*];
 
         impl AlarmId {
             /// Every alarm, sorted by number.

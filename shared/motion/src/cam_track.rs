@@ -1117,20 +1117,17 @@ impl CamTrack {
                     (true, true) => p.on_compensation,
                     (true, false) => p.off_compensation,
                 };
-                let t = t0 + ((dt - lead).max(floor) * 1e9).round() as i64;
+                let t = motion.ns((dt - lead).max(floor));
                 push(&mut raw, t, want, cause, &mut phys);
             }
         }
         if let Some(c) = cut {
             if phys {
-                push(&mut raw, t0 + (c * 1e9).round() as i64, false, 0, &mut phys);
+                push(&mut raw, motion.ns(c), false, 0, &mut phys);
             }
         }
         // Edges after a switch-over never come before it, in later cycles too.
-        let floor_ns = self
-            .core
-            .switched_at
-            .map_or(i64::MIN, |dt| t0 + (dt * 1e9).round() as i64);
+        let floor_ns = self.core.switched_at.map_or(i64::MIN, |dt| motion.ns(dt));
         self.last_edge_ns = last.max(floor_ns);
         self.phys = phys;
 

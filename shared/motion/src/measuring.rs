@@ -820,7 +820,7 @@ impl SimulatedSensor {
             set.crossings(run.xa, run.xb, |c, entering| {
                 let t = run.time_of(c) + self.dead_time;
                 crossings.push(InputEdge {
-                    time_ns: motion.t0_ns + (t * 1e9).round() as i64,
+                    time_ns: motion.ns(t),
                     rising: entering,
                 });
                 true

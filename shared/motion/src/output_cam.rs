@@ -316,11 +316,6 @@ pub(crate) fn point_crossings(
     }
 }
 
-/// Seconds to ns for compensation offsets.
-pub(crate) fn secs_ns(s: f64) -> f64 {
-    s * 1e9
-}
-
 // ---------------------------------------------------------------------------------------------
 // Output cam TO
 // ---------------------------------------------------------------------------------------------
@@ -742,7 +737,7 @@ impl OutputCam {
         } else {
             p.off_compensation
         };
-        let t = motion.t0_ns + (secs_ns(dt - comp)).round() as i64;
+        let t = motion.ns(dt - comp);
         self.emit(edges, t, phys);
     }
 
@@ -845,15 +840,11 @@ impl OutputCam {
                             true
                         });
                     }
-                    PathEvent::Turn { dt, dir, at } => {
+                    PathEvent::Turn { dt, dir, at }
+                    | PathEvent::Sweep {
+                        dt, dir, to: at, ..
+                    } => {
                         let logic = set.contains_moving(at, dir) && dir_cfg.enables(dir);
-                        if logic != self.logic {
-                            self.logic = logic;
-                            self.switch_at(edges, motion, dt, logic);
-                        }
-                    }
-                    PathEvent::Sweep { dt, dir, to, .. } => {
-                        let logic = set.contains_moving(to, dir) && dir_cfg.enables(dir);
                         if logic != self.logic {
                             self.logic = logic;
                             self.switch_at(edges, motion, dt, logic);
@@ -865,14 +856,10 @@ impl OutputCam {
                 let (p, period) = self.start_point(motion);
                 let dir_cfg = self.input.direction;
                 path.walk(motion, h, |ev| {
-                    let (dt_of, dir, from, to): (Option<&Run>, i8, f64, f64) = match ev {
-                        PathEvent::Move { run, from, to } => (Some(run), run.dir(), from, to),
-                        PathEvent::Sweep { dir, from, to, .. } => (None, dir, from, to),
+                    let (dt_of, sweep_dt, dir, from, to) = match ev {
+                        PathEvent::Move { run, from, to } => (Some(run), 0.0, run.dir(), from, to),
+                        PathEvent::Sweep { dt, dir, from, to } => (None, dt, dir, from, to),
                         PathEvent::Turn { .. } => return,
-                    };
-                    let sweep_dt = match ev {
-                        PathEvent::Sweep { dt, .. } => dt,
-                        _ => 0.0,
                     };
                     if !armed || !dir_cfg.enables(dir) {
                         return;
@@ -911,10 +898,10 @@ impl OutputCam {
         } else {
             p.off_compensation
         };
-        let off = motion.t0_ns + secs_ns(dt + d - comp).round() as i64;
+        let off = motion.ns(dt + d - comp);
         self.running = Some(Running {
             off_edge_ns: Some(off),
-            logical_end_ns: motion.t0_ns + secs_ns(dt + d).round() as i64,
+            logical_end_ns: motion.ns(dt + d),
         });
     }
 

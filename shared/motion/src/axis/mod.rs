@@ -809,23 +809,10 @@ impl Axis {
                 abort_acceleration,
             } => {
                 self.check_motion_allowed()?;
-                let d = Dynamics {
-                    velocity: -1.0,
-                    acceleration: -1.0,
-                    deceleration,
-                    jerk,
-                };
-                let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
-                self.warn_clamped(r.clamped);
-                self.apply_override_table(NewJob::Halt);
-                self.fold_superimposed();
+                let lim = self.stop_limits(deceleration, jerk)?;
                 if abort_acceleration {
                     self.basic.a = 0.0;
                 }
-                let lim = Limits {
-                    acc: r.limits.dec,
-                    ..r.limits
-                };
                 Ok(self.start_main(Instruction::Halt, lim, Goal::Stop { lim }))
             }
             Command::Stop {
@@ -1231,23 +1218,28 @@ impl Axis {
         if self.stopping_alarm_pending() {
             return Err(ErrorId::JobRejectedInErrorStop);
         }
+        let lim = self.stop_limits(deceleration, jerk)?;
+        let id = self.start_main(Instruction::Stop, lim, Goal::Stop { lim });
+        self.stop_lock = true;
+        Ok(id)
+    }
+
+    /// The braking limits of MC_Halt / MC_Stop (deceleration also used as acceleration), after
+    /// the override table and folding the superimposed motion into the basic one.
+    fn stop_limits(&mut self, deceleration: f64, jerk: f64) -> Result<Limits, ErrorId> {
         let d = Dynamics {
-            velocity: -1.0,
-            acceleration: -1.0,
             deceleration,
             jerk,
+            ..Dynamics::DEFAULT
         };
         let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
         self.warn_clamped(r.clamped);
         self.apply_override_table(NewJob::Halt);
         self.fold_superimposed();
-        let lim = Limits {
+        Ok(Limits {
             acc: r.limits.dec,
             ..r.limits
-        };
-        let id = self.start_main(Instruction::Stop, lim, Goal::Stop { lim });
-        self.stop_lock = true;
-        Ok(id)
+        })
     }
 
     fn cmd_jog(
