@@ -930,3 +930,109 @@ mod cams_and_measuring {
         assert_eq!(s.lost_edge_counter1, 0);
     }
 }
+
+/// The leading-value buffer (design §4) of a leader sampled every 1 ms, 256 samples buffered:
+/// a follower's lookup inside the last two sample intervals (the common case: delay of one or
+/// two cycles), a lookup deep in the buffer (binary search), and one cycle of the runtime (push
+/// the new sample, then look the leader up at a delay of 1.5 ms). The lookup times are a corpus
+/// of random offsets.
+#[divan::bench_group(sample_count = 3000, sample_size = 1000)]
+mod leading_value_buffer {
+    use super::*;
+    use tandem_motion::leading::{LeadingSample, LeadingValueBuffer, Lookup};
+
+    const MS: i64 = 1_000_000;
+    const N: usize = 256;
+
+    /// Sample `k` of a leader whose acceleration swings ±600/s² around 1000/s.
+    fn sample(k: i64) -> LeadingSample {
+        let t = k as f64 * 1e-3;
+        let w = 2.0 * std::f64::consts::PI;
+        let (s, c) = (w * t).sin_cos();
+        LeadingSample {
+            t_ns: k * MS,
+            seq: k as u64,
+            p: 1000.0 * t - 600.0 / (w * w) * s,
+            v: 1000.0 - 600.0 / w * c,
+            a: 600.0 * s,
+            modulo: None,
+            valid: true,
+        }
+    }
+
+    fn full() -> LeadingValueBuffer<N> {
+        let mut b = LeadingValueBuffer::new();
+        for k in 0..N as i64 {
+            b.push(sample(k)).unwrap();
+        }
+        b
+    }
+
+    /// `CORPUS` offsets in `[lo, hi)` ns.
+    fn offsets(seed: u64, lo: i64, hi: i64) -> Vec<i64> {
+        let mut rng = Rng::new(seed);
+        (0..CORPUS)
+            .map(|_| rng.uniform(lo as f64, hi as f64) as i64)
+            .collect()
+    }
+
+    fn value(l: Lookup) -> f64 {
+        l.value().map_or(f64::NAN, |v| v.p)
+    }
+
+    /// `at` for a time inside the last two sample intervals of the full buffer.
+    #[divan::bench]
+    fn at_last_two_samples(bencher: divan::Bencher) {
+        let b = full();
+        let newest = b.newest().unwrap().t_ns;
+        let times: Vec<i64> = offsets(0x1ead_0001, -2 * MS, 0)
+            .into_iter()
+            .map(|o| newest + o)
+            .collect();
+        assert!(times.iter().all(|&t| b.at(t, 0).value().is_some()));
+        let mut k = Cycle::new(times.len());
+        bencher.bench_local(|| value(black_box(&b).at(black_box(times[k.next()]), MS)));
+    }
+
+    /// `at` for a time anywhere in the older 250 intervals of the full buffer (binary search).
+    #[divan::bench]
+    fn at_deep(bencher: divan::Bencher) {
+        let b = full();
+        let newest = b.newest().unwrap().t_ns;
+        let times: Vec<i64> = offsets(0x1ead_0002, -(N as i64 - 1) * MS, -5 * MS)
+            .into_iter()
+            .map(|o| newest + o)
+            .collect();
+        assert!(times.iter().all(|&t| b.at(t, 0).value().is_some()));
+        let mut k = Cycle::new(times.len());
+        bencher.bench_local(|| value(black_box(&b).at(black_box(times[k.next()]), MS)));
+    }
+
+    /// One cycle: push the leader's new sample into the full buffer, then look the leader up
+    /// at a delay of 1.5 ms (interpolated between the two newest samples). The samples come
+    /// from a table of one period of the leader's motion (1 s), shifted by whole periods.
+    #[divan::bench]
+    fn push_and_at(bencher: divan::Bencher) {
+        const PERIOD: i64 = 1000;
+        let mut b = full();
+        let table: Vec<LeadingSample> = (0..PERIOD).map(sample).collect();
+        let mut k = N as i64;
+        bencher.bench_local(|| {
+            let (n, i) = (k / PERIOD, k % PERIOD);
+            let base = table[i as usize];
+            let s = LeadingSample {
+                t_ns: k * MS,
+                seq: k as u64,
+                p: base.p + 1000.0 * n as f64,
+                ..base
+            };
+            k += 1;
+            let _ = b.push(black_box(s));
+            value(b.at(black_box(s.t_ns - 3 * MS / 2), MS))
+        });
+        assert_eq!((b.rejected(), b.lost()), (0, 0));
+        let newest = b.newest().unwrap().t_ns;
+        assert!(b.at(newest - 3 * MS / 2, 0).value().is_some());
+        assert_eq!(b.len(), N);
+    }
+}
