@@ -47,13 +47,37 @@ impl core::fmt::Display for ConfigError {
 
 impl std::error::Error for ConfigError {}
 
-/// A node of the cell.
+/// A node of the cell: one process with one servo cycle.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Node {
     /// Name.
     pub name: String,
     /// Servo cycle (ns).
     pub cycle_ns: i64,
+    /// Index into [`Cell::hosts`].
+    pub host: usize,
+    /// Scheduling of the cyclic thread.
+    pub realtime: Realtime,
+}
+
+/// Scheduling of a node's cyclic thread (`[nodes.realtime]`).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct Realtime {
+    /// SCHED_FIFO priority 1..=99; `None`: normal scheduling.
+    pub priority: Option<u8>,
+    /// CPU the cyclic thread is pinned to.
+    pub cpu: Option<usize>,
+    /// Lock the process' memory.
+    pub lock_memory: bool,
+}
+
+/// How followers receive a leader's values (`[axes.<name>.leading_value]`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct LeadingValueConfig {
+    /// Leading-value delay D (ns): every follower evaluates the leader at `t - D`.
+    pub delay_ns: i64,
+    /// How long a late sample is bridged by extrapolation (ns).
+    pub tolerance_ns: i64,
 }
 
 /// How a follower reads a leader.
@@ -243,6 +267,12 @@ pub struct Cell {
     pub name: String,
     /// Base tick (ns).
     pub base_tick_ns: i64,
+    /// Time budget of a leading value between two nodes of one host (ns).
+    pub ipc_budget_ns: i64,
+    /// Time budget of a leading value between nodes of different hosts (ns).
+    pub network_budget_ns: i64,
+    /// Host names (`local` when the file has no `[[hosts]]`).
+    pub hosts: Vec<String>,
     /// Nodes.
     pub nodes: Vec<Node>,
     /// Axes, in name order.
@@ -257,9 +287,65 @@ pub struct Cell {
     pub cam_tracks: Vec<CamTrackEntry>,
     /// Measuring inputs, in file order.
     pub measuring_inputs: Vec<MeasuringInputEntry>,
+    /// Per leader (axes, then encoders, as in [`Cell::object_names`]): its leading-value delay
+    /// and tolerance.
+    pub leading: Vec<LeadingValueConfig>,
 }
 
 impl Cell {
+    /// How axis `follower` reads leader `leader` (axes, then encoders), or `None` if it may not
+    /// follow it. Without a `leaders` table an axis may follow any leader of its own node, by
+    /// setpoint.
+    pub fn coupling(&self, follower: usize, leader: usize) -> Option<Coupling> {
+        let f = self.axes.get(follower)?;
+        match &f.leaders {
+            Some(_) => f.coupling(leader),
+            None => (self.leader_node(leader)? == f.node).then_some(Coupling::Setpoint),
+        }
+    }
+
+    /// The node that hosts leader `leader` (axes, then encoders).
+    pub fn leader_node(&self, leader: usize) -> Option<usize> {
+        match self.axes.get(leader) {
+            Some(a) => Some(a.node),
+            None => self
+                .encoders
+                .get(leader.checked_sub(self.axes.len())?)
+                .map(|e| e.node),
+        }
+    }
+
+    /// The leaders of other nodes that followers on `node` may follow (sorted, unique).
+    pub fn remote_leaders(&self, node: usize) -> Vec<usize> {
+        let mut out: Vec<usize> = self
+            .axes
+            .iter()
+            .filter(|a| a.node == node)
+            .flat_map(|a| a.leaders.iter().flatten().map(|(l, _)| *l))
+            .filter(|l| self.leader_node(*l) != Some(node))
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The leaders on `node` that followers on other nodes may follow (sorted, unique).
+    pub fn published_leaders(&self, node: usize) -> Vec<usize> {
+        let mut out: Vec<usize> = (0..self.nodes.len())
+            .filter(|n| *n != node)
+            .flat_map(|n| self.remote_leaders(n))
+            .filter(|l| self.leader_node(*l) == Some(node))
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The index of the node named `name`.
+    pub fn node(&self, name: &str) -> Option<usize> {
+        self.nodes.iter().position(|n| n.name == name)
+    }
+
     /// The names of all technology objects that can be addressed or lead: axes, then encoders
     /// (a leader's id is its index here).
     pub fn object_names(&self) -> Vec<&str> {
@@ -360,8 +446,61 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         ));
     }
     let base = raw.cell.base_tick_us;
+    let mut hosts: Vec<String> = Vec::new();
+    for (i, h) in raw.hosts.iter().enumerate() {
+        if hosts.contains(&h.name) || h.name.is_empty() || h.name.contains('/') {
+            return Err(ConfigError {
+                file: file.into(),
+                line: locate_in_array(src, "hosts", i, "name"),
+                key: format!("hosts[{i}].name"),
+                message: format!("host `{}` is defined twice, empty or contains `/`", h.name),
+            });
+        }
+        hosts.push(h.name.clone());
+    }
+    if hosts.is_empty() {
+        hosts.push("local".into());
+    }
     let mut nodes = Vec::new();
-    for n in &raw.nodes {
+    for (i, n) in raw.nodes.iter().enumerate() {
+        let at = |key: &str, message: String| ConfigError {
+            file: file.into(),
+            line: locate_in_array(src, "nodes", i, key),
+            key: format!("nodes[{i}].{key}"),
+            message,
+        };
+        if n.name.is_empty() || n.name.contains('/') {
+            return Err(at(
+                "name",
+                format!("`{}`: a node name must be non-empty, without `/`", n.name),
+            ));
+        }
+        let host = match &n.host {
+            Some(h) => hosts.iter().position(|x| x == h).ok_or_else(|| {
+                at(
+                    "host",
+                    format!("unknown host `{h}`; the cell has: {}", hosts.join(", ")),
+                )
+            })?,
+            None if hosts.len() == 1 => 0,
+            None => {
+                return Err(at(
+                    "host",
+                    format!(
+                        "node `{}` needs `host = ...`: the cell has several hosts",
+                        n.name
+                    ),
+                ))
+            }
+        };
+        if let Some(p) = n.realtime.priority {
+            if !(1..=99).contains(&p) {
+                return Err(at(
+                    "realtime",
+                    format!("priority = {p}: SCHED_FIFO priorities are 1 to 99"),
+                ));
+            }
+        }
         if n.cycle_us == 0 || n.cycle_us % base != 0 {
             return Err(err(
                 &["nodes"],
@@ -380,6 +519,12 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         nodes.push(Node {
             name: n.name.clone(),
             cycle_ns: n.cycle_us as i64 * 1000,
+            host,
+            realtime: Realtime {
+                priority: n.realtime.priority,
+                cpu: n.realtime.cpu,
+                lock_memory: n.realtime.lock_memory,
+            },
         });
     }
     let mut axes = Vec::new();
@@ -421,8 +566,13 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
             continue;
         };
         let mut list = Vec::new();
-        for (leader, kind) in table {
-            let path = ["axes", name.as_str(), "leaders", leader.as_str()];
+        for (key, kind) in table {
+            let path = ["axes", name.as_str(), "leaders", key.as_str()];
+            // `node/to` names the leader's node too; it must be the node that hosts it.
+            let (leader_node, leader) = match key.split_once('/') {
+                Some((n, to)) => (Some(n), to),
+                None => (None, key.as_str()),
+            };
             let idx = names.iter().position(|n| n == leader).ok_or_else(|| {
                 err(
                     &path,
@@ -434,6 +584,18 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
             })?;
             if leader == name {
                 return Err(err(&path, "an axis cannot lead itself".into()));
+            }
+            if let Some(n) = leader_node {
+                let hosted = match raw.axes.get(leader) {
+                    Some(x) => &x.node,
+                    None => raw.encoders.get(leader).map(|e| &e.node).unwrap_or(&a.node),
+                };
+                if hosted != n {
+                    return Err(err(
+                        &path,
+                        format!("`{leader}` is on node `{hosted}`, not `{n}`"),
+                    ));
+                }
             }
             let coupling = match kind.as_str() {
                 "setpoint" => Coupling::Setpoint,
@@ -590,10 +752,15 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
             definition,
         });
     }
+    let leading = leading_values(file, src, &raw, &axes, &encoders, &nodes)?;
     let objects = objects(file, src, &raw, &axes, &nodes)?;
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: base as i64 * 1000,
+        ipc_budget_ns: raw.cell.ipc_budget_us as i64 * 1000,
+        network_budget_ns: raw.cell.network_budget_us as i64 * 1000,
+        hosts,
+        leading,
         nodes,
         axes,
         encoders,
@@ -602,6 +769,113 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         cam_tracks: objects.1,
         measuring_inputs: objects.2,
     })
+}
+
+/// Samples a leader's buffer holds at each follower: the delay plus the tolerance, in leader
+/// cycles, must fit with a margin of four samples.
+pub const LEADING_BUFFER: usize = 256;
+
+/// The leading-value delay and tolerance of every leader, checked against the links its
+/// followers need: a follower on another node needs `D >= leader cycle + link budget +
+/// follower cycle` (design §4), the link being `ipc_budget_us` on one host and
+/// `network_budget_us` between hosts.
+fn leading_values(
+    file: &str,
+    src: &str,
+    raw: &CellFile,
+    axes: &[AxisEntry],
+    encoders: &[EncoderEntry],
+    nodes: &[Node],
+) -> Result<Vec<LeadingValueConfig>, ConfigError> {
+    let err = |path: &[&str], message: String| {
+        let line = locate(src, path).or_else(|| locate(src, &path[..2]));
+        ConfigError {
+            file: file.into(),
+            line,
+            key: path.join("."),
+            message,
+        }
+    };
+    let sections = raw
+        .axes
+        .iter()
+        .map(|(n, a)| ("axes", n, a.leading_value.as_ref()))
+        .chain(
+            raw.encoders
+                .iter()
+                .map(|(n, e)| ("encoders", n, e.leading_value.as_ref())),
+        );
+    let leader_nodes = axes
+        .iter()
+        .map(|a| a.node)
+        .chain(encoders.iter().map(|e| e.node));
+    let mut out = Vec::new();
+    for ((table, name, section), node) in sections.zip(leader_nodes) {
+        let cycle = nodes[node].cycle_ns;
+        let delay_ns = section.map_or(0, |s| s.delay_us as i64 * 1000);
+        let tolerance_ns = section
+            .and_then(|s| s.tolerance_us)
+            .map_or(2 * cycle, |t| t as i64 * 1000);
+        let depth = (delay_ns + tolerance_ns) / cycle + 4;
+        if depth > LEADING_BUFFER as i64 {
+            return Err(err(
+                &[table, name, "leading_value", "delay_us"],
+                format!(
+                    "delay plus tolerance span {} cycles of node `{}`; at most {} fit the buffer",
+                    depth - 4,
+                    nodes[node].name,
+                    LEADING_BUFFER - 4
+                ),
+            ));
+        }
+        out.push(LeadingValueConfig {
+            delay_ns,
+            tolerance_ns,
+        });
+    }
+    let ipc = raw.cell.ipc_budget_us as i64 * 1000;
+    let net = raw.cell.network_budget_us as i64 * 1000;
+    let names: Vec<(&str, &String)> = raw
+        .axes
+        .keys()
+        .map(|n| ("axes", n))
+        .chain(raw.encoders.keys().map(|n| ("encoders", n)))
+        .collect();
+    for (follower, f) in axes.iter().enumerate() {
+        for (leader, _) in f.leaders.iter().flatten() {
+            let l_node = if *leader < axes.len() {
+                axes[*leader].node
+            } else {
+                encoders[*leader - axes.len()].node
+            };
+            if l_node == f.node {
+                continue;
+            }
+            let (link, budget) = if nodes[l_node].host == nodes[f.node].host {
+                (ipc, "ipc_budget_us")
+            } else {
+                (net, "network_budget_us")
+            };
+            let need = nodes[l_node].cycle_ns + link + nodes[f.node].cycle_ns;
+            let (table, lname) = names[*leader];
+            if out[*leader].delay_ns < need {
+                return Err(err(
+                    &[table, lname, "leading_value", "delay_us"],
+                    format!(
+                        "leading-value delay {} µs is shorter than the link to follower `{}` on node `{}` needs: {} µs (leader cycle {} + {budget} {} + follower cycle {})",
+                        out[*leader].delay_ns / 1000,
+                        axes[follower].name,
+                        nodes[f.node].name,
+                        need / 1000,
+                        nodes[l_node].cycle_ns / 1000,
+                        link / 1000,
+                        nodes[f.node].cycle_ns / 1000,
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(out)
 }
 
 type Objects = (

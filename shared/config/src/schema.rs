@@ -10,6 +10,9 @@ use std::collections::BTreeMap;
 pub struct CellFile {
     /// `[cell]`.
     pub cell: CellSection,
+    /// `[[hosts]]`: the controllers of the cell; without it, one host named `local`.
+    #[serde(default)]
+    pub hosts: Vec<HostSection>,
     /// `[[nodes]]`.
     #[serde(default)]
     pub nodes: Vec<NodeSection>,
@@ -300,6 +303,8 @@ pub struct EncoderSection {
     /// `[encoders.<name>.extrapolation]`.
     #[serde(default)]
     pub extrapolation: ExtrapolationSection,
+    /// `[encoders.<name>.leading_value]`: this encoder as a leader.
+    pub leading_value: Option<LeadingValueSection>,
 }
 
 fn one() -> f64 {
@@ -315,6 +320,55 @@ pub struct CellSection {
     /// Base tick of the cell clock in µs: every node cycle is a multiple of it.
     #[serde(default = "default_base_tick_us")]
     pub base_tick_us: u64,
+    /// The time a leading value needs from the leader's node to a follower's node on the same
+    /// host (publish, iceoryx2, wake-up), in µs: part of the minimum leading-value delay.
+    #[serde(default = "default_ipc_budget_us")]
+    pub ipc_budget_us: u64,
+    /// The same between nodes of different hosts (gateway, Zenoh, network), in µs.
+    #[serde(default = "default_network_budget_us")]
+    pub network_budget_us: u64,
+}
+
+fn default_network_budget_us() -> u64 {
+    2000
+}
+
+fn default_ipc_budget_us() -> u64 {
+    200
+}
+
+/// `[[hosts]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HostSection {
+    /// Host name (`tandem up --host <name>`).
+    pub name: String,
+}
+
+/// `[nodes.realtime]`: scheduling of the node's cyclic thread.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RealtimeSection {
+    /// SCHED_FIFO priority 1..=99; absent: normal scheduling.
+    pub priority: Option<u8>,
+    /// Pin the cyclic thread to this CPU.
+    pub cpu: Option<usize>,
+    /// Lock the process' memory (mlockall).
+    #[serde(default)]
+    pub lock_memory: bool,
+}
+
+/// `[axes.<name>.leading_value]` / `[encoders.<name>.leading_value]`: how followers receive this
+/// leader's values.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LeadingValueSection {
+    /// Leading-value delay D (µs): every follower, local or remote, evaluates the leader at
+    /// `t - D`.
+    #[serde(default)]
+    pub delay_us: u64,
+    /// How long a late sample is bridged by extrapolation (µs); default: two leader cycles.
+    pub tolerance_us: Option<u64>,
 }
 
 fn default_base_tick_us() -> u64 {
@@ -329,6 +383,11 @@ pub struct NodeSection {
     pub name: String,
     /// Servo cycle in µs.
     pub cycle_us: u64,
+    /// The host that runs it (`[[hosts]]`); may be left out when the cell has one host.
+    pub host: Option<String>,
+    /// `[nodes.realtime]`.
+    #[serde(default)]
+    pub realtime: RealtimeSection,
 }
 
 /// `[axes.<name>]`.
@@ -383,8 +442,11 @@ pub struct AxisSection {
     #[serde(default)]
     pub extrapolation: ExtrapolationSection,
     /// `[axes.<name>.leaders]`: the leaders this axis may follow, `name = "setpoint"` or
-    /// `"actual"` (the coupling). Without the table any axis may lead, by setpoint.
+    /// `"actual"` (the coupling); a leader is named `to` or `"node/to"`. Without the table any
+    /// axis of the same node may lead, by setpoint.
     pub leaders: Option<BTreeMap<String, String>>,
+    /// `[axes.<name>.leading_value]`: this axis as a leader.
+    pub leading_value: Option<LeadingValueSection>,
 }
 
 /// `[axes.<name>.extrapolation]`.

@@ -534,6 +534,103 @@ fn parse_with(
     })
 }
 
+/// Parses one command as the CLI gives it (`<object> <instruction> --param value ...`) with the
+/// script's rules: the same instruction names, parameters, defaults and errors. A value that is
+/// a number or `true`/`false` is one; anything else is a name (a leader, a cam). A leader may be
+/// named `node/object`.
+pub fn parse_command(
+    cell: &crate::Cell,
+    object: &str,
+    instruction: &str,
+    params: &[(String, String)],
+) -> Result<ScriptEntry, String> {
+    use std::fmt::Write as _;
+    let quote = |s: &str| {
+        let mut q = String::from("\"");
+        for c in s.chars() {
+            match c {
+                '"' => q.push_str("\\\""),
+                '\\' => q.push_str("\\\\"),
+                c if c.is_control() => {}
+                c => q.push(c),
+            }
+        }
+        q.push('"');
+        q
+    };
+    let mut src = String::from("[sim]\nduration = 0\n[[at]]\nt = 0\n");
+    let _ = writeln!(src, "axis = {}", quote(object));
+    let _ = writeln!(src, "instruction = {}", quote(instruction));
+    for (k, v) in params {
+        if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(format!("`--{k}` is not a parameter name"));
+        }
+        if matches!(k.as_str(), "t" | "axis" | "instruction") {
+            return Err(format!("`--{k}` is not a parameter of an instruction"));
+        }
+        let value = if v == "true" || v == "false" || v.parse::<f64>().is_ok_and(f64::is_finite) {
+            v.clone()
+        } else {
+            // `node/object` names a leader on its node.
+            let name = match v.split_once('/') {
+                Some((node, o)) if cell.node(node).is_some() => o,
+                _ => v.as_str(),
+            };
+            quote(name)
+        };
+        let _ = writeln!(src, "{k} = {value}");
+    }
+    let script = parse_cell("command", &src, cell).map_err(|e| e.message)?;
+    script
+        .entries
+        .into_iter()
+        .next()
+        .ok_or_else(|| format!("`{instruction}` was not understood"))
+}
+
+/// A command line: `<object> <instruction> [--param value | --param=value]...`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CommandLine {
+    /// The object, `object` or `node/object`.
+    pub object: String,
+    /// The instruction.
+    pub instruction: String,
+    /// Parameters in order (dashes in names become underscores).
+    pub params: Vec<(String, String)>,
+}
+
+/// Splits a command line into object, instruction and `--param value` pairs.
+pub fn split_command(text: &str) -> Result<CommandLine, String> {
+    let mut words = text.split_whitespace();
+    let object = words.next().ok_or("empty command")?.to_string();
+    let instruction = words
+        .next()
+        .ok_or_else(|| format!("`{object}`: no instruction given"))?
+        .to_string();
+    let mut params = Vec::new();
+    while let Some(w) = words.next() {
+        let Some(key) = w.strip_prefix("--") else {
+            return Err(format!("`{w}`: expected `--parameter value`"));
+        };
+        let (k, v) = match key.split_once('=') {
+            Some((k, v)) => (k.to_string(), v.to_string()),
+            None => (
+                key.to_string(),
+                words
+                    .next()
+                    .ok_or_else(|| format!("`--{key}` needs a value"))?
+                    .to_string(),
+            ),
+        };
+        params.push((k.replace('-', "_"), v));
+    }
+    Ok(CommandLine {
+        object,
+        instruction,
+        params,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
