@@ -1,4 +1,7 @@
-//! tandem-runtime: runs the engine. For now the deterministic simulator ([`sim`]): the
-//! configured axes of a cell on virtual time, driven by a script, traced to CSV.
+//! tandem-runtime: runs the engine. [`exec`] is the cyclic executive of one node (or of a whole
+//! cell), free of IO and clocks; [`sim`] drives it on virtual time from a script and traces it
+//! to CSV.
 
+pub mod exec;
+mod objects;
 pub mod sim;
