@@ -1,0 +1,131 @@
+//! The operating-system calls of the cyclic thread: the absolute-time sleep, real-time
+//! scheduling, CPU affinity, memory locking and the termination signals. Each is one libc call;
+//! this is the only module of tandem with `unsafe` code, and each block says why it is sound.
+#![allow(unsafe_code)]
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The cell clock: CLOCK_REALTIME in ns (PTP-disciplined on a real cell, design §4).
+pub fn now_ns() -> i64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; CLOCK_REALTIME always exists.
+    unsafe {
+        libc::clock_gettime(libc::CLOCK_REALTIME, &mut ts);
+    }
+    // time_t and c_long are i64 on the 64-bit Linux targets tandem runs on.
+    ts.tv_sec * 1_000_000_000 + ts.tv_nsec
+}
+
+/// Sleeps until the cell clock reads `t_ns` (absolute, so no drift accumulates). Returns early
+/// on a signal; the caller checks the time and the termination flag.
+pub fn sleep_until(t_ns: i64) {
+    let ts = libc::timespec {
+        tv_sec: t_ns.div_euclid(1_000_000_000) as libc::time_t,
+        tv_nsec: t_ns.rem_euclid(1_000_000_000) as libc::c_long,
+    };
+    // SAFETY: `ts` is a valid timespec; the remaining-time pointer may be null with
+    // TIMER_ABSTIME.
+    unsafe {
+        libc::clock_nanosleep(
+            libc::CLOCK_REALTIME,
+            libc::TIMER_ABSTIME,
+            &ts,
+            std::ptr::null_mut(),
+        );
+    }
+}
+
+fn errno_text() -> String {
+    std::io::Error::last_os_error().to_string()
+}
+
+/// Sets the calling thread's timer slack to 1 ns, so that an absolute sleep ends when asked
+/// (normal threads get 50 µs of slack by default; SCHED_FIFO threads have none).
+pub fn no_timer_slack() {
+    // SAFETY: PR_SET_TIMERSLACK takes one integer argument; the others are ignored.
+    unsafe {
+        libc::prctl(libc::PR_SET_TIMERSLACK, 1 as libc::c_ulong, 0, 0, 0);
+    }
+}
+
+/// Runs the calling thread under SCHED_FIFO at `priority` (1..=99).
+pub fn set_fifo(priority: u8) -> Result<(), String> {
+    let param = libc::sched_param {
+        sched_priority: i32::from(priority),
+    };
+    // SAFETY: `param` is a valid sched_param; pid 0 is the calling thread.
+    let r = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) };
+    if r == 0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "SCHED_FIFO priority {priority} not permitted ({}); the node runs with normal \
+             scheduling (run as root, or grant CAP_SYS_NICE or an rtprio limit)",
+            errno_text()
+        ))
+    }
+}
+
+/// Pins the calling thread to `cpu`.
+pub fn pin_to_cpu(cpu: usize) -> Result<(), String> {
+    // SAFETY: cpu_set_t is plain data; zeroed is the empty set, CPU_SET writes inside it (the
+    // index is checked against its size first).
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        if cpu >= 8 * std::mem::size_of::<libc::cpu_set_t>() {
+            return Err(format!("CPU {cpu} does not exist"));
+        }
+        libc::CPU_SET(cpu, &mut set);
+        if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
+            return Err(format!("cannot pin to CPU {cpu} ({})", errno_text()));
+        }
+    }
+    Ok(())
+}
+
+/// Locks the process' current and future memory (no page faults on the cyclic path).
+pub fn lock_memory() -> Result<(), String> {
+    // SAFETY: plain flags.
+    let r = unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) };
+    if r == 0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "cannot lock memory ({}); page faults may delay cycles (raise the memlock limit)",
+            errno_text()
+        ))
+    }
+}
+
+static TERMINATE: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    TERMINATE.store(true, Ordering::SeqCst);
+}
+
+/// Installs handlers for SIGINT and SIGTERM that set the flag [`termination_requested`] reads.
+pub fn install_termination_handler() {
+    let handler: extern "C" fn(libc::c_int) = on_signal;
+    // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+    unsafe {
+        libc::signal(libc::SIGINT, handler as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, handler as libc::sighandler_t);
+    }
+}
+
+/// Whether SIGINT or SIGTERM arrived.
+pub fn termination_requested() -> bool {
+    TERMINATE.load(Ordering::SeqCst)
+}
+
+/// The resident memory of this process (bytes), from /proc/self/statm.
+pub fn resident_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: u64 = s.split_whitespace().nth(1)?.parse().ok()?;
+    // SAFETY: sysconf has no preconditions.
+    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    Some(pages * u64::try_from(page).ok()?)
+}

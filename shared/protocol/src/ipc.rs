@@ -1,0 +1,178 @@
+//! Opening a cell's iceoryx2 services with the settings each needs. Creator and opener call
+//! the same function, so their settings always agree.
+//!
+//! Every publish-subscribe service overflows safely (the oldest sample is dropped, so a slow
+//! reader never blocks a writer, design §5).
+
+use crate::names;
+use crate::wire::{
+    AxisTelemetry, CommandReply, CommandRequest, Event, IoEvent, LeadingValueSample, NodeHealth,
+};
+use core::fmt;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{publish_subscribe, request_response};
+
+/// An iceoryx2 node of tandem.
+pub type IpcNode = Node<ipc::Service>;
+
+/// The leading-value service of one leader.
+pub type LeadingValueService = publish_subscribe::PortFactory<ipc::Service, LeadingValueSample, ()>;
+/// A node's telemetry service: a slice of axes with the node's health as header.
+pub type TelemetryService =
+    publish_subscribe::PortFactory<ipc::Service, [AxisTelemetry], NodeHealth>;
+/// A node's event service.
+pub type EventService = publish_subscribe::PortFactory<ipc::Service, Event, ()>;
+/// An object's output edges or measured values.
+pub type IoService = publish_subscribe::PortFactory<ipc::Service, IoEvent, ()>;
+/// A node's command service.
+pub type CommandService =
+    request_response::PortFactory<ipc::Service, CommandRequest, (), CommandReply, ()>;
+
+/// An iceoryx2 call that failed, with what was being done.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct IpcError {
+    /// What failed and why.
+    pub message: String,
+}
+
+impl fmt::Display for IpcError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for IpcError {}
+
+/// Wraps an iceoryx2 error with what was being done.
+pub fn ctx<T, E: fmt::Display>(r: Result<T, E>, what: impl fmt::Display) -> Result<T, IpcError> {
+    r.map_err(|e| IpcError {
+        message: format!("{what}: {e}"),
+    })
+}
+
+/// Creates an iceoryx2 node named `name`. Signals are left to the process (tandem handles
+/// SIGINT/SIGTERM itself).
+pub fn node(name: &str) -> Result<IpcNode, IpcError> {
+    // iceoryx2 warns on stdout that it runs on its default config: that is intended.
+    set_log_level(LogLevel::Error);
+    let node_name = ctx(NodeName::new(name), format_args!("node name `{name}`"))?;
+    ctx(
+        NodeBuilder::new()
+            .name(&node_name)
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>(),
+        format_args!("creating iceoryx2 node `{name}`"),
+    )
+}
+
+/// Removes what crashed processes left behind (their nodes' ports and services). Returns how
+/// many dead nodes were cleaned.
+pub fn cleanup_dead_nodes() -> usize {
+    let mut cleaned = 0;
+    let _ = Node::<ipc::Service>::list(Config::global_config(), |state| {
+        if let NodeState::Dead(view) = state {
+            if view.try_remove_stale_resources().is_ok() {
+                cleaned += 1;
+            }
+        }
+        CallbackProgression::Continue
+    });
+    cleaned
+}
+
+fn service_name(s: &str) -> Result<ServiceName, IpcError> {
+    ctx(ServiceName::new(s), format_args!("service name `{s}`"))
+}
+
+/// The leading values of `leader`, keeping `history` samples for late joiners and readers.
+pub fn leading_values(
+    node: &IpcNode,
+    cell: &str,
+    leader: &str,
+    actual: bool,
+    history: usize,
+) -> Result<LeadingValueService, IpcError> {
+    let name = names::leading_value(cell, leader, actual);
+    ctx(
+        node.service_builder(&service_name(&name)?)
+            .publish_subscribe::<LeadingValueSample>()
+            .history_size(history)
+            .subscriber_max_buffer_size(history)
+            .enable_safe_overflow(true)
+            .max_publishers(4)
+            .max_subscribers(32)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}
+
+/// The per-cycle telemetry snapshots of `node_name`.
+pub fn telemetry(
+    node: &IpcNode,
+    cell: &str,
+    node_name: &str,
+) -> Result<TelemetryService, IpcError> {
+    let name = names::telemetry(cell, node_name);
+    ctx(
+        node.service_builder(&service_name(&name)?)
+            .publish_subscribe::<[AxisTelemetry]>()
+            .user_header::<NodeHealth>()
+            .history_size(1)
+            .subscriber_max_buffer_size(64)
+            .enable_safe_overflow(true)
+            .max_publishers(4)
+            .max_subscribers(16)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}
+
+/// The job events and log lines of `node_name`.
+pub fn events(node: &IpcNode, cell: &str, node_name: &str) -> Result<EventService, IpcError> {
+    let name = names::events(cell, node_name);
+    ctx(
+        node.service_builder(&service_name(&name)?)
+            .publish_subscribe::<Event>()
+            .history_size(0)
+            .subscriber_max_buffer_size(1024)
+            .enable_safe_overflow(true)
+            .max_publishers(4)
+            .max_subscribers(16)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}
+
+/// The output edges or measured values of object `object`.
+pub fn io(node: &IpcNode, cell: &str, object: &str) -> Result<IoService, IpcError> {
+    let name = names::io(cell, object);
+    ctx(
+        node.service_builder(&service_name(&name)?)
+            .publish_subscribe::<IoEvent>()
+            .history_size(16)
+            .subscriber_max_buffer_size(256)
+            .enable_safe_overflow(true)
+            .max_publishers(4)
+            .max_subscribers(16)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}
+
+/// The command service of `node_name`.
+pub fn commands(node: &IpcNode, cell: &str, node_name: &str) -> Result<CommandService, IpcError> {
+    let name = names::commands(cell, node_name);
+    ctx(
+        node.service_builder(&service_name(&name)?)
+            .request_response::<CommandRequest, CommandReply>()
+            .max_clients(16)
+            .max_servers(2)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}

@@ -1,0 +1,38 @@
+//! Every service name of a cell. A cell's services live under `tandem/<cell>/`, so two cells on
+//! one host never meet.
+
+/// The leading values of `leader` (an axis or external encoder), for followers coupled by
+/// setpoint (or by `actual` value).
+pub fn leading_value(cell: &str, leader: &str, actual: bool) -> String {
+    if actual {
+        format!("tandem/{cell}/lv/{leader}/actual")
+    } else {
+        format!("tandem/{cell}/lv/{leader}")
+    }
+}
+
+/// Request-response: the instructions addressed to the objects of `node`.
+pub fn commands(cell: &str, node: &str) -> String {
+    format!("tandem/{cell}/node/{node}/cmd")
+}
+
+/// Publish-subscribe: one telemetry snapshot of `node` per cycle.
+pub fn telemetry(cell: &str, node: &str) -> String {
+    format!("tandem/{cell}/node/{node}/telemetry")
+}
+
+/// Publish-subscribe: job events and alarms of `node`, as they happen.
+pub fn events(cell: &str, node: &str) -> String {
+    format!("tandem/{cell}/node/{node}/events")
+}
+
+/// Publish-subscribe: the switching edges of an output cam or cam track, or the measured
+/// values of a measuring input, named `object`.
+pub fn io(cell: &str, object: &str) -> String {
+    format!("tandem/{cell}/io/{object}")
+}
+
+/// The iceoryx2 node name of a tandem node process.
+pub fn node(cell: &str, node: &str) -> String {
+    format!("tandem/{cell}/{node}")
+}

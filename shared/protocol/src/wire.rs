@@ -1,0 +1,348 @@
+//! The `#[repr(C)]` payloads of the iceoryx2 services (design §5). Each carries a type name with
+//! a version, so a process built from another version fails to open the service
+//! (`IncompatibleTypes`) instead of misreading it.
+
+use iceoryx2::prelude::ZeroCopySend;
+use tandem_motion::axis::{AxisState, AxisStatus};
+use tandem_motion::job::JobEventKind;
+use tandem_motion::leading::LeadingSample;
+use tandem_motion::modulo::Modulo;
+
+/// [`LeadingValueSample::status`] bit: the value is valid.
+pub const LV_VALID: u32 = 1;
+
+/// One leading value of a leader (design §4): at `t_ns` on the cell clock the leader was at
+/// (`p`, `v`, `a`). Positions are continuous; a modulo leader sends its modulo range with them.
+#[derive(Copy, Clone, Debug, PartialEq, ZeroCopySend)]
+#[type_name("tandem.LeadingValueSample.v1")]
+#[repr(C)]
+pub struct LeadingValueSample {
+    /// The time the value is valid for (ns, cell clock).
+    pub t_ns: i64,
+    /// Sequence number, +1 per leader cycle.
+    pub seq: u64,
+    /// Position (continuous).
+    pub p: f64,
+    /// Velocity.
+    pub v: f64,
+    /// Acceleration.
+    pub a: f64,
+    /// Modulo start (with `modulo_length > 0`).
+    pub modulo_start: f64,
+    /// Modulo length; 0: not a modulo leader.
+    pub modulo_length: f64,
+    /// Bits: [`LV_VALID`].
+    pub status: u32,
+    /// The leader's index in the cell (axes, then encoders).
+    pub leader: u32,
+}
+
+impl LeadingValueSample {
+    /// The wire form of an engine sample of leader `leader`.
+    pub fn from_sample(leader: u32, s: &LeadingSample) -> Self {
+        Self {
+            t_ns: s.t_ns,
+            seq: s.seq,
+            p: s.p,
+            v: s.v,
+            a: s.a,
+            modulo_start: s.modulo.map_or(0.0, |m| m.start),
+            modulo_length: s.modulo.map_or(0.0, |m| m.length),
+            status: if s.valid { LV_VALID } else { 0 },
+            leader,
+        }
+    }
+
+    /// The engine form.
+    pub fn to_sample(&self) -> LeadingSample {
+        LeadingSample {
+            t_ns: self.t_ns,
+            seq: self.seq,
+            p: self.p,
+            v: self.v,
+            a: self.a,
+            modulo: (self.modulo_length > 0.0).then_some(Modulo {
+                start: self.modulo_start,
+                length: self.modulo_length,
+            }),
+            valid: self.status & LV_VALID != 0,
+        }
+    }
+}
+
+/// Bytes of text a command or event carries.
+pub const TEXT_LEN: usize = 240;
+
+/// Fixed-size UTF-8 text (truncated at a character boundary).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ZeroCopySend)]
+#[type_name("tandem.Text.v1")]
+#[repr(C)]
+pub struct Text {
+    len: u32,
+    bytes: [u8; TEXT_LEN],
+}
+
+impl Default for Text {
+    fn default() -> Self {
+        Self {
+            len: 0,
+            bytes: [0; TEXT_LEN],
+        }
+    }
+}
+
+impl Text {
+    /// `s`, cut to [`TEXT_LEN`] bytes at a character boundary.
+    pub fn new(s: &str) -> Self {
+        let mut t = Self::default();
+        t.push(s);
+        t
+    }
+
+    /// Replaces the text (cut as in [`Text::new`]).
+    pub fn set(&mut self, s: &str) {
+        self.len = 0;
+        self.push(s);
+    }
+
+    /// Appends `s`, cut at [`TEXT_LEN`] bytes in all at a character boundary.
+    pub fn push(&mut self, s: &str) {
+        let at = (self.len as usize).min(TEXT_LEN);
+        let mut n = s.len().min(TEXT_LEN - at);
+        while !s.is_char_boundary(n) {
+            n -= 1;
+        }
+        self.bytes[at..at + n].copy_from_slice(&s.as_bytes()[..n]);
+        self.len = (at + n) as u32;
+    }
+
+    /// The text; empty if the bytes are not UTF-8 (a foreign writer).
+    pub fn as_str(&self) -> &str {
+        let n = (self.len as usize).min(TEXT_LEN);
+        core::str::from_utf8(&self.bytes[..n]).unwrap_or("")
+    }
+}
+
+/// A command for an object of a node: `<object> <instruction> [--param value]...`, parsed by
+/// the node with the script's instruction table.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ZeroCopySend)]
+#[type_name("tandem.CommandRequest.v1")]
+#[repr(C)]
+pub struct CommandRequest {
+    /// The command line.
+    pub text: Text,
+}
+
+/// [`CommandReply::outcome`]: accepted; an Execute-type instruction's job id is in `job`.
+pub const OUTCOME_ACCEPTED: u32 = 0;
+/// Rejected by the object with the ErrorID in `error_id`; its running job goes on.
+pub const OUTCOME_REJECTED: u32 = 1;
+/// Not understood (unknown object, instruction or parameter); `message` says what.
+pub const OUTCOME_INVALID: u32 = 2;
+/// The node's command queue is full; try again.
+pub const OUTCOME_BUSY: u32 = 3;
+
+/// The node's answer to a [`CommandRequest`], sent once the command was applied in a cycle.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ZeroCopySend)]
+#[type_name("tandem.CommandReply.v1")]
+#[repr(C)]
+pub struct CommandReply {
+    /// One of the `OUTCOME_*` values.
+    pub outcome: u32,
+    /// The job id (Execute-type instructions), else 0.
+    pub job: u32,
+    /// The ErrorID (`16#80xx`) with [`OUTCOME_REJECTED`].
+    pub error_id: u32,
+    /// The cycle time at which it was applied (ns).
+    pub t_ns: i64,
+    /// What went wrong, in words.
+    pub message: Text,
+}
+
+/// [`Event::kind`]: a line of the node's log (text only).
+pub const EVENT_LOG: u32 = 0;
+/// A job event: `object`, `job`, `code`, `error_id` are set, `message` describes it.
+pub const EVENT_JOB: u32 = 1;
+
+/// [`Event::code`] of a job event: the job ended with Done.
+pub const JOB_DONE: u32 = 1;
+/// The job was aborted by another.
+pub const JOB_ABORTED: u32 = 2;
+/// The job ended with an error (`error_id`).
+pub const JOB_ERROR: u32 = 3;
+/// Any other event of a running job (Busy, InVelocity, InSync, ...).
+pub const JOB_PROGRESS: u32 = 0;
+
+/// The code of a job event kind.
+pub fn job_code(kind: JobEventKind) -> (u32, u32) {
+    match kind {
+        JobEventKind::Done => (JOB_DONE, 0),
+        JobEventKind::CommandAborted => (JOB_ABORTED, 0),
+        JobEventKind::Error(e) => (JOB_ERROR, u32::from(e.code())),
+        _ => (JOB_PROGRESS, 0),
+    }
+}
+
+/// A job event or a log line of a node, as it happens.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ZeroCopySend)]
+#[type_name("tandem.Event.v1")]
+#[repr(C)]
+pub struct Event {
+    /// When (ns, cell clock).
+    pub t_ns: i64,
+    /// [`EVENT_LOG`] or [`EVENT_JOB`].
+    pub kind: u32,
+    /// The object (index in the cell's object names: axes, then encoders).
+    pub object: u32,
+    /// The job id.
+    pub job: u32,
+    /// `JOB_*`.
+    pub code: u32,
+    /// The ErrorID of a failed job.
+    pub error_id: u32,
+    /// The text.
+    pub message: Text,
+}
+
+/// The names of [`AxisState`] by [`state_code`].
+pub const STATE_NAMES: [&str; 8] = [
+    "Disabled",
+    "Standstill",
+    "Homing",
+    "DiscreteMotion",
+    "ContinuousMotion",
+    "SynchronizedMotion",
+    "Stopping",
+    "ErrorStop",
+];
+
+/// The code of a PLCopen state (index into [`STATE_NAMES`]).
+pub fn state_code(s: AxisState) -> u32 {
+    match s {
+        AxisState::Disabled => 0,
+        AxisState::Standstill => 1,
+        AxisState::Homing => 2,
+        AxisState::DiscreteMotion => 3,
+        AxisState::ContinuousMotion => 4,
+        AxisState::SynchronizedMotion => 5,
+        AxisState::Stopping => 6,
+        AxisState::ErrorStop => 7,
+    }
+}
+
+/// A node's health, the header of each telemetry snapshot.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
+#[type_name("tandem.NodeHealth.v1")]
+#[repr(C)]
+pub struct NodeHealth {
+    /// The cycle's time (ns, cell clock).
+    pub t_ns: i64,
+    /// Servo cycle (ns).
+    pub cycle_ns: i64,
+    /// Compute time of the previous cycle (ns).
+    pub compute_ns: i64,
+    /// Wake-up lateness of this cycle (ns).
+    pub lateness_ns: i64,
+    /// Largest compute time so far (ns).
+    pub max_compute_ns: i64,
+    /// Largest lateness so far (ns).
+    pub max_lateness_ns: i64,
+    /// Cycles whose compute ended after the next cycle's start.
+    pub overruns: u64,
+    /// Cycles run.
+    pub cycles: u64,
+    /// Leading-value samples received that the buffer refused or that arrived out of order.
+    pub samples_rejected: u64,
+    /// Process id.
+    pub pid: u32,
+    /// Axes in the snapshot.
+    pub axes: u32,
+}
+
+/// One axis in a telemetry snapshot.
+#[derive(Copy, Clone, Debug, Default, PartialEq, ZeroCopySend)]
+#[type_name("tandem.AxisTelemetry.v1")]
+#[repr(C)]
+pub struct AxisTelemetry {
+    /// The axis' index in the cell.
+    pub axis: u32,
+    /// [`state_code`].
+    pub state: u32,
+    /// `StatusWord`.
+    pub status_word: u32,
+    /// `ErrorWord`.
+    pub error_word: u32,
+    /// `WarningWord`.
+    pub warning_word: u32,
+    /// `ErrorDetail.Number`: the pending alarm, 0 for none.
+    pub alarm: u32,
+    /// `StatusSynchronizedMotion.FunctionState`: 0 none, 1 GearIn, 2 GearInPos, 3 CamIn.
+    pub sync_function: u32,
+    /// The running job's id (basic motion, else synchronous operation), 0 for none.
+    pub job: u32,
+    /// Setpoint position (modulo-reduced).
+    pub position: f64,
+    /// Setpoint velocity.
+    pub velocity: f64,
+    /// Setpoint acceleration.
+    pub acceleration: f64,
+    /// Setpoint position, continuous.
+    pub position_unwrapped: f64,
+    /// Actual position (modulo-reduced).
+    pub actual_position: f64,
+    /// Actual velocity.
+    pub actual_velocity: f64,
+    /// Following error.
+    pub following_error: f64,
+    /// Velocity override (%).
+    pub override_velocity: f64,
+}
+
+impl AxisTelemetry {
+    /// The telemetry of axis `axis` from its status.
+    pub fn from_status(axis: u32, s: &AxisStatus) -> Self {
+        Self {
+            axis,
+            state: state_code(s.state),
+            status_word: s.status_word,
+            error_word: s.error_word,
+            warning_word: s.warning_word,
+            alarm: u32::from(s.error_detail.number),
+            sync_function: u32::from(s.sync_function),
+            job: s.motion_job.or(s.sync_job).map_or(0, |(j, _)| j),
+            position: s.position,
+            velocity: s.velocity,
+            acceleration: s.acceleration,
+            position_unwrapped: s.position_unwrapped,
+            actual_position: s.actual_position,
+            actual_velocity: s.actual_velocity,
+            following_error: s.following_error,
+            override_velocity: s.override_velocity,
+        }
+    }
+
+    /// The PLCopen state name.
+    pub fn state_name(&self) -> &'static str {
+        STATE_NAMES.get(self.state as usize).copied().unwrap_or("?")
+    }
+}
+
+/// [`IoEvent::kind`]: an output switched on (`value` = 1) or off (0).
+pub const IO_OUTPUT: u32 = 0;
+/// A measured value (`value` = the position, `counter` its measurement counter).
+pub const IO_MEASURED: u32 = 1;
+
+/// An output edge of an output cam or cam track, or a measured value of a measuring input.
+#[derive(Copy, Clone, Debug, PartialEq, ZeroCopySend)]
+#[type_name("tandem.IoEvent.v1")]
+#[repr(C)]
+pub struct IoEvent {
+    /// The exact time of the edge (ns, cell clock).
+    pub t_ns: i64,
+    /// `IO_*`.
+    pub kind: u32,
+    /// The measurement counter, or the cam number of a cam track (1-based; 0 for an output cam).
+    pub counter: u32,
+    /// 1/0 for an output, the position for a measured value.
+    pub value: f64,
+}
