@@ -1,7 +1,13 @@
-//! The `tandem` command line: `sim` runs a cell on virtual time, `check` validates a cell file.
+//! The `tandem` command line: `up` starts and supervises a host's nodes, `status`, `watch` and
+//! `cmd` work on a running cell, `sim` runs a cell on virtual time, `check` validates a cell
+//! file.
 //!
-//! Exit codes: 0 success; 1 with `sim --strict`: the run finished but a command was rejected or
-//! an alarm is pending; 2 the input is wrong (usage, config or script error); 3 IO error.
+//! Exit codes: 0 success; 1 the command failed (`cmd`: rejected with an ErrorID, or the job
+//! ended in error or was aborted; `sim --strict`: a command was rejected or an alarm is
+//! pending); 2 the input is wrong (usage, config, script or command error); 3 the cell is not
+//! reachable (a node not running, a timeout) or an IO error of `sim`; 4 an iceoryx2 error.
+
+pub mod live;
 
 use clap::{Arg, ArgAction, Command};
 use std::ffi::OsString;
@@ -44,6 +50,69 @@ fn cli() -> Command {
                         .short('q')
                         .action(ArgAction::SetTrue)
                         .help("Do not print job events and alarms"),
+                ),
+        )
+        .subcommand(
+            Command::new("up")
+                .about("Start this host's nodes of a cell, supervise them (restart on a crash), stop them on Ctrl-C")
+                .arg(Arg::new("cell").required(true).value_parser(clap::value_parser!(PathBuf)))
+                .arg(Arg::new("host").long("host").help("The host whose nodes to start (default: the cell's only host)"))
+                .arg(
+                    Arg::new("script")
+                        .long("script")
+                        .value_parser(clap::value_parser!(PathBuf))
+                        .help("Script of timed instructions, applied by each node to its objects on the cell clock"),
+                )
+                .arg(
+                    Arg::new("record")
+                        .long("record")
+                        .value_parser(clap::value_parser!(PathBuf))
+                        .help("Directory for each node's CSV trace and log (<node>.csv, <node>.log)"),
+                )
+                .arg(
+                    Arg::new("duration")
+                        .long("duration")
+                        .value_parser(clap::value_parser!(f64))
+                        .help("Stop after this many seconds (default: the script's duration, else Ctrl-C)"),
+                )
+                .arg(
+                    Arg::new("no-view")
+                        .long("no-view")
+                        .action(ArgAction::SetTrue)
+                        .help("Print events as they happen instead of the live table"),
+                ),
+        )
+        .subcommand(
+            Command::new("status")
+                .about("One snapshot of the running nodes of this host: axes and node health")
+                .arg(cell_arg())
+                .arg(Arg::new("host").long("host")),
+        )
+        .subcommand(
+            Command::new("watch")
+                .about("Live table of the running axes, optionally filtered by a pattern (node/axis substring)")
+                .arg(cell_arg())
+                .arg(Arg::new("host").long("host"))
+                .arg(Arg::new("pattern"))
+                .arg(
+                    Arg::new("count")
+                        .long("count")
+                        .value_parser(clap::value_parser!(u64))
+                        .help("Stop after this many refreshes (4 per second)"),
+                ),
+        )
+        .subcommand(
+            Command::new("cmd")
+                .about("Send an instruction to an object of a running node: tandem cmd <node>/<object> <instruction> [--param value]... [--wait]")
+                .arg(cell_arg())
+                .arg(Arg::new("target").required(true).help("<node>/<object>"))
+                .arg(Arg::new("instruction").required(true).help("e.g. MC_MoveAbsolute, MoveVelocity, gear_in"))
+                .arg(
+                    Arg::new("params")
+                        .num_args(0..)
+                        .allow_hyphen_values(true)
+                        .trailing_var_arg(true)
+                        .help("--param value pairs (the script's parameter names); --wait follows the job; --timeout <s> (default 60)"),
                 ),
         )
         .subcommand(
@@ -99,7 +168,94 @@ pub fn run(args: Vec<OsString>, out: &mut impl Write, err: &mut impl Write) -> E
             }
         }
         Some(("sim", sub)) => sim(sub, out, err),
+        Some((name, sub)) => match running(name, sub, out) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(live::Fail(code, message)) => {
+                let _ = writeln!(err, "error: {message}");
+                ExitCode::from(code)
+            }
+        },
         _ => ExitCode::from(2),
+    }
+}
+
+fn cell_arg() -> Arg {
+    Arg::new("cell")
+        .long("cell")
+        .value_parser(clap::value_parser!(PathBuf))
+        .help("The cell file (default: $TANDEM_CELL)")
+}
+
+/// `up`, `status`, `watch`, `cmd`.
+fn running(name: &str, m: &clap::ArgMatches, out: &mut impl Write) -> Result<(), live::Fail> {
+    let host = m.get_one::<String>("host").map(String::as_str);
+    match name {
+        "up" => {
+            let cell = m
+                .get_one::<PathBuf>("cell")
+                .ok_or_else(|| live::Fail(2, "a cell file is required".into()))?;
+            let o = live::UpOptions {
+                host: host.map(str::to_string),
+                script: m.get_one::<PathBuf>("script").cloned(),
+                record: m.get_one::<PathBuf>("record").cloned(),
+                view: !m.get_flag("no-view")
+                    && std::io::IsTerminal::is_terminal(&std::io::stdout()),
+                duration_s: m.get_one::<f64>("duration").copied(),
+            };
+            live::up(cell, &o, out)
+        }
+        "status" => live::status(&live::cell_path(m.get_one::<PathBuf>("cell"))?, host, out),
+        "watch" => live::watch(
+            &live::cell_path(m.get_one::<PathBuf>("cell"))?,
+            host,
+            m.get_one::<String>("pattern").map(String::as_str),
+            m.get_one::<u64>("count").copied(),
+            out,
+        ),
+        "cmd" => {
+            let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
+            let target = m.get_one::<String>("target").cloned().unwrap_or_default();
+            let instruction = m
+                .get_one::<String>("instruction")
+                .cloned()
+                .unwrap_or_default();
+            let rest: Vec<String> = m
+                .get_many::<String>("params")
+                .map(|v| v.cloned().collect())
+                .unwrap_or_default();
+            let mut wait = false;
+            let mut timeout = std::time::Duration::from_secs(60);
+            let mut words = Vec::new();
+            let mut it = rest.into_iter();
+            while let Some(w) = it.next() {
+                match w.as_str() {
+                    "--wait" => wait = true,
+                    "--timeout" => {
+                        let v = it
+                            .next()
+                            .and_then(|x| x.parse::<f64>().ok())
+                            .filter(|x| *x > 0.0);
+                        timeout = std::time::Duration::from_secs_f64(v.ok_or_else(|| {
+                            live::Fail(2, "--timeout needs a number of seconds > 0".into())
+                        })?);
+                    }
+                    _ => words.push(w),
+                }
+            }
+            let line = format!("{target} {instruction} {}", words.join(" "));
+            let parsed =
+                tandem_config::script::split_command(&line).map_err(|m| live::Fail(2, m))?;
+            live::cmd(
+                &cell,
+                &target,
+                &instruction,
+                &parsed.params,
+                wait,
+                timeout,
+                out,
+            )
+        }
+        _ => Err(live::Fail(2, format!("unknown command `{name}`"))),
     }
 }
 

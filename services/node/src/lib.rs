@@ -433,6 +433,7 @@ fn cyclic(
     let mut log = LogRing::new();
     let mut report = Report::default();
     let mut health = NodeHealth {
+        epoch_ns: epoch,
         cycle_ns: cycle,
         pid: std::process::id(),
         axes: owned.len() as u32,
@@ -560,6 +561,7 @@ fn cyclic(
         health.lateness_ns = lateness;
         health.max_lateness_ns = health.max_lateness_ns.max(lateness);
         health.cycles += 1;
+        health.extrapolated = exec.extrapolated;
         let status = exec.status();
         if let Ok(mut sample) = telemetry.loan_slice_uninit(owned.len()) {
             *sample.user_header_mut() = health;
@@ -595,10 +597,12 @@ fn cyclic(
     report.wall_ns = rt::now_ns() - started;
     report.cpu_ns = cpu_time_ns() - cpu0;
     eprintln!(
-        "tandem-node {}: stopped after {} cycles ({} overruns); compute {}; lateness {}",
+        "tandem-node {}: stopped after {} cycles ({} overruns, {} leading values extrapolated); \
+         compute {}; lateness {}",
         me.name,
         report.cycles,
         report.overruns,
+        exec.extrapolated,
         report.compute.summary(),
         report.lateness.summary()
     );

@@ -129,3 +129,14 @@ pub fn resident_bytes() -> Option<u64> {
     let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
     Some(pages * u64::try_from(page).ok()?)
 }
+
+/// Sends `signal` (`libc::SIGTERM`, `libc::SIGKILL`...) to process `pid`.
+pub fn send_signal(pid: u32, signal: libc::c_int) -> Result<(), String> {
+    let pid = libc::pid_t::try_from(pid).map_err(|_| format!("no process {pid}"))?;
+    // SAFETY: kill has no memory preconditions; a wrong pid is an error return.
+    if unsafe { libc::kill(pid, signal) } == 0 {
+        Ok(())
+    } else {
+        Err(format!("cannot signal process {pid}: {}", errno_text()))
+    }
+}

@@ -68,6 +68,7 @@ pub fn node(name: &str) -> Result<IpcNode, IpcError> {
 /// Removes what crashed processes left behind (their nodes' ports and services). Returns how
 /// many dead nodes were cleaned.
 pub fn cleanup_dead_nodes() -> usize {
+    set_log_level(LogLevel::Error);
     let mut cleaned = 0;
     let _ = Node::<ipc::Service>::list(Config::global_config(), |state| {
         if let NodeState::Dead(view) = state {

@@ -170,15 +170,22 @@ pub const JOB_DONE: u32 = 1;
 pub const JOB_ABORTED: u32 = 2;
 /// The job ended with an error (`error_id`).
 pub const JOB_ERROR: u32 = 3;
-/// Any other event of a running job (Busy, InVelocity, InSync, ...).
+/// The job reached its goal and goes on: InVelocity, InGear, InSync, or an Enable-type
+/// instruction's `Status` TRUE.
+pub const JOB_REACHED: u32 = 4;
+/// Any other event of a running job (Busy, StartSync, EndOfProfile, ...).
 pub const JOB_PROGRESS: u32 = 0;
 
-/// The code of a job event kind.
+/// The code of a job event kind, and its ErrorID.
 pub fn job_code(kind: JobEventKind) -> (u32, u32) {
     match kind {
         JobEventKind::Done => (JOB_DONE, 0),
         JobEventKind::CommandAborted => (JOB_ABORTED, 0),
         JobEventKind::Error(e) => (JOB_ERROR, u32::from(e.code())),
+        JobEventKind::InVelocity
+        | JobEventKind::InGear
+        | JobEventKind::InSync
+        | JobEventKind::Status(true) => (JOB_REACHED, 0),
         _ => (JOB_PROGRESS, 0),
     }
 }
@@ -235,8 +242,10 @@ pub fn state_code(s: AxisState) -> u32 {
 #[type_name("tandem.NodeHealth.v1")]
 #[repr(C)]
 pub struct NodeHealth {
-    /// The cycle's time (ns, cell clock).
+    /// The cycle's engine time (ns); it runs on the cell clock at `epoch_ns + t_ns`.
     pub t_ns: i64,
+    /// The cell clock's time of engine time 0 (ns, CLOCK_REALTIME).
+    pub epoch_ns: i64,
     /// Servo cycle (ns).
     pub cycle_ns: i64,
     /// Compute time of the previous cycle (ns).
@@ -253,6 +262,8 @@ pub struct NodeHealth {
     pub cycles: u64,
     /// Leading-value samples received that the buffer refused or that arrived out of order.
     pub samples_rejected: u64,
+    /// Leading values bridged by extrapolation because a sample was late.
+    pub extrapolated: u64,
     /// Process id.
     pub pid: u32,
     /// Axes in the snapshot.

@@ -23,7 +23,7 @@ use tandem_motion::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::error_id::ErrorId;
 use tandem_motion::job::{Instruction, JobEventKind, JobId};
 use tandem_motion::leading::{
-    LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Rejected,
+    LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
 
 /// Formats ns as seconds with 9 decimals, exactly.
@@ -131,6 +131,10 @@ struct LeaderBuffer {
     tolerance_ns: i64,
     samples: Box<LeadingValueBuffer<LEADING_BUFFER>>,
     seq: u64,
+    /// Why the value is missing since the last lookup (logged once per outage).
+    missing: Option<Missing>,
+    /// The outage was logged.
+    logged: bool,
 }
 
 /// A job event of an axis or encoder, for the node to publish.
@@ -195,6 +199,8 @@ pub struct Executive<'c> {
     jobs: Vec<JobNote>,
     /// Notes dropped because more than [`NOTES`] came in one step.
     pub notes_dropped: u64,
+    /// Leading values bridged by extrapolation (a late sample).
+    pub extrapolated: u64,
     /// Commands applied and rejected (script, CLI and register corrections).
     pub commands: usize,
     /// Commands rejected with an ErrorID.
@@ -319,6 +325,8 @@ impl<'c> Executive<'c> {
                     tolerance_ns: lv.tolerance_ns,
                     samples,
                     seq: 0,
+                    missing: None,
+                    logged: false,
                 });
             }
         }
@@ -345,6 +353,7 @@ impl<'c> Executive<'c> {
             buffers,
             jobs: Vec::with_capacity(NOTES),
             notes_dropped: 0,
+            extrapolated: 0,
             commands: 0,
             rejected: 0,
         })
@@ -590,24 +599,77 @@ impl<'c> Executive<'c> {
     }
 
     /// The value follower `i` reads of leader `l` at time `t`.
-    fn leading_value(&self, i: usize, l: usize, t: i64) -> Option<LeadingValue> {
+    fn leading_value(&mut self, i: usize, l: usize, t: i64) -> Option<LeadingValue> {
         let coupling = if l >= self.axes.len() {
             Coupling::Setpoint
         } else {
             self.cell.coupling(i, l).unwrap_or(Coupling::Setpoint)
         };
+        let owned = self.owns_leader(l);
         match self
             .buffers
-            .iter()
+            .iter_mut()
             .find(|b| b.leader == l && b.coupling == coupling)
         {
             Some(b) => match b.samples.at(t - b.delay_ns, b.tolerance_ns) {
-                Lookup::Interpolated(v) | Lookup::Extrapolated { value: v, .. } => Some(v),
-                Lookup::Missing(_) => None,
+                Lookup::Interpolated(v) => {
+                    b.missing = None;
+                    b.logged = false;
+                    Some(v)
+                }
+                Lookup::Extrapolated { value, .. } => {
+                    b.missing = None;
+                    b.logged = false;
+                    self.extrapolated += 1;
+                    Some(value)
+                }
+                Lookup::Missing(m) => {
+                    b.missing = Some(m);
+                    None
+                }
             },
-            None if self.owns_leader(l) => self.direct(l, coupling),
+            None if owned => self.direct(l, coupling),
             None => None,
         }
+    }
+
+    /// Logs each leader whose value went missing this step, once per outage: which leader,
+    /// why, and the newest sample's time.
+    fn log_missing(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        let names = &self.cell.axes;
+        for b in self.buffers.iter_mut().filter(|b| !b.logged) {
+            let Some(m) = b.missing else {
+                continue;
+            };
+            b.logged = true;
+            let leader = match names.get(b.leader) {
+                Some(a) => a.name.as_str(),
+                None => self
+                    .cell
+                    .encoders
+                    .get(b.leader - names.len())
+                    .map_or("?", |e| e.name.as_str()),
+            };
+            let why = match m {
+                Missing::Empty => "no sample received yet".to_string(),
+                Missing::TooOld { oldest_ns } => {
+                    format!("t - D is before the oldest sample ({})", Secs(oldest_ns))
+                }
+                Missing::Late { newest_ns } => format!(
+                    "newest sample t={}, later than the tolerance {} ms allows",
+                    Secs(newest_ns),
+                    b.tolerance_ns as f64 * 1e-6
+                ),
+                Missing::Invalid => "the leader marks its value invalid".to_string(),
+            };
+            writeln!(
+                log,
+                "t={} leading value of {leader} missing at t - D = {}: {why}",
+                Secs(t),
+                Secs(t - b.delay_ns)
+            )?;
+        }
+        Ok(())
     }
 
     /// One step at time `t` (a multiple of [`Executive::tick_ns`]): encoders, then axes in
@@ -703,6 +765,7 @@ impl<'c> Executive<'c> {
             }
         }
         self.record_samples(t, false);
+        self.log_missing(t, log)?;
         for (i, axis) in self.axes.iter_mut().enumerate() {
             if !self.owned_axes[i] {
                 continue;
