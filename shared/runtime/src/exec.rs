@@ -650,24 +650,27 @@ impl<'c> Executive<'c> {
                     .get(b.leader - names.len())
                     .map_or("?", |e| e.name.as_str()),
             };
-            let why = match m {
-                Missing::Empty => "no sample received yet".to_string(),
-                Missing::TooOld { oldest_ns } => {
-                    format!("t - D is before the oldest sample ({})", Secs(oldest_ns))
-                }
-                Missing::Late { newest_ns } => format!(
-                    "newest sample t={}, later than the tolerance {} ms allows",
-                    Secs(newest_ns),
-                    b.tolerance_ns as f64 * 1e-6
-                ),
-                Missing::Invalid => "the leader marks its value invalid".to_string(),
-            };
-            writeln!(
+            write!(
                 log,
-                "t={} leading value of {leader} missing at t - D = {}: {why}",
+                "t={} leading value of {leader} missing at t - D = {}: ",
                 Secs(t),
                 Secs(t - b.delay_ns)
             )?;
+            match m {
+                Missing::Empty => writeln!(log, "no sample received yet")?,
+                Missing::TooOld { oldest_ns } => writeln!(
+                    log,
+                    "t - D is before the oldest sample ({})",
+                    Secs(oldest_ns)
+                )?,
+                Missing::Late { newest_ns } => writeln!(
+                    log,
+                    "newest sample t={}, later than the tolerance {} ms allows",
+                    Secs(newest_ns),
+                    b.tolerance_ns as f64 * 1e-6
+                )?,
+                Missing::Invalid => writeln!(log, "the leader marks its value invalid")?,
+            }
         }
         Ok(())
     }

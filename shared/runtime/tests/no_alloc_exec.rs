@@ -1,0 +1,80 @@
+//! The node's cyclic path does not allocate: the three executives of `config/line.toml` (a
+//! leader, geared followers reading it at t - D from their buffers, a cam follower with an
+//! output cam and a measuring input) step 6,000 cycles, exchanging leading values as the nodes
+//! do, with 0 allocations once the commands are applied.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+#[path = "../../motion/tests/common/counting.rs"]
+mod counting;
+use counting::{arm, disarm, Counting};
+use tandem_config::Coupling;
+use tandem_runtime::exec::Executive;
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn three_executives_step_without_allocating() {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let cell = tandem_config::load(&root.join("config/line.toml")).unwrap();
+    let src = std::fs::read_to_string(root.join("config/line-script.toml")).unwrap();
+    let script = tandem_config::script::parse_cell("line-script.toml", &src, &cell).unwrap();
+    let node = |n: &str| cell.node(n).unwrap();
+    let mut nodes: Vec<Executive> = ["leaders", "followers", "cutter"]
+        .iter()
+        .map(|n| Executive::new(&cell, Some(node(n))).unwrap())
+        .collect();
+    let line = cell.axes.iter().position(|a| a.name == "line").unwrap();
+    let mut log = std::io::sink();
+    let mut next = 0;
+    let mut allocations = 0;
+    let mut stepped = 0;
+    for k in 0..6000i64 {
+        let t = k * 1_000_000;
+        // Commands (which may allocate: a job takes its cam) between the counted steps.
+        while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
+            next += 1;
+            for x in nodes.iter_mut() {
+                let _ = x.apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log);
+            }
+        }
+        arm();
+        // From 5 s the leader's samples stop coming (its node died): the followers bridge
+        // the tolerance, log the outage, raise 601 and brake, still without allocating.
+        let alive = k < 5000;
+        if alive {
+            nodes[0].step(t, &mut log).unwrap();
+        }
+        let s = nodes[0].sample(line, Coupling::Setpoint, t, k as u64);
+        for x in nodes[1..].iter_mut() {
+            if alive {
+                x.feed(line, Coupling::Setpoint, s).unwrap();
+            }
+            x.step(t, &mut log).unwrap();
+        }
+        for x in nodes.iter_mut() {
+            x.drain_job_notes(|_| {});
+            x.drain_io_notes(|_| {});
+        }
+        allocations += disarm().0;
+        stepped += 1;
+    }
+    assert_eq!(stepped, 6000);
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    // It did work: the followers were coupled, bridged the outage for the tolerance (4 ms:
+    // three extrapolated cycles after the last sample), then stopped with 601.
+    let knife = cell.axes.iter().position(|a| a.name == "knife").unwrap();
+    let feed = cell.axes.iter().position(|a| a.name == "feed").unwrap();
+    for (n, a) in [(1, feed), (2, knife)] {
+        let st = nodes[n].status()[a];
+        assert_eq!(st.state.name(), "ErrorStop", "{}", cell.axes[a].name);
+        assert_eq!(st.error_detail.number, 601);
+        assert_eq!(st.velocity, 0.0);
+    }
+    assert_eq!(
+        nodes[1].extrapolated,
+        2 * 4,
+        "two followers, four cycles within 4 ms"
+    );
+    assert_eq!(nodes[2].extrapolated, 4);
+}
