@@ -106,7 +106,7 @@ impl Observer {
             let svc = ipc::telemetry(iox, &cell.name, name)?;
             let sub = svc
                 .subscriber_builder()
-                .buffer_size(8)
+                .buffer_size(4)
                 .create()
                 .map_err(|e| Fail(4, format!("telemetry of {name}: {e}")))?;
             telemetry.push((*n, sub));

@@ -316,6 +316,8 @@ fn parse_with(
         )
     })?;
     let mut entries = Vec::new();
+    // Line numbers by binary search over the newlines (a script may have thousands of entries).
+    let newlines: Vec<usize> = src.match_indices('\n').map(|(i, _)| i).collect();
     if let Some(at) = doc.get("at") {
         let tables = at.as_array_of_tables().ok_or_else(|| {
             e(
@@ -325,7 +327,9 @@ fn parse_with(
             )
         })?;
         for (i, t) in tables.iter().enumerate() {
-            let line = t.span().map(|s| line_at(src, s.start));
+            let line = t
+                .span()
+                .map(|s| newlines.partition_point(|&i| i < s.start) + 1);
             let key = format!("at[{i}]");
             let time = t
                 .get("t")

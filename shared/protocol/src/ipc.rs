@@ -120,10 +120,12 @@ pub fn telemetry(
             .publish_subscribe::<[AxisTelemetry]>()
             .user_header::<NodeHealth>()
             .history_size(1)
-            .subscriber_max_buffer_size(64)
+            // Observers want the newest snapshot: a few buffered ones are enough, and each
+            // one is a whole node (136 B per axis) in shared memory.
+            .subscriber_max_buffer_size(4)
             .enable_safe_overflow(true)
             .max_publishers(4)
-            .max_subscribers(16)
+            .max_subscribers(8)
             .max_nodes(32)
             .open_or_create(),
         format_args!("opening {name}"),

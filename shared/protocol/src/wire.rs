@@ -264,6 +264,8 @@ pub struct NodeHealth {
     pub samples_rejected: u64,
     /// Leading values bridged by extrapolation because a sample was late.
     pub extrapolated: u64,
+    /// Log lines and notes dropped because more than fit came in one cycle.
+    pub log_dropped: u64,
     /// Process id.
     pub pid: u32,
     /// Axes in the snapshot.
