@@ -9,6 +9,7 @@ pub mod script;
 
 use schema::{AxisSection, CellFile};
 use std::path::Path;
+use tandem_motion::alarm::Reaction;
 use tandem_motion::axis::{
     AxisConfig, AxisKind, EncoderType, FollowingErrorMonitoring, HomingConfig, HomingMark,
     MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
@@ -1422,7 +1423,21 @@ fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, FieldError> {
     };
     let dy = &a.dynamics;
     let hw = a.hw_limits.as_ref();
+    let leader_missing_reaction = match &a.leader_missing_reaction {
+        None => None,
+        Some(r) => Some(pick(
+            "leader_missing_reaction",
+            r,
+            &[
+                ("stop_current_dynamics", Reaction::StopCurrentDynamics),
+                ("stop_max_dynamics", Reaction::StopMaxDynamics),
+                ("emergency_stop", Reaction::EmergencyStop),
+                ("remove_enable", Reaction::RemoveEnable),
+            ],
+        )?),
+    };
     Ok(AxisConfig {
+        leader_missing_reaction,
         kind,
         motion_type,
         modulo: a.modulo.as_ref().map(|m| Modulo {

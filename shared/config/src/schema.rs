@@ -447,6 +447,9 @@ pub struct AxisSection {
     pub leaders: Option<BTreeMap<String, String>>,
     /// `[axes.<name>.leading_value]`: this axis as a leader.
     pub leading_value: Option<LeadingValueSection>,
+    /// The reaction to alarm 601 (leading value missing): `stop_current_dynamics`,
+    /// `stop_max_dynamics` (default, the table value), `emergency_stop`, `remove_enable`.
+    pub leader_missing_reaction: Option<String>,
 }
 
 /// `[axes.<name>.extrapolation]`.

@@ -646,12 +646,23 @@ pub struct AlarmInstance {
     pub id: AlarmId,
     /// Sub-cause; [`supplement::NONE`] if the alarm has none.
     pub supplement: u16,
+    /// The effective reaction: the table's, unless the configuration sets another (alarm 601).
+    pub reaction: Reaction,
 }
 
 impl AlarmInstance {
-    /// New instance.
+    /// New instance, with the table's reaction.
     pub const fn new(id: AlarmId, supplement: u16) -> Self {
-        Self { id, supplement }
+        Self {
+            id,
+            supplement,
+            reaction: id.reaction(),
+        }
+    }
+
+    /// The same alarm with a configured reaction.
+    pub const fn with_reaction(self, reaction: Reaction) -> Self {
+        Self { reaction, ..self }
     }
 
     /// The static description of the alarm.
@@ -705,7 +716,7 @@ impl ErrorDetail {
         match highest_priority(pending) {
             Some(a) => ErrorDetail {
                 number: a.id.number(),
-                reaction: a.id.reaction(),
+                reaction: a.reaction,
             },
             None => ErrorDetail::NONE,
         }

@@ -703,3 +703,85 @@ proptest! {
         prop_assert!(started);
     }
 }
+
+/// A missing leading value (a leader on another node that stopped publishing) is alarm 601 with
+/// the follower's configured reaction: by default the table's stop with maximum dynamics; a
+/// configured emergency stop brakes with the emergency deceleration; remove enable disables.
+/// Each reaction shows in ErrorDetail. The follower never jumps.
+#[test]
+fn a_missing_leading_value_raises_601_with_the_configured_reaction() {
+    use tandem_motion::alarm::Reaction;
+    for configured in [
+        None,
+        Some(Reaction::StopCurrentDynamics),
+        Some(Reaction::EmergencyStop),
+        Some(Reaction::RemoveEnable),
+    ] {
+        let mut cfg = AxisConfig::example(0.001);
+        cfg.leader_missing_reaction = configured;
+        let mut p = Pair::new(AxisConfig::example(0.001), cfg);
+        p.leader
+            .command(&Command::MoveVelocity {
+                dynamics: dynamics(200.0, 2000.0, 2000.0, 40000.0),
+                direction: VelocityDirection::Positive,
+                current: false,
+                position_controlled: true,
+            })
+            .unwrap();
+        p.step(10);
+        let g = p.f(gear_in(1, 1)).unwrap();
+        p.until(g, JobEventKind::InGear, 5000);
+        p.step(500);
+        let before = p.fs();
+        assert!((before.velocity - 200.0).abs() < 1e-9);
+        // The leading value is gone from now on.
+        let t = p.k * 1_000_000;
+        p.follower.set_leading_value(LEADER, None);
+        p.follower.step(t);
+        let s = p.fs();
+        let expected = configured.unwrap_or(Reaction::StopMaxDynamics);
+        assert_eq!(s.error_detail.number, AlarmId::LeaderMissing.number());
+        assert_eq!(s.error_detail.reaction, expected, "{configured:?}");
+        assert!(p
+            .follower
+            .alarms()
+            .any(|a| a.id == AlarmId::LeaderMissing && a.reaction == expected));
+        // No jump: the first cycle without the leader continues from the last state.
+        let step = s.position_unwrapped - before.position_unwrapped;
+        assert!(
+            (step - 0.2).abs() < 1e-3,
+            "{configured:?}: moved {step} in the first cycle without the leader"
+        );
+        match expected {
+            Reaction::RemoveEnable => {
+                assert_eq!(s.state, AxisState::ErrorStop);
+                assert!(!s.has(status_bit::ENABLE));
+            }
+            _ => {
+                assert_eq!(s.state, AxisState::ErrorStop);
+                // Braking: the deceleration of the reaction (max 5000, emergency 10000; the
+                // job's 2000 for the current dynamics), ramped up by the jerk where it has one.
+                let mut v = s.velocity;
+                let mut decel = 0.0f64;
+                for k in 0..400 {
+                    let t = (p.k + 1 + k) * 1_000_000;
+                    p.follower.set_leading_value(LEADER, None);
+                    p.follower.step(t);
+                    let now = p.fs();
+                    decel = decel.max((v - now.velocity) / 0.001);
+                    v = now.velocity;
+                }
+                assert_eq!(v, 0.0, "{expected:?}: braked to standstill");
+                let limit = match expected {
+                    Reaction::StopCurrentDynamics => 2000.0,
+                    Reaction::StopMaxDynamics => 5000.0,
+                    _ => 10000.0,
+                };
+                assert!(
+                    decel <= limit * (1.0 + 1e-6) && decel > 0.5 * limit,
+                    "{expected:?}: deceleration {decel}, limit {limit}"
+                );
+            }
+        }
+    }
+}

@@ -806,7 +806,7 @@ impl<'c> Executive<'c> {
                         cell.axes[i].name,
                         a.id,
                         a.supplement,
-                        a.id.reaction(),
+                        a.reaction,
                         a.spec().text
                     )?;
                 }

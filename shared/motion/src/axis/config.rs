@@ -204,6 +204,10 @@ pub struct AxisConfig {
     /// `Extrapolation.*`: how this axis' actual value is prepared when a follower couples to it
     /// by actual value.
     pub extrapolation: ExtrapolationConfig,
+    /// The reaction to alarm 601 when a leading value is missing (a leader on another node that
+    /// stopped publishing): stop with the current or the maximum dynamics (default, the table
+    /// value), emergency stop, or remove the enable. `None`: the table value.
+    pub leader_missing_reaction: Option<crate::alarm::Reaction>,
 }
 
 /// A configuration value that is not acceptable: which field, and why.
@@ -304,12 +308,22 @@ impl AxisConfig {
             plant: Plant::default(),
             initial_position: 0.0,
             extrapolation: ExtrapolationConfig::default(),
+            leader_missing_reaction: None,
         }
     }
 
     /// Checks every value; the first problem found is returned with the key that has it.
     pub fn validate(&self) -> Result<(), ConfigError> {
         positive("cycle", self.cycle)?;
+        if matches!(
+            self.leader_missing_reaction,
+            Some(crate::alarm::Reaction::None | crate::alarm::Reaction::TrackSetpoints)
+        ) {
+            return Err(ConfigError {
+                field: "leader_missing_reaction",
+                problem: "a follower without its leading value must stop: stop_current_dynamics, stop_max_dynamics, emergency_stop or remove_enable",
+            });
+        }
         positive("dynamics.max_velocity", self.limits.max_velocity)?;
         positive("dynamics.max_acceleration", self.limits.max_acceleration)?;
         positive("dynamics.max_deceleration", self.limits.max_deceleration)?;

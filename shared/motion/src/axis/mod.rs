@@ -515,7 +515,7 @@ impl Axis {
     }
 
     fn stopping_alarm_pending(&self) -> bool {
-        self.alarms().any(|a| a.id.reaction() != Reaction::None)
+        self.alarms().any(|a| a.reaction != Reaction::None)
     }
 
     fn warn_clamped(&mut self, c: Clamped) {
@@ -671,10 +671,13 @@ impl Axis {
         if self.alarms().any(|a| a.id == id && a.supplement == supp) {
             return;
         }
+        let reaction = match (id, self.config().leader_missing_reaction) {
+            (AlarmId::LeaderMissing, Some(r)) => r,
+            _ => id.reaction(),
+        };
         if let Some(slot) = self.alarms.iter_mut().find(|a| a.is_none()) {
-            *slot = Some(AlarmInstance::new(id, supp));
+            *slot = Some(AlarmInstance::new(id, supp).with_reaction(reaction));
         }
-        let reaction = id.reaction();
         if reaction == Reaction::None {
             return;
         }
@@ -1126,7 +1129,7 @@ impl Axis {
                 disabling: false,
             };
             self.emit(self.power.job, Instruction::Power, JobEventKind::Busy);
-            if !self.alarms().any(|a| a.id.reaction().removes_enable()) {
+            if !self.alarms().any(|a| a.reaction.removes_enable()) {
                 self.enable_now();
             }
         } else if !enable && self.power.enable {
@@ -1191,9 +1194,7 @@ impl Axis {
             }
         }
         // Automatic re-enable after acknowledgement while Enable is still held.
-        if self.power.enable
-            && !self.enabled
-            && !self.alarms().any(|a| a.id.reaction().removes_enable())
+        if self.power.enable && !self.enabled && !self.alarms().any(|a| a.reaction.removes_enable())
         {
             self.enable_now();
         }

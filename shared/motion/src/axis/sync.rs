@@ -704,6 +704,18 @@ impl Axis {
             return;
         };
         let Some(lv) = self.lead[0] else {
+            // No setpoint was computed for this cycle: continue the last cycle's motion by
+            // one cycle, so the alarm reaction brakes from where the follower is now (the
+            // position and its velocity stay consistent; nothing jumps).
+            if self.goal == Goal::Sync {
+                let dt = self.cfg.cycle;
+                let b = self.basic;
+                self.basic = State {
+                    p: b.p + dt * (b.v + 0.5 * dt * b.a),
+                    v: b.v + dt * b.a,
+                    a: b.a,
+                };
+            }
             self.raise(AlarmId::LeaderMissing, supplement::NONE);
             return;
         };
