@@ -391,6 +391,32 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
         assert!(o.status.success(), "{}", text(&o));
         assert!(text(&o).contains("InVelocity"), "{}", text(&o));
 
+        // The live table, filtered: the feed's row only.
+        let w = run(
+            {
+                let mut c = tandem();
+                c.arg("watch")
+                    .arg("--cell")
+                    .arg(&cell)
+                    .arg("--count")
+                    .arg("1")
+                    .arg("feed");
+                c
+            },
+            Duration::from_secs(10),
+        );
+        assert!(w.status.success(), "{}", text(&w));
+        let table = text(&w);
+        assert_eq!(
+            row(&table, "feed").get(2).map(String::as_str),
+            Some("SynchronizedMotion"),
+            "{table}"
+        );
+        assert!(
+            row(&table, "line").is_empty() && row(&table, "unwind").is_empty(),
+            "{table}"
+        );
+
         // A bad command: rejected with its ErrorID, the gearing goes on.
         let before = row(&text(&status(&cell)), "feed");
         let o = cmd(
