@@ -150,6 +150,29 @@ fn edges(log: &str, object: &str) -> Vec<(i64, bool)> {
         .collect()
 }
 
+/// Starts `tandem up` on `cell`, recording into `rec`, without the live view; the second value
+/// collects its output.
+fn up(cell: &Path, rec: &Path, extra: &[&str]) -> (Child, std::thread::JoinHandle<String>) {
+    let mut child = tandem()
+        .arg("up")
+        .arg(cell)
+        .arg("--record")
+        .arg(rec)
+        .arg("--no-view")
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = child.stdout.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = out.read_to_string(&mut s);
+        s
+    });
+    (child, reader)
+}
+
 /// Three processes on a 1 ms cycle for 7 s: over the 6.5 s after synchronization every follower
 /// setpoint is its coupling law applied to the leader at `t - D` within 1e-6, the whole run
 /// equals `tandem sim` of the same cell and script, and the glue valve's edges agree with the
@@ -163,24 +186,7 @@ fn three_processes_follow_the_leader_at_t_minus_d_like_the_simulator() {
     let src = std::fs::read_to_string(root().join("config/line-script.toml")).unwrap();
     std::fs::write(&script, src.replace("duration = 6.0", "duration = 7.0")).unwrap();
     let rec = dir.join("rec");
-    let mut up = tandem()
-        .arg("up")
-        .arg(&cell)
-        .arg("--script")
-        .arg(&script)
-        .arg("--record")
-        .arg(&rec)
-        .arg("--no-view")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut up_out = up.stdout.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = up_out.read_to_string(&mut s);
-        s
-    });
+    let (mut up, reader) = up(&cell, &rec, &["--script", script.to_str().unwrap()]);
     let status = wait_for(&mut up, Duration::from_secs(60), "tandem up");
     let up_log = reader.join().unwrap();
     assert!(status.success(), "tandem up failed: {status}\n{up_log}");
@@ -307,6 +313,18 @@ fn cmd(cell: &Path, args: &[&str]) -> Output {
     run(c, Duration::from_secs(30))
 }
 
+/// Gears the feed to the line and waits for InGear.
+fn gear_feed(cell: &Path) -> Output {
+    let args = [
+        "followers/feed",
+        "MC_GearIn",
+        "--master",
+        "leaders/line",
+        "--wait",
+    ];
+    cmd(cell, &args)
+}
+
 fn status(cell: &Path) -> Output {
     let mut c = tandem();
     c.arg("status").arg("--cell").arg(cell);
@@ -340,24 +358,7 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
     let dir = tmp("kill");
     let cell = cell(&dir, &format!("kill{}", std::process::id()));
     let rec = dir.join("rec");
-    let mut up = tandem()
-        .arg("up")
-        .arg(&cell)
-        .arg("--record")
-        .arg(&rec)
-        .arg("--no-view")
-        .arg("--duration")
-        .arg("120")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut up_out = up.stdout.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = up_out.read_to_string(&mut s);
-        s
-    });
+    let (mut up, reader) = up(&cell, &rec, &["--duration", "120"]);
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         until(Duration::from_secs(20), "all three nodes up", || {
             status(&cell).status.success()
@@ -366,16 +367,7 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
             let o = cmd(&cell, &[target, "MC_Power", "--wait"]);
             assert!(o.status.success(), "{target} MC_Power: {}", text(&o));
         }
-        let o = cmd(
-            &cell,
-            &[
-                "followers/feed",
-                "MC_GearIn",
-                "--master",
-                "leaders/line",
-                "--wait",
-            ],
-        );
+        let o = gear_feed(&cell);
         assert!(o.status.success(), "{}", text(&o));
         assert!(text(&o).contains("InGear"), "{}", text(&o));
         let o = cmd(
@@ -483,16 +475,7 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
             let o = cmd(&cell, &[target, instr, "--wait"]);
             assert!(o.status.success(), "{target} {instr}: {}", text(&o));
         }
-        let o = cmd(
-            &cell,
-            &[
-                "followers/feed",
-                "MC_GearIn",
-                "--master",
-                "leaders/line",
-                "--wait",
-            ],
-        );
+        let o = gear_feed(&cell);
         assert!(o.status.success(), "{}", text(&o));
         let o = cmd(
             &cell,

@@ -85,6 +85,28 @@ fn service_name(s: &str) -> Result<ServiceName, IpcError> {
     ctx(ServiceName::new(s), format_args!("service name `{s}`"))
 }
 
+/// A publish-subscribe service of `T` named `name`: `history` samples for late joiners,
+/// subscriber buffers up to `buffer`, safe overflow.
+fn pubsub<T: core::fmt::Debug + ZeroCopySend>(
+    node: &IpcNode,
+    name: &str,
+    history: usize,
+    buffer: usize,
+) -> Result<publish_subscribe::PortFactory<ipc::Service, T, ()>, IpcError> {
+    ctx(
+        node.service_builder(&service_name(name)?)
+            .publish_subscribe::<T>()
+            .history_size(history)
+            .subscriber_max_buffer_size(buffer)
+            .enable_safe_overflow(true)
+            .max_publishers(4)
+            .max_subscribers(32)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}
+
 /// The leading values of `leader`, keeping `history` samples for late joiners and readers.
 pub fn leading_values(
     node: &IpcNode,
@@ -93,18 +115,11 @@ pub fn leading_values(
     actual: bool,
     history: usize,
 ) -> Result<LeadingValueService, IpcError> {
-    let name = names::leading_value(cell, leader, actual);
-    ctx(
-        node.service_builder(&service_name(&name)?)
-            .publish_subscribe::<LeadingValueSample>()
-            .history_size(history)
-            .subscriber_max_buffer_size(history)
-            .enable_safe_overflow(true)
-            .max_publishers(4)
-            .max_subscribers(32)
-            .max_nodes(32)
-            .open_or_create(),
-        format_args!("opening {name}"),
+    pubsub(
+        node,
+        &names::leading_value(cell, leader, actual),
+        history,
+        history,
     )
 }
 
@@ -134,36 +149,12 @@ pub fn telemetry(
 
 /// The job events and log lines of `node_name`.
 pub fn events(node: &IpcNode, cell: &str, node_name: &str) -> Result<EventService, IpcError> {
-    let name = names::events(cell, node_name);
-    ctx(
-        node.service_builder(&service_name(&name)?)
-            .publish_subscribe::<Event>()
-            .history_size(0)
-            .subscriber_max_buffer_size(1024)
-            .enable_safe_overflow(true)
-            .max_publishers(4)
-            .max_subscribers(16)
-            .max_nodes(32)
-            .open_or_create(),
-        format_args!("opening {name}"),
-    )
+    pubsub(node, &names::events(cell, node_name), 0, 1024)
 }
 
 /// The output edges or measured values of object `object`.
 pub fn io(node: &IpcNode, cell: &str, object: &str) -> Result<IoService, IpcError> {
-    let name = names::io(cell, object);
-    ctx(
-        node.service_builder(&service_name(&name)?)
-            .publish_subscribe::<IoEvent>()
-            .history_size(16)
-            .subscriber_max_buffer_size(256)
-            .enable_safe_overflow(true)
-            .max_publishers(4)
-            .max_subscribers(16)
-            .max_nodes(32)
-            .open_or_create(),
-        format_args!("opening {name}"),
-    )
+    pubsub(node, &names::io(cell, object), 16, 256)
 }
 
 /// The command service of `node_name`.

@@ -21,7 +21,7 @@ use tandem_motion::axis::{Axis, AxisStatus, CamId, Command};
 use tandem_motion::cam::{Cam, CamDefinition};
 use tandem_motion::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{Instruction, JobEventKind, JobId};
+use tandem_motion::job::{Instruction, JobEvent, JobEventKind, JobId};
 use tandem_motion::leading::{
     LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
@@ -120,6 +120,36 @@ fn recursive(axes: &[Axis], owned: &[bool], follower: usize, leader: usize) -> b
         }
     }
     false
+}
+
+/// Keeps a job event of `object` as a note (unless the step already has [`NOTES`]) and logs it.
+fn job_event(
+    jobs: &mut Vec<JobNote>,
+    dropped: &mut u64,
+    log: &mut impl Write,
+    name: &str,
+    object: usize,
+    ev: JobEvent,
+) -> io::Result<()> {
+    if jobs.len() < NOTES {
+        jobs.push(JobNote {
+            t_ns: ev.time_ns,
+            object,
+            job: ev.job,
+            instruction: ev.instruction,
+            kind: ev.kind,
+        });
+    } else {
+        *dropped += 1;
+    }
+    writeln!(
+        log,
+        "t={} {name} {} job {}: {}",
+        Secs(ev.time_ns),
+        ev.instruction.name(),
+        ev.job,
+        Describe(ev.kind)
+    )
 }
 
 /// The samples of one leader (in one coupling) that followers read at `t - D`.
@@ -481,10 +511,12 @@ impl<'c> Executive<'c> {
         action: Action,
         log: &mut impl Write,
     ) -> io::Result<Applied> {
-        self.apply_timed(t, t, target, instruction, action, log)
+        self.apply_at(t, t, target, instruction, action, log)
     }
 
-    fn apply_timed(
+    /// Applies an action whose own time `at_ns` differs from the step time `t` (an input
+    /// edge between two steps); otherwise as [`Executive::apply`].
+    pub fn apply_at(
         &mut self,
         t: i64,
         at_ns: i64,
@@ -514,20 +546,6 @@ impl<'c> Executive<'c> {
             }
         }
         Ok(result)
-    }
-
-    /// Applies an action whose own time `at_ns` differs from the step time `t` (an input
-    /// edge between two steps); otherwise as [`Executive::apply`].
-    pub fn apply_at(
-        &mut self,
-        t: i64,
-        at_ns: i64,
-        target: &str,
-        instruction: &str,
-        action: Action,
-        log: &mut impl Write,
-    ) -> io::Result<Applied> {
-        self.apply_timed(t, at_ns, target, instruction, action, log)
     }
 
     fn apply_inner(&mut self, t: i64, target: &str, action: Action) -> Applied {
@@ -702,25 +720,14 @@ impl<'c> Executive<'c> {
             };
             enc.step(t, p, v);
             while let Some(ev) = enc.pop_event() {
-                if self.jobs.len() < NOTES {
-                    self.jobs.push(JobNote {
-                        t_ns: ev.time_ns,
-                        object: n_axes + k,
-                        job: ev.job,
-                        instruction: ev.instruction,
-                        kind: ev.kind,
-                    });
-                } else {
-                    self.notes_dropped += 1;
-                }
-                writeln!(
+                let name = &cell.encoders[k].name;
+                job_event(
+                    &mut self.jobs,
+                    &mut self.notes_dropped,
                     log,
-                    "t={} {} {} job {}: {}",
-                    Secs(ev.time_ns),
-                    cell.encoders[k].name,
-                    ev.instruction.name(),
-                    ev.job,
-                    Describe(ev.kind)
+                    name,
+                    n_axes + k,
+                    ev,
                 )?;
             }
             self.encoder_status[k] = *enc.status();
@@ -774,26 +781,8 @@ impl<'c> Executive<'c> {
                 continue;
             }
             while let Some(ev) = axis.pop_event() {
-                if self.jobs.len() < NOTES {
-                    self.jobs.push(JobNote {
-                        t_ns: ev.time_ns,
-                        object: i,
-                        job: ev.job,
-                        instruction: ev.instruction,
-                        kind: ev.kind,
-                    });
-                } else {
-                    self.notes_dropped += 1;
-                }
-                writeln!(
-                    log,
-                    "t={} {} {} job {}: {}",
-                    Secs(ev.time_ns),
-                    cell.axes[i].name,
-                    ev.instruction.name(),
-                    ev.job,
-                    Describe(ev.kind)
-                )?;
+                let name = &cell.axes[i].name;
+                job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
             }
             let mut now = [(0u16, 0u16); 8];
             for (slot, a) in now.iter_mut().zip(axis.alarms()) {

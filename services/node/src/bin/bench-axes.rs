@@ -446,9 +446,9 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         trace: None,
         log: with_log.then(|| log_path.clone()),
     };
-    let steal0 = cpu_and_steal();
+    let steal0 = rt::cpu_and_steal();
     let result = tandem_node::run(&options);
-    let steal = steal_percent(steal0, cpu_and_steal());
+    let steal = rt::steal_percent(steal0, rt::cpu_and_steal());
     stop.store(true, Ordering::SeqCst);
     let seen = watcher
         .join()
@@ -638,32 +638,6 @@ fn print_table(outcomes: &[Outcome], seconds: f64, with_log: bool) {
         core::mem::size_of::<tandem_motion::axis::AxisStatus>(),
         256 * core::mem::size_of::<tandem_motion::axis::AxisStatus>() / 1024
     );
-}
-
-/// The machine's CPU time and the part of it stolen by the hypervisor (jiffies, all CPUs),
-/// from the `cpu` line of /proc/stat.
-fn cpu_and_steal() -> (u64, u64) {
-    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-    let f: Vec<u64> = stat
-        .lines()
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .skip(1)
-        .take(8)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    (f.iter().sum(), f.get(7).copied().unwrap_or(0))
-}
-
-/// Steal in % of the machine's CPU time between two [`cpu_and_steal`] readings.
-fn steal_percent(a: (u64, u64), b: (u64, u64)) -> f64 {
-    let total = b.0.saturating_sub(a.0);
-    if total == 0 {
-        0.0
-    } else {
-        100.0 * b.1.saturating_sub(a.1) as f64 / total as f64
-    }
 }
 
 fn main() -> ExitCode {

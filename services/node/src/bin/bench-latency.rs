@@ -596,32 +596,6 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// The machine's CPU time and the part of it stolen by the hypervisor (jiffies, all CPUs),
-/// from the `cpu` line of /proc/stat.
-fn cpu_and_steal() -> (u64, u64) {
-    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-    let f: Vec<u64> = stat
-        .lines()
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .skip(1)
-        .take(8)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    (f.iter().sum(), f.get(7).copied().unwrap_or(0))
-}
-
-/// Steal in % of the machine's CPU time between two [`cpu_and_steal`] readings.
-fn steal_percent(a: (u64, u64), b: (u64, u64)) -> f64 {
-    let total = b.0.saturating_sub(a.0);
-    if total == 0 {
-        0.0
-    } else {
-        100.0 * b.1.saturating_sub(a.1) as f64 / total as f64
-    }
-}
-
 fn main() -> ExitCode {
     let m = Command::new("tandem-bench-latency")
         .about(
@@ -714,7 +688,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
     // Per round: p50 of each row (µs).
     let mut p50s: Vec<Vec<f64>> = rows.iter().map(|_| Vec::new()).collect();
     let started = Instant::now();
-    let steal0 = cpu_and_steal();
+    let steal0 = rt::cpu_and_steal();
     let mut floors = Vec::new();
     for r in 0..rounds {
         floors.push(cache_line_floor(200_000));
@@ -726,10 +700,10 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
             };
             for path in order {
                 let n = if mode == Mode::Busy { busy_n } else { period_n };
-                let st = cpu_and_steal();
+                let st = rt::cpu_and_steal();
                 let x = measure(path, mode, n, &tag)
                     .map_err(|e| format!("{} {}: {e}", path.name(), mode.name()))?;
-                let st = steal_percent(st, cpu_and_steal());
+                let st = rt::steal_percent(st, rt::cpu_and_steal());
                 let i = rows
                     .iter()
                     .position(|row| *row == (path, mode))
@@ -756,7 +730,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
         }
     }
     let elapsed = started.elapsed();
-    let steal = steal_percent(steal0, cpu_and_steal());
+    let steal = rt::steal_percent(steal0, rt::cpu_and_steal());
 
     println!();
     println!(
