@@ -2,7 +2,8 @@
 # The test command of README: sets up what the tests need on a fresh machine, then runs them.
 #  1. Python oracles: installs the pinned `ruckig` and `pyplcopen` packages and regenerates the
 #     committed fixtures into temp files; they must match byte for byte (the oracles are real).
-#  2. All Rust tests of the workspace, in release (proptest and the simulator run faster).
+#  2. All binaries (the process tests run `tandem up`, which starts `tandem-node` from beside
+#     itself), then all Rust tests of the workspace, in release.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,4 +23,5 @@ if ! cmp -s "$tmp/cam_laws.csv" shared/motion/tests/fixtures/cam_laws.csv; then
 fi
 echo "pyplcopen cam law fixtures: reproduced exactly"
 
+cargo build --workspace --release --locked --bins
 cargo test --workspace --release --locked "$@"

@@ -153,6 +153,12 @@ fn edges(log: &str, object: &str) -> Vec<(i64, bool)> {
 /// Starts `tandem up` on `cell`, recording into `rec`, without the live view; the second value
 /// collects its output.
 fn up(cell: &Path, rec: &Path, extra: &[&str]) -> (Child, std::thread::JoinHandle<String>) {
+    let node = Path::new(env!("CARGO_BIN_EXE_tandem")).with_file_name("tandem-node");
+    assert!(
+        node.exists(),
+        "{} is missing: build it first (cargo build --release --bins, as tests/run.sh does)",
+        node.display()
+    );
     let mut child = tandem()
         .arg("up")
         .arg(cell)
@@ -165,10 +171,16 @@ fn up(cell: &Path, rec: &Path, extra: &[&str]) -> (Child, std::thread::JoinHandl
         .spawn()
         .unwrap();
     let mut out = child.stdout.take().unwrap();
+    let mut err = child.stderr.take().unwrap();
     let reader = std::thread::spawn(move || {
+        let errors = std::thread::spawn(move || {
+            let mut s = String::new();
+            let _ = err.read_to_string(&mut s);
+            s
+        });
         let mut s = String::new();
         let _ = out.read_to_string(&mut s);
-        s
+        s + &errors.join().unwrap_or_default()
     });
     (child, reader)
 }
