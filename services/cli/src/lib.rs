@@ -80,6 +80,12 @@ fn cli() -> Command {
                         .long("no-view")
                         .action(ArgAction::SetTrue)
                         .help("Print events as they happen instead of the live table"),
+                )
+                .arg(
+                    Arg::new("no-gateway")
+                        .long("no-gateway")
+                        .action(ArgAction::SetTrue)
+                        .help("Do not start the host's gateway (no Zenoh: nothing crosses to other hosts or observers)"),
                 ),
         )
         .subcommand(
@@ -201,6 +207,7 @@ fn running(name: &str, m: &clap::ArgMatches, out: &mut impl Write) -> Result<(),
                 view: !m.get_flag("no-view")
                     && std::io::IsTerminal::is_terminal(&std::io::stdout()),
                 duration_s: m.get_one::<f64>("duration").copied(),
+                gateway: !m.get_flag("no-gateway"),
             };
             live::up(cell, &o, out)
         }

@@ -53,7 +53,7 @@ pub fn cell_path(given: Option<&PathBuf>) -> Result<PathBuf, Fail> {
 }
 
 /// The nodes of `host` (by name; the only host when `None`).
-fn host_nodes(cell: &Cell, host: Option<&str>) -> Result<Vec<usize>, Fail> {
+fn host_nodes(cell: &Cell, host: Option<&str>) -> Result<(String, Vec<usize>), Fail> {
     let h = match host {
         Some(h) => cell.hosts.iter().position(|x| x == h).ok_or_else(|| {
             Fail(
@@ -77,17 +77,18 @@ fn host_nodes(cell: &Cell, host: Option<&str>) -> Result<Vec<usize>, Fail> {
             ))
         }
     };
-    Ok((0..cell.nodes.len())
+    let nodes = (0..cell.nodes.len())
         .filter(|n| cell.nodes[*n].host == h)
-        .collect())
+        .collect();
+    Ok((cell.hosts[h].clone(), nodes))
 }
 
-fn cli_node(cell: &Cell, what: &str) -> Result<IpcNode, Fail> {
-    Ok(ipc::node(&format!(
-        "tandem/{}/{what}-{}",
-        cell.name,
-        std::process::id()
-    ))?)
+/// An iceoryx2 node of this command in the domain of `host`.
+fn cli_node(cell: &Cell, what: &str, host: &str) -> Result<IpcNode, Fail> {
+    Ok(ipc::node(
+        &format!("tandem/{}/{what}-{}", cell.name, std::process::id()),
+        host,
+    )?)
 }
 
 /// What an observer holds of the cell's nodes.
@@ -232,8 +233,8 @@ fn render(cell: &Cell, obs: &Observer, nodes: &[usize], pattern: Option<&str>) -
 /// `tandem status`: one snapshot of the host's nodes. Exit 0 when every node runs, 3 if not.
 pub fn status(cell_path: &Path, host: Option<&str>, out: &mut impl Write) -> Result<(), Fail> {
     let cell = load(cell_path)?;
-    let nodes = host_nodes(&cell, host)?;
-    let iox = cli_node(&cell, "status")?;
+    let (host, nodes) = host_nodes(&cell, host)?;
+    let iox = cli_node(&cell, "status", &host)?;
     let mut obs = Observer::new(&iox, &cell, &nodes, false)?;
     let deadline = Instant::now() + Duration::from_millis(1500);
     while Instant::now() < deadline && !nodes.iter().all(|n| obs.alive(*n)) {
@@ -269,8 +270,8 @@ pub fn watch(
     out: &mut impl Write,
 ) -> Result<(), Fail> {
     let cell = load(cell_path)?;
-    let nodes = host_nodes(&cell, host)?;
-    let iox = cli_node(&cell, "watch")?;
+    let (host, nodes) = host_nodes(&cell, host)?;
+    let iox = cli_node(&cell, "watch", &host)?;
     let mut obs = Observer::new(&iox, &cell, &nodes, false)?;
     rt::install_termination_handler();
     let mut shown = 0u64;
@@ -324,7 +325,7 @@ pub fn cmd(
     for (k, v) in params {
         text.push_str(&format!(" --{k} {v}"));
     }
-    let iox = cli_node(&cell, "cmd")?;
+    let iox = cli_node(&cell, "cmd", &cell.hosts[cell.nodes[n].host])?;
     let events = if wait {
         let svc = ipc::events(&iox, &cell.name, node)?;
         Some(
@@ -449,9 +450,12 @@ pub fn cmd(
     ))
 }
 
-/// A node process of `up`, with its restart state.
+/// A process of `up` (a node, or the host's gateway), with its restart state.
 struct Slot {
-    node: usize,
+    /// The node, or `None` for the gateway.
+    node: Option<usize>,
+    /// What `up` calls it in its messages.
+    name: String,
     child: Option<Child>,
     restarts: u32,
     backoff: Duration,
@@ -460,13 +464,14 @@ struct Slot {
     finished: bool,
 }
 
-/// Where `tandem-node` is: beside this executable, else on PATH.
-fn node_binary() -> PathBuf {
+/// Where a tandem program (`tandem-node`, `tandem-gateway`) is: beside this executable, else on
+/// PATH.
+fn binary(name: &str) -> PathBuf {
     std::env::current_exe()
         .ok()
-        .and_then(|p| p.parent().map(|d| d.join("tandem-node")))
+        .and_then(|p| p.parent().map(|d| d.join(name)))
         .filter(|p| p.exists())
-        .unwrap_or_else(|| PathBuf::from("tandem-node"))
+        .unwrap_or_else(|| PathBuf::from(name))
 }
 
 /// How `up` runs.
@@ -482,21 +487,28 @@ pub struct UpOptions {
     pub view: bool,
     /// Stop after this many seconds of engine time.
     pub duration_s: Option<f64>,
+    /// Start the host's gateway (Zenoh) too.
+    pub gateway: bool,
 }
 
 fn spawn(
     cell_path: &Path,
     cell: &Cell,
     slot: &Slot,
-    epoch: i64,
+    (host, epoch): (&str, i64),
     o: &UpOptions,
-    lines: &mpsc::Sender<(usize, String)>,
+    lines: &mpsc::Sender<(String, String)>,
 ) -> std::io::Result<Child> {
-    let name = &cell.nodes[slot.node].name;
-    let mut c = std::process::Command::new(node_binary());
+    let name = &slot.name;
+    let Some(node) = slot.node else {
+        let mut c = std::process::Command::new(binary("tandem-gateway"));
+        c.arg(cell_path).arg("--host").arg(host);
+        return start(c, name, lines);
+    };
+    let mut c = std::process::Command::new(binary("tandem-node"));
     c.arg(cell_path)
         .arg("--node")
-        .arg(name)
+        .arg(&cell.nodes[node].name)
         .arg("--epoch-ns")
         .arg(epoch.to_string());
     if let Some(s) = &o.script {
@@ -516,18 +528,27 @@ fn spawn(
             .arg("--log")
             .arg(dir.join(format!("{name}{suffix}.log")));
     }
+    start(c, name, lines)
+}
+
+/// Starts a program of the set, its stderr lines going to `lines` under `name`.
+fn start(
+    mut c: std::process::Command,
+    name: &str,
+    lines: &mpsc::Sender<(String, String)>,
+) -> std::io::Result<Child> {
     c.stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
     let mut child = c.spawn()?;
     if let Some(stderr) = child.stderr.take() {
-        let (tx, n) = (lines.clone(), slot.node);
+        let (tx, n) = (lines.clone(), name.to_string());
         std::thread::spawn(move || {
             for line in std::io::BufReader::new(stderr)
                 .lines()
                 .map_while(Result::ok)
             {
-                if tx.send((n, line)).is_err() {
+                if tx.send((n.clone(), line)).is_err() {
                     break;
                 }
             }
@@ -549,7 +570,7 @@ fn describe_exit(s: std::process::ExitStatus) -> String {
 /// SIGINT/SIGTERM, and shows the live table or the events.
 pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), Fail> {
     let cell = load(cell_path)?;
-    let nodes = host_nodes(&cell, o.host.as_deref())?;
+    let (host, nodes) = host_nodes(&cell, o.host.as_deref())?;
     if nodes.is_empty() {
         return Err(Fail(2, "this host has no nodes".into()));
     }
@@ -563,16 +584,17 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
         std::fs::create_dir_all(d).map_err(|e| Fail(2, format!("{}: {e}", d.display())))?;
     }
     rt::install_termination_handler();
-    let removed = ipc::cleanup_dead_nodes();
-    let iox = cli_node(&cell, "up")?;
+    let removed = ipc::cleanup_dead_nodes(&host);
+    let iox = cli_node(&cell, "up", &host)?;
     let mut obs = Observer::new(&iox, &cell, &nodes, true)?;
     // Cycle 0 of every node at the next whole second plus one: all start on one grid.
     let epoch = (rt::now_ns() / 1_000_000_000 + 2) * 1_000_000_000;
-    let (tx, rx) = mpsc::channel::<(usize, String)>();
+    let (tx, rx) = mpsc::channel::<(String, String)>();
     let mut slots: Vec<Slot> = nodes
         .iter()
         .map(|n| Slot {
-            node: *n,
+            node: Some(*n),
+            name: cell.nodes[*n].name.clone(),
             child: None,
             restarts: 0,
             backoff: Duration::from_millis(500),
@@ -581,6 +603,18 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
             finished: false,
         })
         .collect();
+    if o.gateway {
+        slots.push(Slot {
+            node: None,
+            name: format!("gateway {host}"),
+            child: None,
+            restarts: 0,
+            backoff: Duration::from_millis(500),
+            start_at: Some(Instant::now()),
+            started: Instant::now(),
+            finished: false,
+        });
+    }
     let _ = writeln!(
         out,
         "tandem up: cell `{}`, {} node(s) on this host: {}{}",
@@ -615,7 +649,7 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
             break;
         }
         for slot in slots.iter_mut() {
-            let name = cell.nodes[slot.node].name.clone();
+            let name = slot.name.clone();
             if let Some(child) = slot.child.as_mut() {
                 if let Ok(Some(status)) = child.try_wait() {
                     slot.child = None;
@@ -626,7 +660,7 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
                         fatal = Some(Fail(
                             2,
                             format!(
-                                "node `{name}` refused its configuration ({})",
+                                "`{name}` refused its configuration ({})",
                                 describe_exit(status)
                             ),
                         ));
@@ -652,7 +686,7 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
             } else if let Some(at) = slot.start_at.filter(|at| Instant::now() >= *at) {
                 let _ = at;
                 slot.start_at = None;
-                match spawn(cell_path, &cell, slot, epoch, o, &tx) {
+                match spawn(cell_path, &cell, slot, (&host, epoch), o, &tx) {
                     Ok(c) => {
                         say(
                             &mut messages,
@@ -672,21 +706,13 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
                         slot.started = Instant::now();
                     }
                     Err(e) => {
-                        fatal = Some(Fail(
-                            4,
-                            format!("cannot start {}: {e}", node_binary().display()),
-                        ));
+                        fatal = Some(Fail(4, format!("cannot start {name}: {e}")));
                     }
                 }
             }
         }
         while let Ok((n, line)) = rx.try_recv() {
-            say(
-                &mut messages,
-                out,
-                o.view,
-                format!("[{}] {line}", cell.nodes[n].name),
-            );
+            say(&mut messages, out, o.view, format!("[{n}] {line}"));
         }
         for (n, e) in obs.events() {
             if e.kind == EVENT_LOG {
@@ -708,7 +734,12 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
             }
             let _ = out.flush();
         }
-        if slots.iter().all(|s| s.finished) {
+        // Done when every node finished (its script or duration ended); the gateway serves them.
+        if slots
+            .iter()
+            .filter(|s| s.node.is_some())
+            .all(|s| s.finished)
+        {
             break;
         }
         std::thread::sleep(Duration::from_millis(20));
@@ -739,7 +770,7 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
     }
     std::thread::sleep(Duration::from_millis(50));
     while let Ok((n, line)) = rx.try_recv() {
-        let _ = writeln!(out, "[{}] {line}", cell.nodes[n].name);
+        let _ = writeln!(out, "[{n}] {line}");
     }
     let _ = writeln!(out, "tandem up: all nodes stopped");
     match fatal {

@@ -236,7 +236,8 @@ pub fn run(o: &Options) -> Result<Report, String> {
             eprintln!("tandem-node {}: warning: {w}", o.node);
         }
     }
-    let cleaned = ipc::cleanup_dead_nodes();
+    let host = &cell.hosts[cell.nodes[n].host];
+    let cleaned = ipc::cleanup_dead_nodes(host);
     if cleaned > 0 {
         eprintln!(
             "tandem-node {}: removed the resources of {cleaned} crashed process(es)",
@@ -319,7 +320,8 @@ fn cyclic(
     pool: Pool<'_>,
 ) -> Result<Report, String> {
     let me = &cell.nodes[n];
-    let iox = ipc::node(&names::node(&cell.name, &me.name)).map_err(|e| e.to_string())?;
+    let host = &cell.hosts[me.host];
+    let iox = ipc::node(&names::node(&cell.name, &me.name), host).map_err(|e| e.to_string())?;
     let mut exec = Executive::new(cell, Some(n)).map_err(|e| e.to_string())?;
     let history = |l: usize| {
         let lv = cell.leading[l];
@@ -375,6 +377,17 @@ fn cyclic(
             .map_err(|e| format!("subscriber for {}: {e}", names_of[l]))?;
         subscribe.push((l, c, s));
     }
+    // A gateway waits on this event to forward the leading values at once.
+    let published = if publish.is_empty() {
+        None
+    } else {
+        let svc = ipc::published(&iox, &cell.name, &me.name).map_err(|e| e.to_string())?;
+        Some(
+            svc.notifier_builder()
+                .create()
+                .map_err(|e| format!("published notifier: {e}"))?,
+        )
+    };
     let telemetry = ipc::telemetry(&iox, &cell.name, &me.name).map_err(|e| e.to_string())?;
     let telemetry = telemetry
         .publisher_builder()
@@ -530,6 +543,9 @@ fn cyclic(
             *seq += 1;
             let _ = p.send_copy(LeadingValueSample::from_sample(*l as u32, &s));
         }
+        if let Some(n) = &published {
+            let _ = n.notify();
+        }
         exec.drain_io_notes(|x| {
             if let Some(Some(p)) = io_pubs.get(x.object) {
                 let _ = p.send_copy(IoEvent {
@@ -681,7 +697,10 @@ fn command_thread(
     done_rx: &Receiver<Done>,
 ) {
     let run = || -> Result<(), String> {
-        let iox: IpcNode = ipc::node(&format!("{}/commands", names::node(&cell.name, node)))
+        let host = cell
+            .node(node)
+            .map_or("local", |n| cell.hosts[cell.nodes[n].host].as_str());
+        let iox: IpcNode = ipc::node(&format!("{}/commands", names::node(&cell.name, node)), host)
             .map_err(|e| e.to_string())?;
         let service = ipc::commands(&iox, &cell.name, node).map_err(|e| e.to_string())?;
         let server = service
@@ -776,8 +795,14 @@ fn recorder_thread(
             }
             let _ = writeln!(w);
         }
-        let iox = ipc::node(&format!("{}/recorder", names::node(&cell.name, &o.node)))
-            .map_err(|e| e.to_string())?;
+        let host = cell
+            .node(&o.node)
+            .map_or("local", |n| cell.hosts[cell.nodes[n].host].as_str());
+        let iox = ipc::node(
+            &format!("{}/recorder", names::node(&cell.name, &o.node)),
+            host,
+        )
+        .map_err(|e| e.to_string())?;
         let events = ipc::events(&iox, &cell.name, &o.node).map_err(|e| e.to_string())?;
         let sub = events
             .subscriber_builder()

@@ -274,6 +274,12 @@ pub struct Cell {
     pub network_budget_ns: i64,
     /// Host names (`local` when the file has no `[[hosts]]`).
     pub hosts: Vec<String>,
+    /// Per host: the Zenoh endpoints its gateway listens on.
+    pub host_listen: Vec<Vec<String>>,
+    /// Telemetry rate of the gateways (Hz).
+    pub telemetry_hz: f64,
+    /// Clock-offset warning threshold, as a share of the smallest cross-host delay.
+    pub clock_warning_fraction: f64,
     /// Nodes.
     pub nodes: Vec<Node>,
     /// Axes, in name order.
@@ -373,6 +379,14 @@ impl Cell {
     }
 }
 
+/// A name that can stand in a file name, an iceoryx2 service name and a Zenoh key expression.
+fn plain_name(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= 64
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
 /// Finds the 1-based line of `key` in table `index` of the array of tables `array` (or of the
 /// table itself when `key` is empty), best effort.
 pub fn locate_in_array(src: &str, array: &str, index: usize, key: &str) -> Option<usize> {
@@ -447,9 +461,24 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         ));
     }
     let base = raw.cell.base_tick_us;
+    if !(raw.cell.telemetry_hz.is_finite()
+        && raw.cell.telemetry_hz > 0.0
+        && raw.cell.telemetry_hz <= 1000.0)
+    {
+        return Err(err(
+            &["cell", "telemetry_hz"],
+            "must be a rate in Hz, above 0 and at most 1000".into(),
+        ));
+    }
+    if !(raw.cell.clock_warning_fraction > 0.0 && raw.cell.clock_warning_fraction <= 1.0) {
+        return Err(err(
+            &["cell", "clock_warning_fraction"],
+            "must be a share above 0 and at most 1".into(),
+        ));
+    }
     let mut hosts: Vec<String> = Vec::new();
     for (i, h) in raw.hosts.iter().enumerate() {
-        if hosts.contains(&h.name) || h.name.is_empty() || h.name.contains('/') {
+        if hosts.contains(&h.name) || !plain_name(&h.name) {
             return Err(ConfigError {
                 file: file.into(),
                 line: locate_in_array(src, "hosts", i, "name"),
@@ -470,10 +499,13 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
             key: format!("nodes[{i}].{key}"),
             message,
         };
-        if n.name.is_empty() || n.name.contains('/') {
+        if !plain_name(&n.name) {
             return Err(at(
                 "name",
-                format!("`{}`: a node name must be non-empty, without `/`", n.name),
+                format!(
+                    "`{}`: a node name is a plain name (letters, digits, `_`, `-`; it names services and keys)",
+                    n.name
+                ),
             ));
         }
         let host = match &n.host {
@@ -760,6 +792,13 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         base_tick_ns: base as i64 * 1000,
         ipc_budget_ns: raw.cell.ipc_budget_us as i64 * 1000,
         network_budget_ns: raw.cell.network_budget_us as i64 * 1000,
+        host_listen: if raw.hosts.is_empty() {
+            vec![Vec::new()]
+        } else {
+            raw.hosts.iter().map(|h| h.listen.clone()).collect()
+        },
+        telemetry_hz: raw.cell.telemetry_hz,
+        clock_warning_fraction: raw.cell.clock_warning_fraction,
         hosts,
         leading,
         nodes,

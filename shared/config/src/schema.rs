@@ -327,6 +327,21 @@ pub struct CellSection {
     /// The same between nodes of different hosts (gateway, Zenoh, network), in µs.
     #[serde(default = "default_network_budget_us")]
     pub network_budget_us: u64,
+    /// Telemetry rate of the gateways on Zenoh (per TO state), in Hz.
+    #[serde(default = "default_telemetry_hz")]
+    pub telemetry_hz: f64,
+    /// The gateway warns when the clock offset to another host exceeds this share of the
+    /// smallest leading-value delay of a coupling between them.
+    #[serde(default = "default_clock_warning")]
+    pub clock_warning_fraction: f64,
+}
+
+fn default_telemetry_hz() -> f64 {
+    50.0
+}
+
+fn default_clock_warning() -> f64 {
+    0.25
 }
 
 fn default_network_budget_us() -> u64 {
@@ -343,6 +358,10 @@ fn default_ipc_budget_us() -> u64 {
 pub struct HostSection {
     /// Host name (`tandem up --host <name>`).
     pub name: String,
+    /// Zenoh endpoints its gateway listens on (`tcp/10.0.0.1:7447`); the other hosts' gateways
+    /// connect to them. Empty: multicast scouting finds the peers.
+    #[serde(default)]
+    pub listen: Vec<String>,
 }
 
 /// `[nodes.realtime]`: scheduling of the node's cyclic thread.

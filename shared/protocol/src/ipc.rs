@@ -28,6 +28,9 @@ pub type IoService = publish_subscribe::PortFactory<ipc::Service, IoEvent, ()>;
 pub type CommandService =
     request_response::PortFactory<ipc::Service, CommandRequest, (), CommandReply, ()>;
 
+/// A node's "leading values published" event service.
+pub type PublishedEvent = iceoryx2::service::port_factory::event::PortFactory<ipc::Service>;
+
 /// An iceoryx2 call that failed, with what was being done.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct IpcError {
@@ -50,14 +53,27 @@ pub fn ctx<T, E: fmt::Display>(r: Result<T, E>, what: impl fmt::Display) -> Resu
     })
 }
 
-/// Creates an iceoryx2 node named `name`. Signals are left to the process (tandem handles
-/// SIGINT/SIGTERM itself).
-pub fn node(name: &str) -> Result<IpcNode, IpcError> {
+/// The iceoryx2 configuration of host `host`'s domain ([`names::domain`]).
+pub fn config(host: &str) -> Result<Config, IpcError> {
     // iceoryx2 warns on stdout that it runs on its default config: that is intended.
     set_log_level(LogLevel::Error);
+    let mut c = Config::global_config().clone();
+    let domain = names::domain(host);
+    c.global.prefix = ctx(
+        FileName::new(domain.as_bytes()),
+        format_args!("iceoryx2 domain `{domain}`"),
+    )?;
+    Ok(c)
+}
+
+/// Creates an iceoryx2 node named `name` in the domain of host `host`. Signals are left to the
+/// process (tandem handles SIGINT/SIGTERM itself).
+pub fn node(name: &str, host: &str) -> Result<IpcNode, IpcError> {
+    let config = config(host)?;
     let node_name = ctx(NodeName::new(name), format_args!("node name `{name}`"))?;
     ctx(
         NodeBuilder::new()
+            .config(&config)
             .name(&node_name)
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>(),
@@ -65,12 +81,14 @@ pub fn node(name: &str) -> Result<IpcNode, IpcError> {
     )
 }
 
-/// Removes what crashed processes left behind (their nodes' ports and services). Returns how
-/// many dead nodes were cleaned.
-pub fn cleanup_dead_nodes() -> usize {
-    set_log_level(LogLevel::Error);
+/// Removes what crashed processes of host `host` left behind (their nodes' ports and services).
+/// Returns how many dead nodes were cleaned.
+pub fn cleanup_dead_nodes(host: &str) -> usize {
+    let Ok(config) = config(host) else {
+        return 0;
+    };
     let mut cleaned = 0;
-    let _ = Node::<ipc::Service>::list(Config::global_config(), |state| {
+    let _ = Node::<ipc::Service>::list(&config, |state| {
         if let NodeState::Dead(view) = state {
             if view.try_remove_stale_resources().is_ok() {
                 cleaned += 1;
@@ -165,6 +183,20 @@ pub fn commands(node: &IpcNode, cell: &str, node_name: &str) -> Result<CommandSe
             .request_response::<CommandRequest, CommandReply>()
             .max_clients(16)
             .max_servers(2)
+            .max_nodes(32)
+            .open_or_create(),
+        format_args!("opening {name}"),
+    )
+}
+
+/// The event `node_name` notifies once per cycle after publishing its leading values.
+pub fn published(node: &IpcNode, cell: &str, node_name: &str) -> Result<PublishedEvent, IpcError> {
+    let name = names::published(cell, node_name);
+    ctx(
+        node.service_builder(&service_name(&name)?)
+            .event()
+            .max_notifiers(4)
+            .max_listeners(8)
             .max_nodes(32)
             .open_or_create(),
         format_args!("opening {name}"),

@@ -11,6 +11,12 @@ pub fn leading_value(cell: &str, leader: &str, actual: bool) -> String {
     }
 }
 
+/// Event: `node` published its leading values of a cycle (one notification per cycle), so a
+/// gateway forwards them at once instead of polling.
+pub fn published(cell: &str, node: &str) -> String {
+    format!("tandem/{cell}/node/{node}/published")
+}
+
 /// Request-response: the instructions addressed to the objects of `node`.
 pub fn commands(cell: &str, node: &str) -> String {
     format!("tandem/{cell}/node/{node}/cmd")
@@ -30,6 +36,13 @@ pub fn events(cell: &str, node: &str) -> String {
 /// values of a measuring input, named `object`.
 pub fn io(cell: &str, object: &str) -> String {
     format!("tandem/{cell}/io/{object}")
+}
+
+/// The iceoryx2 domain of host `host`: the prefix of every file its processes create. Each host
+/// of a cell is a domain of its own, so two "hosts" on one machine (network namespaces share
+/// /dev/shm) never see each other's services: leading values cross only through the gateways.
+pub fn domain(host: &str) -> String {
+    format!("tandem_{host}_")
 }
 
 /// The iceoryx2 node name of a tandem node process.

@@ -314,7 +314,8 @@ fn watch(
     stop: &AtomicBool,
 ) -> Result<Seen, String> {
     let setup = || -> Result<_, String> {
-        let node = tipc::node(&format!("tandem/{cell}/bench-watch")).map_err(|e| e.to_string())?;
+        let node = tipc::node(&format!("tandem/{cell}/bench-watch"), "local")
+            .map_err(|e| e.to_string())?;
         let service = tipc::telemetry(&node, cell, "bench").map_err(|e| e.to_string())?;
         let sub = service
             .subscriber_builder()

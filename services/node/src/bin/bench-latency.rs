@@ -157,7 +157,7 @@ struct Tandem {
 impl Tandem {
     fn open(ping: bool) -> Result<Self, String> {
         let me = if ping { "ping" } else { "pong" };
-        let node = tipc::node(&format!("tandem/bench/{me}")).map_err(|e| e.to_string())?;
+        let node = tipc::node(&format!("tandem/bench/{me}"), "bench").map_err(|e| e.to_string())?;
         let lv = |leader: &str| {
             tipc::leading_values(&node, "bench", leader, false, HISTORY).map_err(|e| e.to_string())
         };
@@ -668,7 +668,7 @@ fn main() -> ExitCode {
 }
 
 fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
-    let cleaned = tipc::cleanup_dead_nodes();
+    let cleaned = tipc::cleanup_dead_nodes("bench");
     if cleaned > 0 {
         eprintln!("tandem-bench-latency: removed the resources of {cleaned} crashed process(es)");
     }

@@ -1,0 +1,723 @@
+//! tandem-gateway: one per host, the bridge between the host's iceoryx2 domain and Zenoh
+//! (design §5).
+//!
+//! - **Leading values out**: for each leader of this host that a follower on another host
+//!   follows, every sample its node publishes is put on `tandem/<cell>/lv/<leader>` (binary,
+//!   `Priority::RealTime`, express, drop on congestion). The gateway wakes on the node's
+//!   "published" event, so a sample leaves within microseconds of its cycle.
+//! - **Leading values in**: for each leader on another host that a follower here follows, the
+//!   Zenoh samples are published into this host's iceoryx2 leading-value service, so the
+//!   follower's node reads a remote leader exactly as a local one. The sample keeps its own
+//!   timestamp.
+//! - **Commands**: a queryable per node (`tandem/<cell>/<node>/*/cmd`) forwards each query to
+//!   the node's command service and replies with the job id or the ErrorID (JSON).
+//! - **Telemetry**: per axis state as JSON at `cell.telemetry_hz`, node health, job events and
+//!   log lines as they happen, a liveliness token per host, and the gateway's own counters.
+//! - **Clock watch**: a queryable answers with this host's clock; the gateway asks the others
+//!   and warns when an offset exceeds `cell.clock_warning_fraction` of the smallest delay of a
+//!   coupling between the two hosts.
+//!
+//! A malformed payload on any key is dropped and counted; it never stops the gateway.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use tandem_config::{Cell, Coupling, LEADING_BUFFER};
+use tandem_node::rt;
+use tandem_protocol::ipc::{self, IpcNode};
+use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
+use tandem_protocol::keys;
+use tandem_protocol::wire::{CommandRequest, Text, EVENT_JOB, EVENT_LOG};
+use zenoh::qos::{CongestionControl, Priority};
+use zenoh::sample::Locality;
+use zenoh::Wait;
+
+/// How a gateway is started.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// The cell file.
+    pub cell: PathBuf,
+    /// This host (default: the cell's only host).
+    pub host: Option<String>,
+    /// Stop after this many seconds (default: on SIGINT/SIGTERM).
+    pub duration_s: Option<f64>,
+}
+
+/// The gateway's counters, published on `tandem/<cell>/gateway/<host>`.
+#[derive(Debug, Default)]
+pub struct Counters {
+    /// Leading values put on Zenoh.
+    pub lv_out: AtomicU64,
+    /// Leading values from Zenoh published into iceoryx2.
+    pub lv_in: AtomicU64,
+    /// Payloads dropped because they could not be decoded (any key).
+    pub malformed: AtomicU64,
+    /// Command queries answered.
+    pub commands: AtomicU64,
+    /// Largest clock offset to another host seen in the last round (ns, absolute).
+    pub clock_offset_ns: AtomicI64,
+    /// Clock offsets above the warning threshold.
+    pub clock_warnings: AtomicU64,
+}
+
+/// What the gateway bridges, from the cell.
+#[derive(Debug, Default)]
+struct Plan {
+    /// Leaders of this host followed on another host: (leader, coupling, node).
+    out: Vec<(usize, Coupling, usize)>,
+    /// Leaders of another host followed here: (leader, coupling).
+    inn: Vec<(usize, Coupling)>,
+    /// This host's nodes.
+    nodes: Vec<usize>,
+    /// Per other host: the smallest delay of a coupling between the two hosts (ns).
+    min_delay: HashMap<usize, i64>,
+}
+
+fn plan(cell: &Cell, h: usize) -> Plan {
+    let mut p = Plan {
+        nodes: (0..cell.nodes.len())
+            .filter(|n| cell.nodes[*n].host == h)
+            .collect(),
+        ..Plan::default()
+    };
+    for f in &cell.axes {
+        let f_host = cell.nodes[f.node].host;
+        for (l, c) in f.leaders.iter().flatten() {
+            let c = if *l >= cell.axes.len() {
+                Coupling::Setpoint
+            } else {
+                *c
+            };
+            let Some(ln) = cell.leader_node(*l) else {
+                continue;
+            };
+            let l_host = cell.nodes[ln].host;
+            if l_host == f_host {
+                continue;
+            }
+            let d = cell.leading[*l].delay_ns;
+            let other = if l_host == h { f_host } else { l_host };
+            if l_host == h || f_host == h {
+                let e = p.min_delay.entry(other).or_insert(d);
+                *e = (*e).min(d);
+            }
+            if l_host == h && !p.out.iter().any(|(x, y, _)| x == l && *y == c) {
+                p.out.push((*l, c, ln));
+            }
+            if f_host == h && !p.inn.iter().any(|(x, y)| x == l && *y == c) {
+                p.inn.push((*l, c));
+            }
+        }
+    }
+    p
+}
+
+fn history(cell: &Cell, l: usize) -> usize {
+    let lv = cell.leading[l];
+    let cycle = cell
+        .leader_node(l)
+        .map_or(1_000_000, |n| cell.nodes[n].cycle_ns);
+    (((lv.delay_ns + lv.tolerance_ns) / cycle.max(1)) as usize + 4).min(LEADING_BUFFER)
+}
+
+/// The Zenoh configuration of host `h`: peer mode, listening on the host's endpoints and
+/// connecting to the other hosts'; multicast scouting only when no endpoint is configured.
+pub fn zenoh_config(cell: &Cell, h: usize) -> Result<zenoh::Config, String> {
+    let mut c = zenoh::Config::default();
+    let set = |c: &mut zenoh::Config, k: &str, v: String| {
+        c.insert_json5(k, &v)
+            .map_err(|e| format!("zenoh config {k} = {v}: {e}"))
+    };
+    set(&mut c, "mode", "\"peer\"".into())?;
+    let listen = cell.host_listen.get(h).cloned().unwrap_or_default();
+    let connect: Vec<String> = cell
+        .host_listen
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != h)
+        .flat_map(|(_, l)| l.clone())
+        .collect();
+    let json = |v: &[String]| serde_json::to_string(v).unwrap_or_else(|_| "[]".into());
+    if !listen.is_empty() {
+        set(&mut c, "listen/endpoints", json(&listen))?;
+    }
+    if !connect.is_empty() {
+        set(&mut c, "connect/endpoints", json(&connect))?;
+        // Keep trying: the other hosts' gateways may start later.
+        set(&mut c, "connect/timeout_ms", "-1".into())?;
+    }
+    if !listen.is_empty() || !connect.is_empty() {
+        set(&mut c, "scouting/multicast/enabled", "false".into())?;
+    }
+    Ok(c)
+}
+
+/// Runs the gateway until SIGINT/SIGTERM or the end of its duration.
+pub fn run(o: &Options) -> Result<Arc<Counters>, String> {
+    let cell = Arc::new(tandem_config::load(&o.cell).map_err(|e| e.to_string())?);
+    let h = match &o.host {
+        Some(name) => cell.hosts.iter().position(|x| x == name).ok_or_else(|| {
+            format!(
+                "{}: no host `{name}`; the cell has: {}",
+                o.cell.display(),
+                cell.hosts.join(", ")
+            )
+        })?,
+        None if cell.hosts.len() == 1 => 0,
+        None => {
+            return Err(format!(
+                "{}: the cell has several hosts ({}): say which with --host",
+                o.cell.display(),
+                cell.hosts.join(", ")
+            ))
+        }
+    };
+    let host = cell.hosts[h].clone();
+    rt::install_termination_handler();
+    ipc::cleanup_dead_nodes(&host);
+    let plan = Arc::new(plan(&cell, h));
+    let session = zenoh::open(zenoh_config(&cell, h)?)
+        .wait()
+        .map_err(|e| format!("opening the Zenoh session: {e}"))?;
+    let _token = session
+        .liveliness()
+        .declare_token(keys::alive(&cell.name, &host))
+        .wait()
+        .map_err(|e| format!("liveliness token: {e}"))?;
+    let counters = Arc::new(Counters::default());
+    let stop = Arc::new(AtomicBool::new(false));
+    eprintln!(
+        "tandem-gateway {host}: cell `{}`, {} node(s); {} leader(s) out, {} in; Zenoh id {}",
+        cell.name,
+        plan.nodes.len(),
+        plan.out.len(),
+        plan.inn.len(),
+        session.zid()
+    );
+    let mut threads = Vec::new();
+    let spawn = |name: &str, f: Box<dyn FnOnce() -> Result<(), String> + Send>| {
+        let what = name.to_string();
+        let host = host.clone();
+        std::thread::Builder::new()
+            .name(what.clone())
+            .spawn(move || {
+                if let Err(e) = f() {
+                    eprintln!("tandem-gateway {host}: {what}: {e}");
+                }
+            })
+            .map_err(|e| format!("cannot start the {name} thread: {e}"))
+    };
+    {
+        let (cell, plan, s, c, stop, host) = (
+            Arc::clone(&cell),
+            Arc::clone(&plan),
+            session.clone(),
+            Arc::clone(&counters),
+            Arc::clone(&stop),
+            host.clone(),
+        );
+        threads.push(spawn(
+            "lv-out",
+            Box::new(move || lv_out(&cell, &host, &plan, &s, &c, &stop)),
+        )?);
+    }
+    {
+        let (cell, plan, s, c, stop, host) = (
+            Arc::clone(&cell),
+            Arc::clone(&plan),
+            session.clone(),
+            Arc::clone(&counters),
+            Arc::clone(&stop),
+            host.clone(),
+        );
+        threads.push(spawn(
+            "lv-in",
+            Box::new(move || lv_in(&cell, &host, &plan, &s, &c, &stop)),
+        )?);
+    }
+    {
+        let (cell, plan, s, c, stop, host) = (
+            Arc::clone(&cell),
+            Arc::clone(&plan),
+            session.clone(),
+            Arc::clone(&counters),
+            Arc::clone(&stop),
+            host.clone(),
+        );
+        threads.push(spawn(
+            "commands",
+            Box::new(move || commands(&cell, &host, &plan, &s, &c, &stop)),
+        )?);
+    }
+    {
+        let (cell, plan, s, c, stop, host) = (
+            Arc::clone(&cell),
+            Arc::clone(&plan),
+            session.clone(),
+            Arc::clone(&counters),
+            Arc::clone(&stop),
+            host.clone(),
+        );
+        threads.push(spawn(
+            "telemetry",
+            Box::new(move || telemetry(&cell, &host, &plan, &s, &c, &stop)),
+        )?);
+    }
+    {
+        let (cell, plan, s, c, stop, host) = (
+            Arc::clone(&cell),
+            Arc::clone(&plan),
+            session.clone(),
+            Arc::clone(&counters),
+            Arc::clone(&stop),
+            host.clone(),
+        );
+        threads.push(spawn(
+            "clock",
+            Box::new(move || clock(&cell, &host, h, &plan, &s, &c, &stop)),
+        )?);
+    }
+    let started = Instant::now();
+    while !rt::termination_requested()
+        && o.duration_s
+            .is_none_or(|d| started.elapsed().as_secs_f64() < d)
+    {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    stop.store(true, Ordering::SeqCst);
+    for t in threads {
+        let _ = t.join();
+    }
+    eprintln!(
+        "tandem-gateway {host}: stopped; leading values out {}, in {}, malformed payloads {}, commands {}",
+        counters.lv_out.load(Ordering::Relaxed),
+        counters.lv_in.load(Ordering::Relaxed),
+        counters.malformed.load(Ordering::Relaxed),
+        counters.commands.load(Ordering::Relaxed)
+    );
+    let _ = session.close().wait();
+    Ok(counters)
+}
+
+fn iox(cell: &Cell, host: &str, what: &str) -> Result<IpcNode, String> {
+    ipc::node(&format!("tandem/{}/gateway-{what}", cell.name), host).map_err(|e| e.to_string())
+}
+
+/// iceoryx2 to Zenoh: wakes on each publishing node's event and forwards every new sample.
+fn lv_out(
+    cell: &Cell,
+    host: &str,
+    plan: &Plan,
+    session: &zenoh::Session,
+    c: &Counters,
+    stop: &AtomicBool,
+) -> Result<(), String> {
+    if plan.out.is_empty() {
+        return Ok(());
+    }
+    rt::no_timer_slack();
+    let node = iox(cell, host, "lv-out")?;
+    let names = cell.object_names();
+    let mut listeners = Vec::new();
+    for n in plan
+        .out
+        .iter()
+        .map(|(_, _, n)| *n)
+        .collect::<std::collections::BTreeSet<_>>()
+    {
+        let svc =
+            ipc::published(&node, &cell.name, &cell.nodes[n].name).map_err(|e| e.to_string())?;
+        listeners.push(
+            svc.listener_builder()
+                .create()
+                .map_err(|e| format!("listener: {e}"))?,
+        );
+    }
+    let mut routes = Vec::new();
+    for (l, cp, _) in &plan.out {
+        let actual = *cp == Coupling::Actual;
+        let svc = ipc::leading_values(&node, &cell.name, names[*l], actual, history(cell, *l))
+            .map_err(|e| e.to_string())?;
+        let sub = svc
+            .subscriber_builder()
+            .buffer_size(history(cell, *l))
+            .create()
+            .map_err(|e| format!("subscriber: {e}"))?;
+        let key = keys::leading_value(&cell.name, names[*l], actual);
+        let publisher = session
+            .declare_publisher(key.clone())
+            .priority(Priority::RealTime)
+            .express(true)
+            .congestion_control(CongestionControl::Drop)
+            .allowed_destination(Locality::Remote)
+            .wait()
+            .map_err(|e| format!("publisher {key}: {e}"))?;
+        routes.push((sub, publisher));
+    }
+    let each = Duration::from_millis(5) / listeners.len().max(1) as u32;
+    while !stop.load(Ordering::SeqCst) {
+        for l in &listeners {
+            let _ = l.timed_wait(|_| {}, each);
+            for (sub, publisher) in &routes {
+                while let Ok(Some(s)) = sub.receive() {
+                    if publisher
+                        .put(json::encode_leading_value(s.payload()))
+                        .wait()
+                        .is_ok()
+                    {
+                        c.lv_out.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Zenoh to iceoryx2: every sample of a remote leader followed here goes into this host's
+/// leading-value service, timestamp unchanged.
+fn lv_in(
+    cell: &Cell,
+    host: &str,
+    plan: &Plan,
+    session: &zenoh::Session,
+    c: &Counters,
+    stop: &AtomicBool,
+) -> Result<(), String> {
+    let node = iox(cell, host, "lv-in")?;
+    let names = cell.object_names();
+    let mut publishers = HashMap::new();
+    for (l, cp) in &plan.inn {
+        let actual = *cp == Coupling::Actual;
+        let svc = ipc::leading_values(&node, &cell.name, names[*l], actual, history(cell, *l))
+            .map_err(|e| e.to_string())?;
+        let p = svc
+            .publisher_builder()
+            .create()
+            .map_err(|e| format!("publisher: {e}"))?;
+        publishers.insert((names[*l].to_string(), actual), (*l, p));
+    }
+    // Every leading value of the cell, so that a malformed one on any lv key is counted.
+    let sub = session
+        .declare_subscriber(keys::leading_values(&cell.name))
+        .allowed_origin(Locality::Remote)
+        .wait()
+        .map_err(|e| format!("subscriber: {e}"))?;
+    while !stop.load(Ordering::SeqCst) {
+        let Ok(Some(sample)) = sub.recv_timeout(Duration::from_millis(50)) else {
+            continue;
+        };
+        let key = sample.key_expr().as_str().to_string();
+        let Some((leader, actual)) = keys::parse_leading_value(&cell.name, &key) else {
+            c.malformed.fetch_add(1, Ordering::Relaxed);
+            continue;
+        };
+        let decoded = json::decode_leading_value(&sample.payload().to_bytes());
+        let Some((l, p)) = publishers.get(&(leader.to_string(), actual)) else {
+            // A leader nobody here follows: not ours to forward (but still checked).
+            if decoded.is_err() {
+                c.malformed.fetch_add(1, Ordering::Relaxed);
+            }
+            continue;
+        };
+        match decoded {
+            Ok(s) if s.leader as usize == *l => {
+                if p.send_copy(s).is_ok() {
+                    c.lv_in.fetch_add(1, Ordering::Relaxed);
+                }
+            }
+            _ => {
+                c.malformed.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Zenoh queries to the nodes' command services and back.
+fn commands(
+    cell: &Cell,
+    host: &str,
+    plan: &Plan,
+    session: &zenoh::Session,
+    c: &Counters,
+    stop: &AtomicBool,
+) -> Result<(), String> {
+    let node = iox(cell, host, "commands")?;
+    let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(64);
+    let mut queryables = Vec::new();
+    let mut clients = HashMap::new();
+    for n in &plan.nodes {
+        let name = &cell.nodes[*n].name;
+        let tx = tx.clone();
+        queryables.push(
+            session
+                .declare_queryable(keys::commands(&cell.name, name))
+                .callback(move |q| {
+                    let _ = tx.try_send(q);
+                })
+                .wait()
+                .map_err(|e| format!("queryable: {e}"))?,
+        );
+        let svc = ipc::commands(&node, &cell.name, name).map_err(|e| e.to_string())?;
+        clients.insert(
+            name.clone(),
+            svc.client_builder()
+                .create()
+                .map_err(|e| format!("command client: {e}"))?,
+        );
+    }
+    while !stop.load(Ordering::SeqCst) {
+        let Ok(q) = rx.recv_timeout(Duration::from_millis(50)) else {
+            continue;
+        };
+        c.commands.fetch_add(1, Ordering::Relaxed);
+        let key = q.key_expr().as_str().to_string();
+        let reply = match keys::parse_command(&cell.name, &key) {
+            None => ReplyJson::failed("invalid", format!("`{key}` is not a command key")),
+            Some((node_name, object)) => {
+                let text = q
+                    .payload()
+                    .map(|p| p.try_to_string().map(|s| s.to_string()))
+                    .unwrap_or(Ok(String::new()));
+                let line = match text {
+                    Err(_) => Err("the payload is not UTF-8".to_string()),
+                    Ok(t) if t.trim_start().starts_with('{') => {
+                        serde_json::from_str::<json::CommandJson>(&t)
+                            .map_err(|e| format!("the JSON command is malformed: {e}"))
+                            .and_then(|c| c.to_line())
+                    }
+                    Ok(t) => Ok(t),
+                };
+                match (line, clients.get(node_name)) {
+                    (Err(m), _) => {
+                        c.malformed.fetch_add(1, Ordering::Relaxed);
+                        ReplyJson::failed("invalid", m)
+                    }
+                    (Ok(_), None) => ReplyJson::failed(
+                        "invalid",
+                        format!("node `{node_name}` is not on host `{host}`"),
+                    ),
+                    (Ok(line), Some(client)) => forward(client, &format!("{object} {line}")),
+                }
+            }
+        };
+        let body = serde_json::to_string(&reply).unwrap_or_default();
+        let _ = q.reply(q.key_expr().clone(), body).wait();
+    }
+    drop(queryables);
+    Ok(())
+}
+
+/// Sends one command line to a node and waits up to 5 s for its reply.
+fn forward(
+    client: &iceoryx2::port::client::Client<
+        iceoryx2::prelude::ipc::Service,
+        CommandRequest,
+        (),
+        tandem_protocol::wire::CommandReply,
+        (),
+    >,
+    line: &str,
+) -> ReplyJson {
+    let pending = match client.send_copy(CommandRequest {
+        text: Text::new(line),
+    }) {
+        Ok(p) => p,
+        Err(e) => return ReplyJson::failed("unreachable", format!("sending to the node: {e}")),
+    };
+    let deadline = Instant::now() + Duration::from_secs(5);
+    while Instant::now() < deadline {
+        match pending.receive() {
+            Ok(Some(r)) => return ReplyJson::from_reply(r.payload()),
+            Ok(None) => std::thread::sleep(Duration::from_millis(1)),
+            Err(e) => return ReplyJson::failed("unreachable", format!("{e}")),
+        }
+    }
+    ReplyJson::failed(
+        "unreachable",
+        if pending.number_of_server_connections() == 0 {
+            "the node is not running".to_string()
+        } else {
+            "the node did not answer within 5 s".to_string()
+        },
+    )
+}
+
+/// Per-axis state and node health at the telemetry rate, events and log lines as they happen.
+fn telemetry(
+    cell: &Cell,
+    host: &str,
+    plan: &Plan,
+    session: &zenoh::Session,
+    c: &Counters,
+    stop: &AtomicBool,
+) -> Result<(), String> {
+    let node = iox(cell, host, "telemetry")?;
+    let names = cell.object_names();
+    let mut subs = Vec::new();
+    for n in &plan.nodes {
+        let name = &cell.nodes[*n].name;
+        let t = ipc::telemetry(&node, &cell.name, name)
+            .map_err(|e| e.to_string())?
+            .subscriber_builder()
+            .buffer_size(4)
+            .create()
+            .map_err(|e| format!("telemetry subscriber: {e}"))?;
+        let e = ipc::events(&node, &cell.name, name)
+            .map_err(|e| e.to_string())?
+            .subscriber_builder()
+            .buffer_size(1024)
+            .create()
+            .map_err(|e| format!("event subscriber: {e}"))?;
+        subs.push((name.as_str(), t, e));
+    }
+    let period = Duration::from_secs_f64(1.0 / cell.telemetry_hz);
+    let put = |key: String, value: String| {
+        let _ = session.put(key, value).wait();
+    };
+    let mut next = Instant::now();
+    while !stop.load(Ordering::SeqCst) {
+        next += period;
+        for (name, t, e) in &subs {
+            let mut newest = None;
+            while let Ok(Some(s)) = t.receive() {
+                newest = Some((*s.user_header(), s.payload().to_vec()));
+            }
+            if let Some((h, axes)) = newest {
+                for a in &axes {
+                    let axis = names.get(a.axis as usize).copied().unwrap_or("?");
+                    let state = AxisState::new(&h, name, axis, a);
+                    put(
+                        keys::state(&cell.name, name, axis),
+                        serde_json::to_string(&state).unwrap_or_default(),
+                    );
+                }
+                put(
+                    keys::health(&cell.name, name),
+                    serde_json::to_string(&Health::new(name, &h)).unwrap_or_default(),
+                );
+            }
+            while let Ok(Some(s)) = e.receive() {
+                let ev = s.payload();
+                let object = if ev.kind == EVENT_JOB {
+                    names.get(ev.object as usize).copied().unwrap_or("?")
+                } else {
+                    ""
+                };
+                let body = serde_json::to_string(&EventJson::new(ev, object)).unwrap_or_default();
+                match ev.kind {
+                    EVENT_JOB => put(keys::events(&cell.name, name, object), body),
+                    EVENT_LOG => put(keys::log(&cell.name, name), body),
+                    _ => {}
+                }
+            }
+        }
+        let own = serde_json::json!({
+            "host": host,
+            "lv_out": c.lv_out.load(Ordering::Relaxed),
+            "lv_in": c.lv_in.load(Ordering::Relaxed),
+            "malformed": c.malformed.load(Ordering::Relaxed),
+            "commands": c.commands.load(Ordering::Relaxed),
+            "clock_offset_us": c.clock_offset_ns.load(Ordering::Relaxed) as f64 * 1e-3,
+            "clock_warnings": c.clock_warnings.load(Ordering::Relaxed),
+        });
+        put(keys::gateway(&cell.name, host), own.to_string());
+        let now = Instant::now();
+        if next > now {
+            std::thread::sleep(next - now);
+        } else {
+            next = now;
+        }
+    }
+    Ok(())
+}
+
+/// Answers clock queries and measures the offset to the other hosts' gateways once a second:
+/// `offset = t_remote - (t_sent + t_received) / 2`, from the round trip with the smallest delay
+/// of five.
+fn clock(
+    cell: &Cell,
+    host: &str,
+    h: usize,
+    plan: &Plan,
+    session: &zenoh::Session,
+    c: &Counters,
+    stop: &AtomicBool,
+) -> Result<(), String> {
+    let _q = session
+        .declare_queryable(keys::clock(&cell.name, host))
+        .callback(|q| {
+            let _ = q
+                .reply(q.key_expr().clone(), rt::now_ns().to_string())
+                .wait();
+        })
+        .wait()
+        .map_err(|e| format!("clock queryable: {e}"))?;
+    let others: Vec<usize> = (0..cell.hosts.len()).filter(|x| *x != h).collect();
+    let mut warned: HashMap<usize, bool> = HashMap::new();
+    while !stop.load(Ordering::SeqCst) {
+        let mut worst = 0i64;
+        for o in &others {
+            let mut best: Option<(i64, i64)> = None;
+            for _ in 0..5 {
+                let t0 = rt::now_ns();
+                let Ok(replies) = session
+                    .get(keys::clock(&cell.name, &cell.hosts[*o]))
+                    .timeout(Duration::from_millis(500))
+                    .wait()
+                else {
+                    continue;
+                };
+                if let Ok(r) = replies.recv() {
+                    let t1 = rt::now_ns();
+                    let remote = r
+                        .result()
+                        .ok()
+                        .and_then(|s| s.payload().try_to_string().ok().map(|x| x.to_string()))
+                        .and_then(|x| x.parse::<i64>().ok());
+                    match remote {
+                        Some(tr) => {
+                            let rtt = t1 - t0;
+                            if best.is_none_or(|(b, _)| rtt < b) {
+                                best = Some((rtt, tr - (t0 + t1) / 2));
+                            }
+                        }
+                        None => {
+                            c.malformed.fetch_add(1, Ordering::Relaxed);
+                        }
+                    }
+                }
+            }
+            let Some((rtt, offset)) = best else {
+                continue;
+            };
+            worst = worst.max(offset.abs());
+            if let Some(d) = plan.min_delay.get(o) {
+                let limit = (*d as f64 * cell.clock_warning_fraction) as i64;
+                let over = offset.abs() > limit;
+                if over && !warned.get(o).copied().unwrap_or(false) {
+                    c.clock_warnings.fetch_add(1, Ordering::Relaxed);
+                    eprintln!(
+                        "tandem-gateway {host}: warning: the clock of host `{}` is {:.1} µs off (round trip {:.1} µs), more than {:.0} % of the {:.1} ms leading-value delay between the hosts: synchronize the clocks (PTP)",
+                        cell.hosts[*o],
+                        offset as f64 * 1e-3,
+                        rtt as f64 * 1e-3,
+                        cell.clock_warning_fraction * 100.0,
+                        *d as f64 * 1e-6
+                    );
+                }
+                warned.insert(*o, over);
+            }
+        }
+        c.clock_offset_ns.store(worst, Ordering::Relaxed);
+        let until = Instant::now() + Duration::from_secs(1);
+        while Instant::now() < until && !stop.load(Ordering::SeqCst) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+    Ok(())
+}
