@@ -9,7 +9,7 @@ use crate::wire::{
 use serde::{Deserialize, Serialize};
 use tandem_motion::error_id::ErrorId;
 
-/// The binary form of a leading value between hosts (fixed-width integers: 68 bytes).
+/// The binary form of a leading value between hosts (fixed-width integers: 64 bytes).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
 struct LeadingValueWire {
     t_ns: i64,
@@ -344,14 +344,14 @@ mod tests {
             leader: 3,
         };
         let b = encode_leading_value(&s);
-        assert_eq!(b.len(), 68);
+        assert_eq!(b.len(), 64);
         assert_eq!(decode_leading_value(&b).unwrap(), s);
-        assert!(decode_leading_value(&b[..67]).is_err());
+        assert!(decode_leading_value(&b[..63]).is_err());
         let mut longer = b.clone();
         longer.push(0);
         assert!(decode_leading_value(&longer)
             .unwrap_err()
-            .contains("69 bytes"));
+            .contains("65 bytes"));
         assert!(decode_leading_value(b"").is_err());
         let nan = LeadingValueSample { p: f64::NAN, ..s };
         assert!(decode_leading_value(&encode_leading_value(&nan)).is_err());
