@@ -82,6 +82,12 @@ fn cli() -> Command {
                         .help("Print events as they happen instead of the live table"),
                 )
                 .arg(
+                    Arg::new("epoch-ns")
+                        .long("epoch-ns")
+                        .value_parser(clap::value_parser!(i64))
+                        .help("Cell clock time of cycle 0 (ns since 1970, CLOCK_REALTIME); every host of a cell must start with the same (default: the next whole second plus one)"),
+                )
+                .arg(
                     Arg::new("no-gateway")
                         .long("no-gateway")
                         .action(ArgAction::SetTrue)
@@ -208,6 +214,7 @@ fn running(name: &str, m: &clap::ArgMatches, out: &mut impl Write) -> Result<(),
                     && std::io::IsTerminal::is_terminal(&std::io::stdout()),
                 duration_s: m.get_one::<f64>("duration").copied(),
                 gateway: !m.get_flag("no-gateway"),
+                epoch_ns: m.get_one::<i64>("epoch-ns").copied(),
             };
             live::up(cell, &o, out)
         }

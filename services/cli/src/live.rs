@@ -489,6 +489,9 @@ pub struct UpOptions {
     pub duration_s: Option<f64>,
     /// Start the host's gateway (Zenoh) too.
     pub gateway: bool,
+    /// The cell clock's time of cycle 0 (ns). Every host of a cell must use the same; default:
+    /// the next whole second plus one.
+    pub epoch_ns: Option<i64>,
 }
 
 fn spawn(
@@ -588,7 +591,9 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
     let iox = cli_node(&cell, "up", &host)?;
     let mut obs = Observer::new(&iox, &cell, &nodes, true)?;
     // Cycle 0 of every node at the next whole second plus one: all start on one grid.
-    let epoch = (rt::now_ns() / 1_000_000_000 + 2) * 1_000_000_000;
+    let epoch = o
+        .epoch_ns
+        .unwrap_or((rt::now_ns() / 1_000_000_000 + 2) * 1_000_000_000);
     let (tx, rx) = mpsc::channel::<(String, String)>();
     let mut slots: Vec<Slot> = nodes
         .iter()
