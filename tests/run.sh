@@ -2,12 +2,13 @@
 # The test command of README: sets up what the tests need on a fresh machine, then runs them.
 #  1. Python oracles: installs the pinned `ruckig` and `pyplcopen` packages and regenerates the
 #     committed fixtures into temp files; they must match byte for byte (the oracles are real).
+#     It also installs `eclipse-zenoh`, the Python observer of the multi-host tests.
 #  2. All binaries (the process tests run `tandem up`, which starts `tandem-node` from beside
 #     itself), then all Rust tests of the workspace, in release.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-python3 -m pip install --quiet --disable-pip-version-check -r tests/oracle/requirements.txt
+python3 -m pip install --quiet --disable-pip-version-check -r tests/oracle/requirements.txt -r tests/python/requirements.txt
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 python3 tests/oracle/gen_ruckig_fixtures.py --out "$tmp/ruckig_1dof.csv" >/dev/null

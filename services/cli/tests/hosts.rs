@@ -363,3 +363,305 @@ fn followers_on_two_hosts_move_in_phase() {
     let _ = std::fs::remove_dir_all(&dir);
     drop(hosts);
 }
+
+/// The pid of the process whose command line contains every one of `words`.
+fn pid_of(words: &[&str]) -> Option<u32> {
+    for e in std::fs::read_dir("/proc").ok()?.flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        let Ok(cmd) = std::fs::read(e.path().join("cmdline")) else {
+            continue;
+        };
+        let cmd = String::from_utf8_lossy(&cmd).replace('\0', " ");
+        if words.iter().all(|w| cmd.contains(w)) {
+            return Some(pid);
+        }
+    }
+    None
+}
+
+/// The Python observer (tests/python/observe.py, eclipse-zenoh) in namespace `ns` of `hosts`.
+fn observe(hosts: &Hosts, ns: usize, cell: &str, seconds: f64, commands: &[(&str, &str)]) -> Child {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/python/observe.py");
+    let mut c = hosts.exec(ns, Path::new("python3"));
+    c.arg(script)
+        .args(["--cell", cell, "--seconds", &seconds.to_string()])
+        .args(["--connect", &format!("tcp/{}:7447", hosts.addr(0))])
+        .args(["--connect", &format!("tcp/{}:7447", hosts.addr(1))]);
+    for (target, text) in commands {
+        c.arg("--command").arg(target).arg(text);
+    }
+    c.stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn observed(child: Child) -> serde_json::Value {
+    let o = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "observe.py: {}\n{text}{}",
+        o.status,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+/// A status row of `axis` on `host`, split in columns (empty if not running).
+fn row(hosts: &Hosts, i: usize, cell: &Path, host: &str, axis: &str) -> Vec<String> {
+    let mut c = hosts.exec(i, &bin("tandem"));
+    c.arg("status")
+        .arg("--cell")
+        .arg(cell)
+        .args(["--host", host]);
+    let o = c.output().unwrap();
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .find(|l| l.split_whitespace().nth(1) == Some(axis))
+        .map(|l| l.split_whitespace().map(str::to_string).collect())
+        .unwrap_or_default()
+}
+
+fn until(limit: Duration, what: &str, mut f: impl FnMut() -> bool) {
+    let deadline = Instant::now() + limit;
+    while !f() {
+        assert!(Instant::now() < deadline, "{what}: not within {limit:?}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+const SPARE: &str = r#"
+[axes.spare]
+node = "nb"
+virtual = true
+
+[axes.spare.dynamics]
+max_velocity = 500.0
+max_acceleration = 5000.0
+max_deceleration = 5000.0
+max_jerk = 100000.0
+velocity = 100.0
+acceleration = 1000.0
+deceleration = 1000.0
+jerk = 20000.0
+emergency_deceleration = 10000.0
+"#;
+
+/// Observation from a third namespace with Python (eclipse-zenoh): the telemetry of both hosts,
+/// commands as queries (accepted, rejected with an ErrorID, malformed), the hosts' liveliness.
+/// Then faults: cutting host 2's link for a second stops its follower with 601 within the
+/// tolerance, nothing crashes, and after the link returns and a reset it couples again; a killed
+/// gateway is seen gone and back through liveliness, restarted by its supervisor.
+#[test]
+fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gateway() {
+    let hosts = Hosts::new("o", 3);
+    let dir = std::env::temp_dir().join(format!("tandem-hosts-o-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let name = format!("o{}", std::process::id());
+    let cell = dir.join("cell.toml");
+    std::fs::write(
+        &cell,
+        CELL.replace("CELLNAME", &name)
+            .replace("ADDR1", &hosts.addr(0))
+            .replace("ADDR2", &hosts.addr(1))
+            + SPARE,
+    )
+    .unwrap();
+    let sc = dir.join("script.toml");
+    std::fs::write(
+        &sc,
+        script(2.0).replace("duration = 2", "duration = 120")
+            + "[[at]]\nt = 0.5\naxis = \"master\"\ninstruction = \"MC_MoveVelocity\"\nvelocity = 200.0\n",
+    )
+    .unwrap();
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos() as i64;
+    let epoch = (now / 1_000_000_000 + 4) * 1_000_000_000;
+    let mut runs = Vec::new();
+    for (i, host) in ["h1", "h2"].iter().enumerate() {
+        let mut c = hosts.exec(i, &bin("tandem"));
+        c.arg("up")
+            .arg(&cell)
+            .args([
+                "--host",
+                host,
+                "--no-view",
+                "--epoch-ns",
+                &epoch.to_string(),
+            ])
+            .arg("--script")
+            .arg(&sc)
+            .arg("--record")
+            .arg(dir.join(host));
+        runs.push(spawn_collect(c));
+    }
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        until(Duration::from_secs(40), "fb geared on host 2", || {
+            let r = row(&hosts, 1, &cell, "h2", "fb");
+            r.get(2).map(String::as_str) == Some("SynchronizedMotion")
+                && r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(200.0)
+        });
+        // Python in the third namespace: everything of both hosts, commands, liveliness.
+        let seen = observed(observe(
+            &hosts,
+            2,
+            &name,
+            3.0,
+            &[
+                ("nb/spare", "MC_Power"),
+                ("nb/spare", "MC_MoveVelocity --velocity 50"),
+                ("nb/spare", "MC_MoveAbsolute --position 10 --velocity 0"),
+                (
+                    "nb/spare",
+                    "{\"instruction\": \"MC_MoveVelocity\", \"params\": {\"velocity\": 60}}",
+                ),
+                ("nb/spare", "{not json"),
+            ],
+        ));
+        for (node, axis) in [
+            ("na", "master"),
+            ("na", "fa"),
+            ("nb", "fb"),
+            ("nb", "spare"),
+        ] {
+            let key = format!("tandem/{name}/{node}/{axis}/state");
+            assert!(seen["states"][&key]["state"].is_string(), "{key}: {seen}");
+        }
+        for node in ["na", "nb"] {
+            let key = format!("tandem/{name}/{node}/health");
+            assert!(seen["health"][&key]["cycle_us"] == 1000.0, "{key}: {seen}");
+        }
+        let fb = &seen["states"][&format!("tandem/{name}/nb/fb/state")];
+        assert_eq!(fb["sync"], "GearIn", "{seen}");
+        let replies = seen["replies"].as_array().unwrap();
+        let outcome = |i: usize| {
+            replies[i]["reply"]["outcome"]
+                .as_str()
+                .unwrap_or("")
+                .to_string()
+        };
+        assert_eq!(outcome(0), "accepted", "{seen}");
+        assert_eq!(outcome(1), "accepted", "{seen}");
+        assert!(replies[1]["reply"]["job"].as_u64().unwrap() > 0, "{seen}");
+        assert_eq!(outcome(2), "rejected", "{seen}");
+        assert!(
+            replies[2]["reply"]["error_id"]
+                .as_str()
+                .unwrap()
+                .starts_with("16#80"),
+            "{seen}"
+        );
+        assert_eq!(outcome(3), "accepted", "{seen}");
+        assert_eq!(outcome(4), "invalid", "{seen}");
+        let alive = seen["alive"].as_array().unwrap();
+        assert_eq!(alive.len(), 2, "{seen}");
+        // The query moved the axis on host 2 (60 after the JSON command).
+        until(Duration::from_secs(10), "spare at 60/s", || {
+            let r = row(&hosts, 1, &cell, "h2", "spare");
+            r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(60.0)
+        });
+
+        // Cut host 2's link for one second.
+        ip(&["-n", &hosts.hub, "link", "set", "h1", "down"]);
+        std::thread::sleep(Duration::from_secs(1));
+        ip(&["-n", &hosts.hub, "link", "set", "h1", "up"]);
+        until(Duration::from_secs(10), "fb stopped with 601", || {
+            let r = row(&hosts, 1, &cell, "h2", "fb");
+            r.get(2).map(String::as_str) == Some("ErrorStop")
+                && r.get(6).map(String::as_str) == Some("601")
+                && r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(0.0)
+        });
+        // The link is back: reset and couple again, once the leader's values flow again (a
+        // GearIn before that ends with 601 again: the follower reads the leader at t - D).
+        let tandem_cmd = |args: &[&str]| -> bool {
+            let mut c = hosts.exec(1, &bin("tandem"));
+            c.arg("cmd").arg("--cell").arg(&cell).args(args);
+            c.output().unwrap().status.success()
+        };
+        until(
+            Duration::from_secs(30),
+            "fb coupled again after the link returned",
+            || {
+                tandem_cmd(&["nb/fb", "MC_Reset", "--wait"])
+                    && tandem_cmd(&["nb/fb", "MC_GearIn", "--master", "na/master", "--wait"])
+            },
+        );
+        until(Duration::from_secs(10), "fb geared again", || {
+            let r = row(&hosts, 1, &cell, "h2", "fb");
+            r.get(2).map(String::as_str) == Some("SynchronizedMotion")
+                && r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(200.0)
+        });
+
+        // Kill host 2's gateway: its liveliness token goes, and comes back with the restart.
+        let watcher = observe(&hosts, 2, &name, 8.0, &[]);
+        std::thread::sleep(Duration::from_secs(3));
+        let cell_s = cell.to_string_lossy().to_string();
+        let pid = pid_of(&["tandem-gateway", &cell_s, "h2"]).expect("host 2's gateway");
+        tandem_node::rt::send_signal(pid, libc::SIGKILL).unwrap();
+        let seen = observed(watcher);
+        let events: Vec<(String, String)> = seen["alive_events"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|e| e[2].as_str().unwrap_or("").ends_with("/h2"))
+            .map(|e| (e[1].as_str().unwrap().to_string(), e[0].to_string()))
+            .collect();
+        let kinds: Vec<&str> = events.iter().map(|e| e.0.as_str()).collect();
+        assert!(
+            kinds.windows(2).any(|w| w == ["gone", "alive"]),
+            "host 2's liveliness: {events:?}"
+        );
+    }));
+    for (child, _) in &runs {
+        let _ = tandem_node::rt::send_signal(child.id(), libc::SIGTERM);
+    }
+    let mut outputs = Vec::new();
+    for (mut child, reader) in runs {
+        let status = wait_for(
+            &mut child,
+            Duration::from_secs(30),
+            "tandem up after SIGTERM",
+        );
+        outputs.push((status, reader.join().unwrap()));
+    }
+    let all: String = outputs
+        .iter()
+        .map(|(_, o)| o.clone())
+        .collect::<Vec<_>>()
+        .join("\n----\n");
+    if let Err(e) = result {
+        eprintln!("{all}");
+        std::panic::resume_unwind(e);
+    }
+    for (status, _) in &outputs {
+        assert!(status.success(), "{status}\n{all}");
+    }
+    assert!(!all.contains("panicked"), "{all}");
+    assert!(
+        all.contains("[gateway h2] crashed (signal 9); restarting"),
+        "{all}"
+    );
+    let log = std::fs::read_to_string(dir.join("h2/nb.log")).unwrap();
+    let missing = log
+        .lines()
+        .find(|l| l.contains("leading value of master missing"))
+        .unwrap_or_else(|| panic!("{log}"));
+    let t_of = |l: &str| -> f64 { l[2..].split(' ').next().unwrap().parse().unwrap() };
+    let newest: f64 = missing
+        .split("newest sample t=")
+        .nth(1)
+        .and_then(|x| x.split(',').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("{missing}"));
+    let late = t_of(missing) - 0.020 - newest;
+    assert!(late > 0.050 && late <= 0.052, "{late}: {missing}");
+    assert!(log.contains("fb alarm 601"), "{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+    drop(hosts);
+}

@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""A tandem cell seen from Python, with nothing but the eclipse-zenoh package.
+
+Subscribes to everything of a cell (tandem/<cell>/**), sends commands as Zenoh queries to
+tandem/<cell>/<node>/<object>/cmd, asks which hosts are alive (liveliness), and prints one JSON
+summary on stdout: the keys seen and how often, the last state of every axis, the replies.
+
+  observe.py --cell line --connect tcp/10.0.0.1:7447 --seconds 4 \
+      --command followers/feed "MC_Power" --command followers/feed "MC_MoveVelocity --velocity 50"
+"""
+import argparse
+import json
+import sys
+import threading
+import time
+
+import zenoh
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--cell", required=True)
+    ap.add_argument("--connect", action="append", default=[], help="a gateway's endpoint")
+    ap.add_argument("--seconds", type=float, default=3.0, help="how long to watch")
+    ap.add_argument("--command", nargs=2, action="append", default=[], metavar=("NODE/OBJECT", "TEXT"))
+    a = ap.parse_args()
+
+    conf = zenoh.Config()
+    conf.insert_json5("mode", '"peer"')
+    if a.connect:
+        conf.insert_json5("connect/endpoints", json.dumps(a.connect))
+        conf.insert_json5("scouting/multicast/enabled", "false")
+    session = zenoh.open(conf)
+
+    counts = {}
+    last = {}
+    lock = threading.Lock()
+
+    def on_sample(sample):
+        key = str(sample.key_expr)
+        with lock:
+            counts[key] = counts.get(key, 0) + 1
+            if key.endswith("/state") or key.endswith("/health") or "/gateway/" in key:
+                try:
+                    last[key] = json.loads(sample.payload.to_string())
+                except ValueError:
+                    last[key] = {"malformed": True}
+
+    sub = session.declare_subscriber(f"tandem/{a.cell}/**", on_sample)
+    t0 = time.monotonic()
+    alive_events = []
+
+    def on_alive(sample):
+        kind = "gone" if sample.kind == zenoh.SampleKind.DELETE else "alive"
+        with lock:
+            alive_events.append([round(time.monotonic() - t0, 3), kind, str(sample.key_expr)])
+
+    alive_sub = session.liveliness().declare_subscriber(f"tandem/{a.cell}/alive/*", on_alive, history=True)
+    time.sleep(min(1.5, a.seconds))
+
+    replies = []
+    for target, text in a.command:
+        key = f"tandem/{a.cell}/{target}/cmd"
+        got = None
+        for reply in session.get(key, payload=text, timeout=10.0):
+            if reply.ok is not None:
+                got = json.loads(reply.ok.payload.to_string())
+            else:
+                got = {"outcome": "zenoh-error", "message": reply.err.payload.to_string()}
+        replies.append({"target": target, "text": text, "reply": got})
+        time.sleep(0.3)
+
+    time.sleep(max(0.0, a.seconds - 1.5))
+    alive = sorted(str(r.ok.key_expr) for r in session.liveliness().get(f"tandem/{a.cell}/alive/*", timeout=2.0) if r.ok is not None)
+    sub.undeclare()
+    alive_sub.undeclare()
+    with lock:
+        summary = {
+            "keys": counts,
+            "states": {k: v for k, v in last.items() if k.endswith("/state")},
+            "health": {k: v for k, v in last.items() if k.endswith("/health")},
+            "gateways": {k: v for k, v in last.items() if "/gateway/" in k},
+            "replies": replies,
+            "alive": alive,
+            "alive_events": alive_events,
+        }
+    session.close()
+    json.dump(summary, sys.stdout)
+    print()
+
+
+if __name__ == "__main__":
+    main()
