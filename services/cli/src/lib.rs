@@ -96,9 +96,10 @@ fn cli() -> Command {
         )
         .subcommand(
             Command::new("status")
-                .about("One snapshot of the running nodes of this host: axes and node health")
+                .about("One snapshot of the running nodes of this host: axes and node health (with --zenoh: of every host, through the gateways)")
                 .arg(cell_arg())
-                .arg(Arg::new("host").long("host")),
+                .arg(Arg::new("host").long("host"))
+                .arg(zenoh_arg()),
         )
         .subcommand(
             Command::new("watch")
@@ -117,6 +118,7 @@ fn cli() -> Command {
             Command::new("cmd")
                 .about("Send an instruction to an object of a running node: tandem cmd <node>/<object> <instruction> [--param value]... [--wait]")
                 .arg(cell_arg())
+                .arg(zenoh_arg())
                 .arg(Arg::new("target").required(true).help("<node>/<object>"))
                 .arg(Arg::new("instruction").required(true).help("e.g. MC_MoveAbsolute, MoveVelocity, gear_in"))
                 .arg(
@@ -191,6 +193,24 @@ pub fn run(args: Vec<OsString>, out: &mut impl Write, err: &mut impl Write) -> E
     }
 }
 
+fn zenoh_arg() -> Arg {
+    Arg::new("zenoh")
+        .long("zenoh")
+        .action(ArgAction::Append)
+        .value_name("ENDPOINT")
+        .help("Go through the cell's gateways over Zenoh, from any machine of the cell network: a gateway endpoint (tcp/10.0.0.1:7447; repeat for more), or `scout` to find them by multicast scouting. Give it before <node>/<object>")
+}
+
+/// The `--zenoh` endpoints, or `None` without `--zenoh`.
+fn zenoh_endpoints(m: &clap::ArgMatches) -> Option<Vec<String>> {
+    m.value_source("zenoh")?;
+    Some(
+        m.get_many::<String>("zenoh")
+            .map(|v| v.filter(|e| *e != "scout").cloned().collect())
+            .unwrap_or_default(),
+    )
+}
+
 fn cell_arg() -> Arg {
     Arg::new("cell")
         .long("cell")
@@ -218,7 +238,13 @@ fn running(name: &str, m: &clap::ArgMatches, out: &mut impl Write) -> Result<(),
             };
             live::up(cell, &o, out)
         }
-        "status" => live::status(&live::cell_path(m.get_one::<PathBuf>("cell"))?, host, out),
+        "status" => {
+            let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
+            match zenoh_endpoints(m) {
+                Some(e) => live::status_zenoh(&cell, &e, out),
+                None => live::status(&cell, host, out),
+            }
+        }
         "watch" => live::watch(
             &live::cell_path(m.get_one::<PathBuf>("cell"))?,
             host,

@@ -783,3 +783,146 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
         None => Ok(()),
     }
 }
+
+fn runtime() -> Result<tokio::runtime::Runtime, Fail> {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .map_err(|e| Fail(4, format!("cannot start the async runtime: {e}")))
+}
+
+fn client_fail(e: tandem_client::ClientError) -> Fail {
+    use tandem_client::ClientError as E;
+    let code = match &e {
+        E::Rejected { .. } | E::JobFailed { .. } => 1,
+        E::Invalid(_) => 2,
+        E::Timeout { .. } | E::Unreachable(_) => 3,
+        E::Zenoh(_) | E::Malformed(_) => 4,
+    };
+    Fail(code, e.to_string())
+}
+
+/// `tandem cmd --zenoh`: the same over Zenoh, through the cell's gateways, from any machine.
+#[allow(clippy::too_many_arguments)]
+pub fn cmd_zenoh(
+    cell_path: &Path,
+    endpoints: &[String],
+    target: &str,
+    instruction: &str,
+    params: &[(String, String)],
+    wait: bool,
+    timeout: Duration,
+    out: &mut impl Write,
+) -> Result<(), Fail> {
+    let cell = load(cell_path)?;
+    let (node, object) = target.split_once('/').ok_or_else(|| {
+        Fail(
+            2,
+            format!("`{target}`: address an object as <node>/<object>"),
+        )
+    })?;
+    // Check it here first, for an error message without a round trip.
+    tandem_config::script::parse_command(&cell, object, instruction, params)
+        .map_err(|m| Fail(2, m))?;
+    let mut line = instruction.to_string();
+    for (k, v) in params {
+        line.push_str(&format!(" --{k} {v}"));
+    }
+    runtime()?.block_on(async {
+        let c = tandem_client::Client::connect(&cell.name, endpoints)
+            .await
+            .map_err(client_fail)?;
+        let result = if wait {
+            c.execute(node, object, &line, timeout).await.map(|o| {
+                let _ = writeln!(out, "{target} {instruction}: accepted, job {}", o.job);
+                for e in &o.events {
+                    let _ = writeln!(
+                        out,
+                        "t={} {}",
+                        tandem_runtime::exec::Secs(e.t_ns),
+                        e.message
+                    );
+                }
+            })
+        } else {
+            c.command(node, object, &line, timeout).await.map(|a| {
+                let _ = writeln!(
+                    out,
+                    "{target} {instruction}: accepted, job {} at t={}",
+                    a.job,
+                    tandem_runtime::exec::Secs(a.t_ns)
+                );
+            })
+        };
+        let _ = c.close().await;
+        result.map_err(client_fail)
+    })
+}
+
+/// `tandem status --zenoh`: every axis of every host, from the gateways' telemetry.
+pub fn status_zenoh(
+    cell_path: &Path,
+    endpoints: &[String],
+    out: &mut impl Write,
+) -> Result<(), Fail> {
+    let cell = load(cell_path)?;
+    runtime()?.block_on(async {
+        let c = tandem_client::Client::connect(&cell.name, endpoints)
+            .await
+            .map_err(client_fail)?;
+        let window = Duration::from_secs_f64((3.0 / cell.telemetry_hz).max(0.3));
+        let hosts = c
+            .alive_hosts(Duration::from_secs(2))
+            .await
+            .map_err(client_fail)?;
+        let states = c.states(window).await.map_err(client_fail)?;
+        let _ = c.close().await;
+        let _ = writeln!(
+            out,
+            "hosts alive: {}",
+            if hosts.is_empty() {
+                "none".to_string()
+            } else {
+                hosts.join(", ")
+            }
+        );
+        let _ = writeln!(
+            out,
+            "{:<12} {:<14} {:<19} {:>13} {:>11} {:<9} {:>5} {:>4}",
+            "node", "axis", "state", "position", "velocity", "sync", "alarm", "job"
+        );
+        for a in &states {
+            let _ = writeln!(
+                out,
+                "{:<12} {:<14} {:<19} {:>13.4} {:>11.4} {:<9} {:>5} {:>4}",
+                a.node,
+                a.axis,
+                a.state,
+                a.position,
+                a.velocity,
+                a.sync,
+                if a.alarm == 0 {
+                    "-".to_string()
+                } else {
+                    a.alarm.to_string()
+                },
+                a.job
+            );
+        }
+        let missing: Vec<&str> = cell
+            .hosts
+            .iter()
+            .filter(|h| !hosts.contains(h))
+            .map(String::as_str)
+            .collect();
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(Fail(
+                3,
+                format!("hosts not reachable: {}", missing.join(", ")),
+            ))
+        }
+    })
+}

@@ -598,6 +598,67 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
                 && r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(200.0)
         });
 
+        // The CLI from the third namespace, through the gateways (tandem-client over Zenoh):
+        // status of every host, and a command awaited to its goal.
+        let zenoh = format!("tcp/{}:7447", hosts.addr(1));
+        let mut c = hosts.exec(2, &bin("tandem"));
+        c.arg("status")
+            .arg("--cell")
+            .arg(&cell)
+            .args(["--zenoh", &zenoh]);
+        let o = c.output().unwrap();
+        let st = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(
+            o.status.success(),
+            "{st}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(st.contains("hosts alive: h1, h2"), "{st}");
+        for axis in ["master", "fa", "fb", "spare"] {
+            assert!(
+                st.lines()
+                    .any(|l| l.split_whitespace().nth(1) == Some(axis)),
+                "{st}"
+            );
+        }
+        let mut c = hosts.exec(2, &bin("tandem"));
+        c.arg("cmd").arg("--cell").arg(&cell).args([
+            "--zenoh",
+            &zenoh,
+            "nb/spare",
+            "MC_MoveVelocity",
+            "--velocity",
+            "70",
+            "--wait",
+        ]);
+        let o = c.output().unwrap();
+        let said = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success(), "{said}");
+        assert!(said.contains("InVelocity"), "{said}");
+        let mut c = hosts.exec(2, &bin("tandem"));
+        c.arg("cmd").arg("--cell").arg(&cell).args([
+            "--zenoh",
+            &zenoh,
+            "nb/spare",
+            "MC_MoveAbsolute",
+            "--position",
+            "1",
+            "--velocity",
+            "0",
+        ]);
+        let o = c.output().unwrap();
+        let said = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert_eq!(o.status.code(), Some(1), "{said}");
+        assert!(said.contains("rejected with 16#80"), "{said}");
+
         // Kill host 2's gateway: its liveliness token goes, and comes back with the restart.
         let watcher = observe(&hosts, 2, &name, 8.0, &[]);
         std::thread::sleep(Duration::from_secs(3));

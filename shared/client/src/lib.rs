@@ -1,0 +1,306 @@
+//! tandem-client: a tandem cell over Zenoh, from any machine of the cell network.
+//!
+//! A user program (or the `tandem` CLI with `--zenoh`) connects to the cell's gateways, sends
+//! PLCopen instructions to technology objects and awaits their job outcomes, and reads the
+//! state of the axes. Everything is typed, async and bounded by a timeout; a failure is a
+//! [`ClientError`] that says what went wrong.
+//!
+//! ```no_run
+//! # async fn demo() -> Result<(), tandem_client::ClientError> {
+//! use std::time::Duration;
+//! let c = tandem_client::Client::connect("line", &["tcp/10.0.0.1:7447".into()]).await?;
+//! let outcome = c
+//!     .execute("leaders", "line", "MC_MoveVelocity --velocity 800", Duration::from_secs(10))
+//!     .await?;
+//! println!("{outcome:?}");
+//! # Ok(()) }
+//! ```
+
+use std::time::Duration;
+use tandem_protocol::json::{AxisState, EventJson, ReplyJson};
+use tandem_protocol::keys;
+
+/// What can go wrong, with what the cell said.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ClientError {
+    /// Zenoh failed (session, declaration, query).
+    Zenoh(String),
+    /// Nothing came within the timeout.
+    Timeout {
+        /// What was awaited.
+        what: String,
+    },
+    /// The object rejected the instruction; its running job goes on.
+    Rejected {
+        /// `16#8003 IllegalVelocity`.
+        error_id: String,
+        /// In words.
+        message: String,
+    },
+    /// The instruction was not understood (unknown object, instruction or parameter).
+    Invalid(String),
+    /// The node did not answer (not running) or its queue was full.
+    Unreachable(String),
+    /// The job ended in error or was aborted.
+    JobFailed {
+        /// `error` or `aborted`.
+        outcome: String,
+        /// The ErrorID of an error.
+        error_id: String,
+        /// The event, as the log shows it.
+        message: String,
+    },
+    /// A payload that is not what the protocol says.
+    Malformed(String),
+}
+
+impl core::fmt::Display for ClientError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Zenoh(m) => write!(f, "zenoh: {m}"),
+            Self::Timeout { what } => write!(f, "no answer: {what}"),
+            Self::Rejected { error_id, message } => {
+                write!(
+                    f,
+                    "rejected with {error_id}: {message}; the running job goes on"
+                )
+            }
+            Self::Invalid(m) => write!(f, "not understood: {m}"),
+            Self::Unreachable(m) => write!(f, "unreachable: {m}"),
+            Self::JobFailed {
+                outcome,
+                error_id,
+                message,
+            } => {
+                if error_id.is_empty() {
+                    write!(f, "the job was {outcome}: {message}")
+                } else {
+                    write!(f, "the job ended with {error_id}: {message}")
+                }
+            }
+            Self::Malformed(m) => write!(f, "malformed answer: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for ClientError {}
+
+/// An accepted instruction.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Accepted {
+    /// The job (0 for instructions without one).
+    pub job: u32,
+    /// The cycle time it was applied at (ns).
+    pub t_ns: i64,
+}
+
+/// How an awaited job went: the events seen, the last one ending it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobOutcome {
+    /// The job.
+    pub job: u32,
+    /// Every event of the job, in order; the last is `done` or `reached`.
+    pub events: Vec<EventJson>,
+}
+
+/// A connection to one cell.
+#[derive(Debug)]
+pub struct Client {
+    session: zenoh::Session,
+    cell: String,
+}
+
+fn z(e: impl core::fmt::Display) -> ClientError {
+    ClientError::Zenoh(e.to_string())
+}
+
+impl Client {
+    /// Connects to cell `cell` through the gateways at `endpoints` (`tcp/10.0.0.1:7447`);
+    /// with none, Zenoh's multicast scouting finds them.
+    pub async fn connect(cell: &str, endpoints: &[String]) -> Result<Client, ClientError> {
+        let mut config = zenoh::Config::default();
+        config.insert_json5("mode", "\"peer\"").map_err(z)?;
+        if !endpoints.is_empty() {
+            let list = serde_json::to_string(endpoints).map_err(z)?;
+            config.insert_json5("connect/endpoints", &list).map_err(z)?;
+            config
+                .insert_json5("scouting/multicast/enabled", "false")
+                .map_err(z)?;
+        }
+        let session = zenoh::open(config).await.map_err(z)?;
+        Ok(Client {
+            session,
+            cell: cell.into(),
+        })
+    }
+
+    /// Sends `line` (`MC_MoveAbsolute --position 10`, the names and parameters of scripts) to
+    /// `object` of `node` and returns when the node applied it.
+    pub async fn command(
+        &self,
+        node: &str,
+        object: &str,
+        line: &str,
+        timeout: Duration,
+    ) -> Result<Accepted, ClientError> {
+        let key = keys::command(&self.cell, node, object);
+        let replies = self
+            .session
+            .get(&key)
+            .payload(line)
+            .timeout(timeout)
+            .await
+            .map_err(z)?;
+        let reply = tokio::time::timeout(timeout, replies.recv_async())
+            .await
+            .map_err(|_| ClientError::Timeout {
+                what: format!("{key}: no reply within {timeout:?}"),
+            })?
+            .map_err(|_| {
+                ClientError::Unreachable(format!(
+                    "{key}: no gateway answered (is the node's host up? `tandem status` there)"
+                ))
+            })?;
+        let sample = reply.result().map_err(|e| {
+            ClientError::Zenoh(
+                e.payload()
+                    .try_to_string()
+                    .map(|s| s.to_string())
+                    .unwrap_or_default(),
+            )
+        })?;
+        let text = sample
+            .payload()
+            .try_to_string()
+            .map_err(|e| ClientError::Malformed(e.to_string()))?;
+        let r: ReplyJson = serde_json::from_str(&text)
+            .map_err(|e| ClientError::Malformed(format!("{e}: {text}")))?;
+        match r.outcome.as_str() {
+            "accepted" => Ok(Accepted {
+                job: r.job,
+                t_ns: r.t_ns,
+            }),
+            "rejected" => Err(ClientError::Rejected {
+                error_id: r.error_id,
+                message: r.message,
+            }),
+            "invalid" => Err(ClientError::Invalid(r.message)),
+            "busy" | "unreachable" => Err(ClientError::Unreachable(r.message)),
+            other => Err(ClientError::Malformed(format!("outcome `{other}`"))),
+        }
+    }
+
+    /// Sends `line` and awaits the job: `Ok` when it is done or reached its goal (InVelocity,
+    /// InGear, InSync, Status TRUE), [`ClientError::JobFailed`] when it ended in error or was
+    /// aborted. An instruction without a job returns at once with no events.
+    pub async fn execute(
+        &self,
+        node: &str,
+        object: &str,
+        line: &str,
+        timeout: Duration,
+    ) -> Result<JobOutcome, ClientError> {
+        // Subscribe first, so no event of the job is missed.
+        let events = self
+            .session
+            .declare_subscriber(keys::events(&self.cell, node, object))
+            .await
+            .map_err(z)?;
+        let accepted = self.command(node, object, line, timeout).await?;
+        let mut out = JobOutcome {
+            job: accepted.job,
+            events: Vec::new(),
+        };
+        if accepted.job == 0 {
+            return Ok(out);
+        }
+        let deadline = tokio::time::Instant::now() + timeout;
+        loop {
+            let sample = tokio::time::timeout_at(deadline, events.recv_async())
+                .await
+                .map_err(|_| ClientError::Timeout {
+                    what: format!(
+                        "job {} of {node}/{object} did not end within {timeout:?}",
+                        accepted.job
+                    ),
+                })?
+                .map_err(z)?;
+            let text = sample
+                .payload()
+                .try_to_string()
+                .map_err(|e| ClientError::Malformed(e.to_string()))?
+                .to_string();
+            let Ok(e) = serde_json::from_str::<EventJson>(&text) else {
+                continue;
+            };
+            if e.job != accepted.job {
+                continue;
+            }
+            let outcome = e.outcome.clone();
+            out.events.push(e);
+            match outcome.as_str() {
+                "done" | "reached" => return Ok(out),
+                "error" | "aborted" => {
+                    let last = out.events.last().cloned();
+                    return Err(ClientError::JobFailed {
+                        outcome,
+                        error_id: last
+                            .as_ref()
+                            .map(|x| x.error_id.clone())
+                            .unwrap_or_default(),
+                        message: last.map(|x| x.message).unwrap_or_default(),
+                    });
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The state of every axis the gateways publish, collected for `window` (at least one
+    /// telemetry period), sorted by node and axis.
+    pub async fn states(&self, window: Duration) -> Result<Vec<AxisState>, ClientError> {
+        let sub = self
+            .session
+            .declare_subscriber(format!("tandem/{}/*/*/state", self.cell))
+            .await
+            .map_err(z)?;
+        let mut seen: std::collections::BTreeMap<(String, String), AxisState> =
+            std::collections::BTreeMap::new();
+        let deadline = tokio::time::Instant::now() + window;
+        while let Ok(Ok(s)) = tokio::time::timeout_at(deadline, sub.recv_async()).await {
+            let Ok(text) = s.payload().try_to_string() else {
+                continue;
+            };
+            if let Ok(a) = serde_json::from_str::<AxisState>(&text) {
+                seen.insert((a.node.clone(), a.axis.clone()), a);
+            }
+        }
+        Ok(seen.into_values().collect())
+    }
+
+    /// The hosts whose gateways are alive (liveliness tokens).
+    pub async fn alive_hosts(&self, timeout: Duration) -> Result<Vec<String>, ClientError> {
+        let replies = self
+            .session
+            .liveliness()
+            .get(keys::alive_all(&self.cell))
+            .timeout(timeout)
+            .await
+            .map_err(z)?;
+        let mut hosts = Vec::new();
+        while let Ok(r) = replies.recv_async().await {
+            if let Ok(s) = r.result() {
+                if let Some(h) = s.key_expr().as_str().rsplit('/').next() {
+                    hosts.push(h.to_string());
+                }
+            }
+        }
+        hosts.sort();
+        Ok(hosts)
+    }
+
+    /// Closes the session.
+    pub async fn close(self) -> Result<(), ClientError> {
+        self.session.close().await.map_err(z)
+    }
+}
