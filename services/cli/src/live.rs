@@ -784,6 +784,18 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
     }
 }
 
+/// The given endpoints plus every host's listen endpoints from the cell file (with none given
+/// and none in the cell: multicast scouting).
+fn with_cell_endpoints(cell: &Cell, given: &[String]) -> Vec<String> {
+    let mut all: Vec<String> = given.to_vec();
+    for e in cell.host_listen.iter().flatten() {
+        if !all.contains(e) {
+            all.push(e.clone());
+        }
+    }
+    all
+}
+
 fn runtime() -> Result<tokio::runtime::Runtime, Fail> {
     tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -830,7 +842,7 @@ pub fn cmd_zenoh(
         line.push_str(&format!(" --{k} {v}"));
     }
     runtime()?.block_on(async {
-        let c = tandem_client::Client::connect(&cell.name, endpoints)
+        let c = tandem_client::Client::connect(&cell.name, &with_cell_endpoints(&cell, endpoints))
             .await
             .map_err(client_fail)?;
         let result = if wait {
@@ -868,15 +880,15 @@ pub fn status_zenoh(
 ) -> Result<(), Fail> {
     let cell = load(cell_path)?;
     runtime()?.block_on(async {
-        let c = tandem_client::Client::connect(&cell.name, endpoints)
+        let c = tandem_client::Client::connect(&cell.name, &with_cell_endpoints(&cell, endpoints))
             .await
             .map_err(client_fail)?;
         let window = Duration::from_secs_f64((3.0 / cell.telemetry_hz).max(0.3));
+        let states = c.states(window).await.map_err(client_fail)?;
         let hosts = c
             .alive_hosts(Duration::from_secs(2))
             .await
             .map_err(client_fail)?;
-        let states = c.states(window).await.map_err(client_fail)?;
         let _ = c.close().await;
         let _ = writeln!(
             out,
