@@ -73,7 +73,7 @@ fn cli() -> Command {
                     Arg::new("duration")
                         .long("duration")
                         .value_parser(clap::value_parser!(f64))
-                        .help("Stop after this many seconds (default: the script's duration, else Ctrl-C)"),
+                        .help("Stop at this engine time in seconds, counted from the epoch (default: the script's duration, else Ctrl-C)"),
                 )
                 .arg(
                     Arg::new("no-view")
