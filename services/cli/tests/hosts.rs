@@ -151,6 +151,15 @@ fn column(p: &Path, col: &str) -> HashMap<i64, f64> {
         .collect()
 }
 
+/// The leading-value delay and tolerance of the test cells (s): generous, because the hosts
+/// share two CPUs of a VM whose stalls reach a few hundred ms under load; a sample later than
+/// D would be extrapolated on host 2 and the followers would differ by the extrapolation error.
+const D_S: f64 = 0.1;
+const TOL_S: f64 = 0.15;
+
+/// The tests take turns: each runs several processes per host on two CPUs.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 const CELL: &str = r#"
 [cell]
 name = "CELLNAME"
@@ -178,8 +187,8 @@ node = "na"
 virtual = true
 
 [axes.master.leading_value]
-delay_us = 20000
-tolerance_us = 50000
+delay_us = 100000
+tolerance_us = 150000
 
 [axes.master.dynamics]
 max_velocity = 2000.0
@@ -229,6 +238,58 @@ acceleration = 10000.0
 deceleration = 10000.0
 jerk = 200000.0
 emergency_deceleration = 40000.0
+
+[cams.wave]
+[[cams.wave.segments]]
+type = "polynomial"
+x = [0.0, 500.0]
+coeffs = [0.0, 360.0, 0.0, 0.0, -3150.0, 7560.0, -6300.0, 1800.0]
+
+[axes.ca]
+node = "na"
+kind = "synchronous"
+motion_type = "rotary"
+virtual = true
+
+[axes.ca.modulo]
+length = 360.0
+
+[axes.ca.leaders]
+master = "setpoint"
+
+[axes.ca.dynamics]
+max_velocity = 36000.0
+max_acceleration = 360000.0
+max_deceleration = 360000.0
+max_jerk = 7200000.0
+velocity = 1800.0
+acceleration = 18000.0
+deceleration = 18000.0
+jerk = 360000.0
+emergency_deceleration = 720000.0
+
+[axes.cb]
+node = "nb"
+kind = "synchronous"
+motion_type = "rotary"
+virtual = true
+
+[axes.cb.modulo]
+length = 360.0
+
+[axes.cb.leaders]
+"na/master" = "setpoint"
+
+[axes.cb.dynamics]
+max_velocity = 36000.0
+max_acceleration = 360000.0
+max_deceleration = 360000.0
+max_jerk = 7200000.0
+velocity = 1800.0
+acceleration = 18000.0
+deceleration = 18000.0
+jerk = 360000.0
+emergency_deceleration = 720000.0
 "#;
 
 /// Power, gear both followers, then jerk-limited moves of the leader with reversals.
@@ -242,6 +303,14 @@ fn script(seconds: f64) -> String {
          [[at]]\nt = 0.1\naxis = \"fa\"\ninstruction = \"MC_GearIn\"\nmaster = \"master\"\n\n\
          [[at]]\nt = 0.1\naxis = \"fb\"\ninstruction = \"MC_GearIn\"\nmaster = \"master\"\n\n"
     );
+    // The cammed pair: a cyclic appending cam (one turn per 500 of leader), synchronous at once.
+    for axis in ["ca", "cb"] {
+        s.push_str(&format!(
+            "[[at]]\nt = 0.0\naxis = \"{axis}\"\ninstruction = \"MC_Power\"\n\n\
+             [[at]]\nt = 0.1\naxis = \"{axis}\"\ninstruction = \"MC_CamIn\"\nmaster = \"master\"\n\
+             cam = \"wave\"\nsync_profile_reference = 2\napplication_mode = 2\n\n"
+        ));
+    }
     let mut t = 0.5;
     let mut target = 600.0;
     while t < seconds - 1.0 {
@@ -256,9 +325,11 @@ fn script(seconds: f64) -> String {
 
 /// A leader on host 1 with a local follower and a follower on host 2: the two followers agree
 /// within 1e-6 at every common cycle over 10 s of moves with reversals, through iceoryx2 on
-/// host 1 and gateway, Zenoh over veth, gateway, iceoryx2 on host 2.
+/// host 1 and gateway, Zenoh over veth, gateway, iceoryx2 on host 2; geared (fa, fb) and, in
+/// the same run, cammed (ca, cb).
 #[test]
 fn followers_on_two_hosts_move_in_phase() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let hosts = Hosts::new("s", 2);
     let dir = std::env::temp_dir().join(format!("tandem-hosts-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -355,6 +426,47 @@ fn followers_on_two_hosts_move_in_phase() {
         worst <= 1e-6,
         "the followers differ by up to {worst}\n{all}"
     );
+    // The cammed pair: in phase too, and really cammed (moving, CamIn to the end).
+    let ca = column(&dir.join("h1/na.csv"), "ca.position");
+    let cb = column(&dir.join("h2/nb.csv"), "cb.position");
+    let mut worst_cam = 0.0f64;
+    let mut moved = 0.0f64;
+    for t in &times {
+        let Some(b) = cb.get(t) else { continue };
+        let mut d = (ca[t] - b).rem_euclid(360.0);
+        d -= 360.0 * (d / 360.0).round();
+        worst_cam = worst_cam.max(d.abs());
+        moved = moved.max((ca[t] - ca[&times[0]]).abs());
+    }
+    assert!(moved > 10.0, "the cammed follower moved {moved}");
+    assert!(
+        worst_cam <= 1e-6,
+        "the cammed followers differ by up to {worst_cam}"
+    );
+    let last = |p: &Path, col: &str| -> String {
+        let s = std::fs::read_to_string(p).unwrap();
+        let head: Vec<&str> = s.lines().next().unwrap().split(',').collect();
+        let c = head.iter().position(|h| *h == col).unwrap();
+        s.lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .nth(c)
+            .unwrap()
+            .to_string()
+    };
+    for (p, axis) in [("h1/na.csv", "ca"), ("h2/nb.csv", "cb")] {
+        assert_eq!(
+            last(&dir.join(p), &format!("{axis}.job")),
+            "MC_CamIn",
+            "{axis}"
+        );
+        assert_eq!(
+            last(&dir.join(p), &format!("{axis}.state")),
+            "SynchronizedMotion",
+            "{axis}"
+        );
+    }
     let logs = std::fs::read_to_string(dir.join("h2/nb.log")).unwrap();
     assert!(
         !logs.contains("missing") && !logs.contains(" alarm "),
@@ -382,7 +494,14 @@ fn pid_of(words: &[&str]) -> Option<u32> {
 }
 
 /// The Python observer (tests/python/observe.py, eclipse-zenoh) in namespace `ns` of `hosts`.
-fn observe(hosts: &Hosts, ns: usize, cell: &str, seconds: f64, commands: &[(&str, &str)]) -> Child {
+fn observe(
+    hosts: &Hosts,
+    ns: usize,
+    cell: &str,
+    seconds: f64,
+    commands: &[(&str, &str)],
+    garbage: &[String],
+) -> Child {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/python/observe.py");
     let mut c = hosts.exec(ns, Path::new("python3"));
     c.arg(script)
@@ -391,6 +510,9 @@ fn observe(hosts: &Hosts, ns: usize, cell: &str, seconds: f64, commands: &[(&str
         .args(["--connect", &format!("tcp/{}:7447", hosts.addr(1))]);
     for (target, text) in commands {
         c.arg("--command").arg(target).arg(text);
+    }
+    for key in garbage {
+        c.arg("--garbage").arg(key);
     }
     c.stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -451,12 +573,14 @@ emergency_deceleration = 10000.0
 "#;
 
 /// Observation from a third namespace with Python (eclipse-zenoh): the telemetry of both hosts,
-/// commands as queries (accepted, rejected with an ErrorID, malformed), the hosts' liveliness.
+/// commands as queries (accepted, rejected with an ErrorID, malformed), the hosts' liveliness,
+/// the gateways' counters (malformed leading values dropped and counted) and clock watch.
 /// Then faults: cutting host 2's link for a second stops its follower with 601 within the
 /// tolerance, nothing crashes, and after the link returns and a reset it couples again; a killed
 /// gateway is seen gone and back through liveliness, restarted by its supervisor.
 #[test]
 fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gateway() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let hosts = Hosts::new("o", 3);
     let dir = std::env::temp_dir().join(format!("tandem-hosts-o-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -523,7 +647,28 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
                 ),
                 ("nb/spare", "{not json"),
             ],
+            &[
+                format!("tandem/{name}/lv/master"),
+                format!("tandem/{name}/lv/nosuch/x/y"),
+            ],
         ));
+        // Malformed payloads were dropped and counted by both gateways; the clocks (one machine)
+        // agree; the follower on host 2 was not disturbed.
+        for host in ["h1", "h2"] {
+            let g = &seen["gateways"][&format!("tandem/{name}/gateway/{host}")];
+            assert!(g["malformed"].as_u64().unwrap_or(0) >= 3, "{host}: {seen}");
+            assert!(
+                g["clock_offset_us"].as_f64().unwrap_or(1e9).abs() < 1000.0,
+                "{host}: {seen}"
+            );
+            assert_eq!(g["clock_warnings"], 0, "{host}: {seen}");
+        }
+        let r = row(&hosts, 1, &cell, "h2", "fb");
+        assert_eq!(
+            r.get(2).map(String::as_str),
+            Some("SynchronizedMotion"),
+            "{r:?}"
+        );
         for (node, axis) in [
             ("na", "master"),
             ("na", "fa"),
@@ -660,7 +805,7 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
         assert!(said.contains("rejected with 16#80"), "{said}");
 
         // Kill host 2's gateway: its liveliness token goes, and comes back with the restart.
-        let watcher = observe(&hosts, 2, &name, 8.0, &[]);
+        let watcher = observe(&hosts, 2, &name, 8.0, &[], &[]);
         std::thread::sleep(Duration::from_secs(3));
         let cell_s = cell.to_string_lossy().to_string();
         let pid = pid_of(&["tandem-gateway", &cell_s, "h2"]).expect("host 2's gateway");
@@ -720,8 +865,8 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
         .and_then(|x| x.split(',').next())
         .and_then(|x| x.parse().ok())
         .unwrap_or_else(|| panic!("{missing}"));
-    let late = t_of(missing) - 0.020 - newest;
-    assert!(late > 0.050 && late <= 0.052, "{late}: {missing}");
+    let late = t_of(missing) - D_S - newest;
+    assert!(late > TOL_S && late <= TOL_S + 0.002, "{late}: {missing}");
     assert!(log.contains("fb alarm 601"), "{log}");
     let _ = std::fs::remove_dir_all(&dir);
     drop(hosts);

@@ -25,7 +25,7 @@ use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tandem_config::{Cell, Coupling, LEADING_BUFFER};
+use tandem_config::{Cell, Coupling};
 use tandem_node::rt;
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
@@ -113,14 +113,6 @@ fn plan(cell: &Cell, h: usize) -> Plan {
         }
     }
     p
-}
-
-fn history(cell: &Cell, l: usize) -> usize {
-    let lv = cell.leading[l];
-    let cycle = cell
-        .leader_node(l)
-        .map_or(1_000_000, |n| cell.nodes[n].cycle_ns);
-    (((lv.delay_ns + lv.tolerance_ns) / cycle.max(1)) as usize + 4).min(LEADING_BUFFER)
 }
 
 /// The Zenoh configuration of host `h`: peer mode, listening on the host's endpoints and
@@ -339,11 +331,17 @@ fn lv_out(
     let mut routes = Vec::new();
     for (l, cp, _) in &plan.out {
         let actual = *cp == Coupling::Actual;
-        let svc = ipc::leading_values(&node, &cell.name, names[*l], actual, history(cell, *l))
-            .map_err(|e| e.to_string())?;
+        let svc = ipc::leading_values(
+            &node,
+            &cell.name,
+            names[*l],
+            actual,
+            cell.leading_history(*l),
+        )
+        .map_err(|e| e.to_string())?;
         let sub = svc
             .subscriber_builder()
-            .buffer_size(history(cell, *l))
+            .buffer_size(cell.leading_history(*l))
             .create()
             .map_err(|e| format!("subscriber: {e}"))?;
         let key = keys::leading_value(&cell.name, names[*l], actual);
@@ -389,16 +387,23 @@ fn lv_in(
 ) -> Result<(), String> {
     let node = iox(cell, host, "lv-in")?;
     let names = cell.object_names();
-    let mut publishers = HashMap::new();
+    // (leader name, actual, leader index, publisher): looked up by &str, no allocation per sample.
+    let mut publishers = Vec::new();
     for (l, cp) in &plan.inn {
         let actual = *cp == Coupling::Actual;
-        let svc = ipc::leading_values(&node, &cell.name, names[*l], actual, history(cell, *l))
-            .map_err(|e| e.to_string())?;
+        let svc = ipc::leading_values(
+            &node,
+            &cell.name,
+            names[*l],
+            actual,
+            cell.leading_history(*l),
+        )
+        .map_err(|e| e.to_string())?;
         let p = svc
             .publisher_builder()
             .create()
             .map_err(|e| format!("publisher: {e}"))?;
-        publishers.insert((names[*l].to_string(), actual), (*l, p));
+        publishers.push((names[*l], actual, *l, p));
     }
     // Every leading value of the cell, so that a malformed one on any lv key is counted.
     let sub = session
@@ -410,13 +415,17 @@ fn lv_in(
         let Ok(Some(sample)) = sub.recv_timeout(Duration::from_millis(50)) else {
             continue;
         };
-        let key = sample.key_expr().as_str().to_string();
-        let Some((leader, actual)) = keys::parse_leading_value(&cell.name, &key) else {
+        let Some((leader, actual)) =
+            keys::parse_leading_value(&cell.name, sample.key_expr().as_str())
+        else {
             c.malformed.fetch_add(1, Ordering::Relaxed);
             continue;
         };
         let decoded = json::decode_leading_value(&sample.payload().to_bytes());
-        let Some((l, p)) = publishers.get(&(leader.to_string(), actual)) else {
+        let Some((_, _, l, p)) = publishers
+            .iter()
+            .find(|(n, a, _, _)| *n == leader && *a == actual)
+        else {
             // A leader nobody here follows: not ours to forward (but still checked).
             if decoded.is_err() {
                 c.malformed.fetch_add(1, Ordering::Relaxed);

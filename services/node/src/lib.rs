@@ -20,7 +20,7 @@ use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};
 use std::sync::Arc;
 use std::time::Duration;
 use tandem_config::script::{split_command, Action, ScriptEntry};
-use tandem_config::{Cell, Coupling, LEADING_BUFFER};
+use tandem_config::{Cell, Coupling};
 use tandem_motion::axis::AxisStatus;
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::names;
@@ -323,13 +323,7 @@ fn cyclic(
     let host = &cell.hosts[me.host];
     let iox = ipc::node(&names::node(&cell.name, &me.name), host).map_err(|e| e.to_string())?;
     let mut exec = Executive::new(cell, Some(n)).map_err(|e| e.to_string())?;
-    let history = |l: usize| {
-        let lv = cell.leading[l];
-        let cycle = cell
-            .leader_node(l)
-            .map_or(me.cycle_ns, |x| cell.nodes[x].cycle_ns);
-        (((lv.delay_ns + lv.tolerance_ns) / cycle.max(1)) as usize + 4).min(LEADING_BUFFER)
-    };
+    let history = |l: usize| cell.leading_history(l);
     let names_of = cell.object_names();
     // Leading values this node publishes: the leaders here that followers elsewhere name.
     let mut publish = Vec::new();

@@ -348,6 +348,18 @@ impl Cell {
         out
     }
 
+    /// The samples of leader `leader` its iceoryx2 service keeps for late joiners and each
+    /// subscriber buffers: the delay plus the tolerance in leader cycles, plus four.
+    pub fn leading_history(&self, leader: usize) -> usize {
+        let Some(lv) = self.leading.get(leader) else {
+            return 4;
+        };
+        let cycle = self
+            .leader_node(leader)
+            .map_or(1_000_000, |n| self.nodes[n].cycle_ns);
+        (((lv.delay_ns + lv.tolerance_ns) / cycle.max(1)) as usize + 4).min(LEADING_BUFFER)
+    }
+
     /// The index of the node named `name`.
     pub fn node(&self, name: &str) -> Option<usize> {
         self.nodes.iter().position(|n| n.name == name)
