@@ -23,6 +23,8 @@ def main():
     ap.add_argument("--connect", action="append", default=[], help="a gateway's endpoint")
     ap.add_argument("--seconds", type=float, default=3.0, help="how long to watch")
     ap.add_argument("--command", nargs=2, action="append", default=[], metavar=("NODE/OBJECT", "TEXT"))
+    ap.add_argument("--garbage", action="append", default=[], metavar="KEY",
+                    help="put a malformed payload on this key first (the gateways must drop and count it)")
     a = ap.parse_args()
 
     conf = zenoh.Config()
@@ -56,6 +58,9 @@ def main():
             alive_events.append([round(time.monotonic() - t0, 3), kind, str(sample.key_expr)])
 
     alive_sub = session.liveliness().declare_subscriber(f"tandem/{a.cell}/alive/*", on_alive, history=True)
+    for key in a.garbage:
+        for payload in (b"", b"\x00garbage", bytes(range(64)) + b"!"):
+            session.put(key, payload)
     time.sleep(min(1.5, a.seconds))
 
     replies = []

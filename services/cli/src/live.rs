@@ -156,6 +156,27 @@ impl Observer {
     }
 }
 
+/// The header of the axis table of `status`, `watch` and `up`.
+const HEADER: &str = "node         axis           state                    position    velocity sync      alarm  job";
+
+/// One row of the axis table.
+fn table_row(
+    node: &str,
+    axis: &str,
+    state: &str,
+    (position, velocity): (f64, f64),
+    sync: &str,
+    alarm: u32,
+    job: u32,
+) -> String {
+    let alarm = if alarm == 0 {
+        "-".to_string()
+    } else {
+        alarm.to_string()
+    };
+    format!("{node:<12} {axis:<14} {state:<19} {position:>13.4} {velocity:>11.4} {sync:<9} {alarm:>5} {job:>4}")
+}
+
 fn sync_name(code: u32) -> &'static str {
     match code {
         1 => "GearIn",
@@ -169,11 +190,7 @@ fn sync_name(code: u32) -> &'static str {
 fn render(cell: &Cell, obs: &Observer, nodes: &[usize], pattern: Option<&str>) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{:<12} {:<14} {:<19} {:>13} {:>11} {:<9} {:>5} {:>4}",
-        "node", "axis", "state", "position", "velocity", "sync", "alarm", "job"
-    );
+    let _ = writeln!(s, "{HEADER}");
     for n in nodes {
         let name = &cell.nodes[*n].name;
         match (&obs.last[*n], obs.alive(*n)) {
@@ -186,22 +203,18 @@ fn render(cell: &Cell, obs: &Observer, nodes: &[usize], pattern: Option<&str>) -
                     if pattern.is_some_and(|p| !format!("{name}/{axis}").contains(p)) {
                         continue;
                     }
-                    let alarm = if a.alarm == 0 {
-                        "-".to_string()
-                    } else {
-                        a.alarm.to_string()
-                    };
                     let _ = writeln!(
                         s,
-                        "{:<12} {:<14} {:<19} {:>13.4} {:>11.4} {:<9} {:>5} {:>4}",
-                        name,
-                        axis,
-                        a.state_name(),
-                        a.position,
-                        a.velocity,
-                        sync_name(a.sync_function),
-                        alarm,
-                        a.job
+                        "{}",
+                        table_row(
+                            name,
+                            axis,
+                            a.state_name(),
+                            (a.position, a.velocity),
+                            sync_name(a.sync_function),
+                            a.alarm,
+                            a.job
+                        )
                     );
                 }
             }
@@ -899,28 +912,23 @@ pub fn status_zenoh(
                 hosts.join(", ")
             }
         );
-        let _ = writeln!(
-            out,
-            "{:<12} {:<14} {:<19} {:>13} {:>11} {:<9} {:>5} {:>4}",
-            "node", "axis", "state", "position", "velocity", "sync", "alarm", "job"
-        );
+        let _ = writeln!(out, "{HEADER}");
         for a in &states {
-            let _ = writeln!(
-                out,
-                "{:<12} {:<14} {:<19} {:>13.4} {:>11.4} {:<9} {:>5} {:>4}",
-                a.node,
-                a.axis,
-                a.state,
-                a.position,
-                a.velocity,
-                a.sync,
-                if a.alarm == 0 {
-                    "-".to_string()
-                } else {
-                    a.alarm.to_string()
-                },
-                a.job
+            let sync = if a.sync == "none" {
+                "-"
+            } else {
+                a.sync.as_str()
+            };
+            let row = table_row(
+                &a.node,
+                &a.axis,
+                &a.state,
+                (a.position, a.velocity),
+                sync,
+                a.alarm,
+                a.job,
             );
+            let _ = writeln!(out, "{row}");
         }
         let missing: Vec<&str> = cell
             .hosts

@@ -7,11 +7,12 @@
 //! followers agree within 1e-6.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+use common::{spawn_collect, until, wait_for};
 use std::collections::HashMap;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 fn bin(name: &str) -> PathBuf {
     let p = Path::new(env!("CARGO_BIN_EXE_tandem")).with_file_name(name);
@@ -97,42 +98,6 @@ impl Drop for Hosts {
         for ns in self.names.iter().chain(std::iter::once(&self.hub)) {
             let _ = Command::new("ip").args(["netns", "del", ns]).output();
         }
-    }
-}
-
-fn spawn_collect(mut c: Command) -> (Child, std::thread::JoinHandle<String>) {
-    let mut child = c
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = child.stdout.take().unwrap();
-    let mut err = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let errors = std::thread::spawn(move || {
-            let mut s = String::new();
-            let _ = err.read_to_string(&mut s);
-            s
-        });
-        let mut s = String::new();
-        let _ = out.read_to_string(&mut s);
-        s + &errors.join().unwrap_or_default()
-    });
-    (child, reader)
-}
-
-fn wait_for(child: &mut Child, limit: Duration, what: &str) -> std::process::ExitStatus {
-    let deadline = Instant::now() + limit;
-    loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            return s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{what} did not end within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
     }
 }
 
@@ -547,14 +512,6 @@ fn row(hosts: &Hosts, i: usize, cell: &Path, host: &str, axis: &str) -> Vec<Stri
         .unwrap_or_default()
 }
 
-fn until(limit: Duration, what: &str, mut f: impl FnMut() -> bool) {
-    let deadline = Instant::now() + limit;
-    while !f() {
-        assert!(Instant::now() < deadline, "{what}: not within {limit:?}");
-        std::thread::sleep(Duration::from_millis(100));
-    }
-}
-
 const SPARE: &str = r#"
 [axes.spare]
 node = "nb"
@@ -746,18 +703,19 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
         // The CLI from the third namespace, through the gateways (tandem-client over Zenoh):
         // status of every host, and a command awaited to its goal.
         let zenoh = format!("tcp/{}:7447", hosts.addr(1));
-        let mut c = hosts.exec(2, &bin("tandem"));
-        c.arg("status")
-            .arg("--cell")
-            .arg(&cell)
-            .args(["--zenoh", &zenoh]);
-        let o = c.output().unwrap();
-        let st = String::from_utf8_lossy(&o.stdout).to_string();
-        assert!(
-            o.status.success(),
-            "{st}{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        let tandem_in_3 = |args: &[&str]| -> (Option<i32>, String) {
+            let mut c = hosts.exec(2, &bin("tandem"));
+            c.args([args[0], "--cell"])
+                .arg(&cell)
+                .args(["--zenoh", &zenoh])
+                .args(&args[1..]);
+            let o = c.output().unwrap();
+            let said = String::from_utf8_lossy(&o.stdout).to_string()
+                + &String::from_utf8_lossy(&o.stderr);
+            (o.status.code(), said)
+        };
+        let (code, st) = tandem_in_3(&["status"]);
+        assert_eq!(code, Some(0), "{st}");
         assert!(st.contains("hosts alive: h1, h2"), "{st}");
         for axis in ["master", "fa", "fb", "spare"] {
             assert!(
@@ -766,28 +724,18 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
                 "{st}"
             );
         }
-        let mut c = hosts.exec(2, &bin("tandem"));
-        c.arg("cmd").arg("--cell").arg(&cell).args([
-            "--zenoh",
-            &zenoh,
+        let (code, said) = tandem_in_3(&[
+            "cmd",
             "nb/spare",
             "MC_MoveVelocity",
             "--velocity",
             "70",
             "--wait",
         ]);
-        let o = c.output().unwrap();
-        let said = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        assert!(o.status.success(), "{said}");
+        assert_eq!(code, Some(0), "{said}");
         assert!(said.contains("InVelocity"), "{said}");
-        let mut c = hosts.exec(2, &bin("tandem"));
-        c.arg("cmd").arg("--cell").arg(&cell).args([
-            "--zenoh",
-            &zenoh,
+        let (code, said) = tandem_in_3(&[
+            "cmd",
             "nb/spare",
             "MC_MoveAbsolute",
             "--position",
@@ -795,13 +743,7 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
             "--velocity",
             "0",
         ]);
-        let o = c.output().unwrap();
-        let said = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        assert_eq!(o.status.code(), Some(1), "{said}");
+        assert_eq!(code, Some(1), "{said}");
         assert!(said.contains("rejected with 16#80"), "{said}");
 
         // Kill host 2's gateway: its liveliness token goes, and comes back with the restart.

@@ -7,12 +7,14 @@
 //! Every wait has a timeout. The tests run one at a time (they share two CPU cores).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+use common::{spawn_collect, until, wait_for};
 use std::collections::HashMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
@@ -45,22 +47,6 @@ fn cell(dir: &Path, name: &str) -> PathBuf {
     let p = dir.join("cell.toml");
     std::fs::write(&p, src).unwrap();
     p
-}
-
-/// Waits for `child` to exit within `limit`; kills it and fails otherwise.
-fn wait_for(child: &mut Child, limit: Duration, what: &str) -> std::process::ExitStatus {
-    let deadline = Instant::now() + limit;
-    loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            return s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{what} did not end within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 /// Runs a short command with a timeout.
@@ -159,30 +145,14 @@ fn up(cell: &Path, rec: &Path, extra: &[&str]) -> (Child, std::thread::JoinHandl
         "{} is missing: build it first (cargo build --release --bins, as tests/run.sh does)",
         node.display()
     );
-    let mut child = tandem()
-        .arg("up")
+    let mut c = tandem();
+    c.arg("up")
         .arg(cell)
         .arg("--record")
         .arg(rec)
         .arg("--no-view")
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = child.stdout.take().unwrap();
-    let mut err = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let errors = std::thread::spawn(move || {
-            let mut s = String::new();
-            let _ = err.read_to_string(&mut s);
-            s
-        });
-        let mut s = String::new();
-        let _ = out.read_to_string(&mut s);
-        s + &errors.join().unwrap_or_default()
-    });
-    (child, reader)
+        .args(extra);
+    spawn_collect(c)
 }
 
 /// Three processes on a 1 ms cycle for 7 s: over the 6.5 s after synchronization every follower
@@ -341,15 +311,6 @@ fn status(cell: &Path) -> Output {
     let mut c = tandem();
     c.arg("status").arg("--cell").arg(cell);
     run(c, Duration::from_secs(10))
-}
-
-/// Polls `f` every 100 ms until it is true or `limit` passes.
-fn until(limit: Duration, what: &str, mut f: impl FnMut() -> bool) {
-    let deadline = Instant::now() + limit;
-    while !f() {
-        assert!(Instant::now() < deadline, "{what}: not within {limit:?}");
-        std::thread::sleep(Duration::from_millis(100));
-    }
 }
 
 /// The row of `axis` in `tandem status` output, split in columns.

@@ -76,6 +76,18 @@ struct Plan {
     min_delay: HashMap<usize, i64>,
 }
 
+/// What every thread of the gateway shares.
+#[derive(Clone)]
+struct Ctx {
+    cell: Arc<Cell>,
+    host: String,
+    h: usize,
+    plan: Arc<Plan>,
+    session: zenoh::Session,
+    counters: Arc<Counters>,
+    stop: Arc<AtomicBool>,
+}
+
 fn plan(cell: &Cell, h: usize) -> Plan {
     let mut p = Plan {
         nodes: (0..cell.nodes.len())
@@ -189,88 +201,36 @@ pub fn run(o: &Options) -> Result<Arc<Counters>, String> {
         plan.inn.len(),
         session.zid()
     );
-    let mut threads = Vec::new();
-    let spawn = |name: &str, f: Box<dyn FnOnce() -> Result<(), String> + Send>| {
-        let what = name.to_string();
-        let host = host.clone();
-        std::thread::Builder::new()
-            .name(what.clone())
-            .spawn(move || {
-                if let Err(e) = f() {
-                    eprintln!("tandem-gateway {host}: {what}: {e}");
-                }
-            })
-            .map_err(|e| format!("cannot start the {name} thread: {e}"))
+    let ctx = Ctx {
+        cell: Arc::clone(&cell),
+        host: host.clone(),
+        h,
+        plan,
+        session: session.clone(),
+        counters: Arc::clone(&counters),
+        stop: Arc::clone(&stop),
     };
-    {
-        let (cell, plan, s, c, stop, host) = (
-            Arc::clone(&cell),
-            Arc::clone(&plan),
-            session.clone(),
-            Arc::clone(&counters),
-            Arc::clone(&stop),
-            host.clone(),
+    type Task = fn(&Ctx) -> Result<(), String>;
+    let tasks: [(&str, Task); 5] = [
+        ("lv-out", lv_out),
+        ("lv-in", lv_in),
+        ("commands", commands),
+        ("telemetry", telemetry),
+        ("clock", clock),
+    ];
+    let mut threads = Vec::new();
+    for (name, task) in tasks {
+        let x = ctx.clone();
+        threads.push(
+            std::thread::Builder::new()
+                .name(name.into())
+                .spawn(move || {
+                    if let Err(e) = task(&x) {
+                        eprintln!("tandem-gateway {}: {name}: {e}", x.host);
+                    }
+                })
+                .map_err(|e| format!("cannot start the {name} thread: {e}"))?,
         );
-        threads.push(spawn(
-            "lv-out",
-            Box::new(move || lv_out(&cell, &host, &plan, &s, &c, &stop)),
-        )?);
-    }
-    {
-        let (cell, plan, s, c, stop, host) = (
-            Arc::clone(&cell),
-            Arc::clone(&plan),
-            session.clone(),
-            Arc::clone(&counters),
-            Arc::clone(&stop),
-            host.clone(),
-        );
-        threads.push(spawn(
-            "lv-in",
-            Box::new(move || lv_in(&cell, &host, &plan, &s, &c, &stop)),
-        )?);
-    }
-    {
-        let (cell, plan, s, c, stop, host) = (
-            Arc::clone(&cell),
-            Arc::clone(&plan),
-            session.clone(),
-            Arc::clone(&counters),
-            Arc::clone(&stop),
-            host.clone(),
-        );
-        threads.push(spawn(
-            "commands",
-            Box::new(move || commands(&cell, &host, &plan, &s, &c, &stop)),
-        )?);
-    }
-    {
-        let (cell, plan, s, c, stop, host) = (
-            Arc::clone(&cell),
-            Arc::clone(&plan),
-            session.clone(),
-            Arc::clone(&counters),
-            Arc::clone(&stop),
-            host.clone(),
-        );
-        threads.push(spawn(
-            "telemetry",
-            Box::new(move || telemetry(&cell, &host, &plan, &s, &c, &stop)),
-        )?);
-    }
-    {
-        let (cell, plan, s, c, stop, host) = (
-            Arc::clone(&cell),
-            Arc::clone(&plan),
-            session.clone(),
-            Arc::clone(&counters),
-            Arc::clone(&stop),
-            host.clone(),
-        );
-        threads.push(spawn(
-            "clock",
-            Box::new(move || clock(&cell, &host, h, &plan, &s, &c, &stop)),
-        )?);
     }
     let started = Instant::now();
     while !rt::termination_requested()
@@ -299,14 +259,15 @@ fn iox(cell: &Cell, host: &str, what: &str) -> Result<IpcNode, String> {
 }
 
 /// iceoryx2 to Zenoh: wakes on each publishing node's event and forwards every new sample.
-fn lv_out(
-    cell: &Cell,
-    host: &str,
-    plan: &Plan,
-    session: &zenoh::Session,
-    c: &Counters,
-    stop: &AtomicBool,
-) -> Result<(), String> {
+fn lv_out(x: &Ctx) -> Result<(), String> {
+    let (cell, host, plan, session, c, stop) = (
+        &*x.cell,
+        x.host.as_str(),
+        &*x.plan,
+        &x.session,
+        &*x.counters,
+        &*x.stop,
+    );
     if plan.out.is_empty() {
         return Ok(());
     }
@@ -377,14 +338,15 @@ fn lv_out(
 
 /// Zenoh to iceoryx2: every sample of a remote leader followed here goes into this host's
 /// leading-value service, timestamp unchanged.
-fn lv_in(
-    cell: &Cell,
-    host: &str,
-    plan: &Plan,
-    session: &zenoh::Session,
-    c: &Counters,
-    stop: &AtomicBool,
-) -> Result<(), String> {
+fn lv_in(x: &Ctx) -> Result<(), String> {
+    let (cell, host, plan, session, c, stop) = (
+        &*x.cell,
+        x.host.as_str(),
+        &*x.plan,
+        &x.session,
+        &*x.counters,
+        &*x.stop,
+    );
     let node = iox(cell, host, "lv-in")?;
     let names = cell.object_names();
     // (leader name, actual, leader index, publisher): looked up by &str, no allocation per sample.
@@ -447,14 +409,15 @@ fn lv_in(
 }
 
 /// Zenoh queries to the nodes' command services and back.
-fn commands(
-    cell: &Cell,
-    host: &str,
-    plan: &Plan,
-    session: &zenoh::Session,
-    c: &Counters,
-    stop: &AtomicBool,
-) -> Result<(), String> {
+fn commands(x: &Ctx) -> Result<(), String> {
+    let (cell, host, plan, session, c, stop) = (
+        &*x.cell,
+        x.host.as_str(),
+        &*x.plan,
+        &x.session,
+        &*x.counters,
+        &*x.stop,
+    );
     let node = iox(cell, host, "commands")?;
     let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(64);
     let mut queryables = Vec::new();
@@ -557,14 +520,15 @@ fn forward(
 }
 
 /// Per-axis state and node health at the telemetry rate, events and log lines as they happen.
-fn telemetry(
-    cell: &Cell,
-    host: &str,
-    plan: &Plan,
-    session: &zenoh::Session,
-    c: &Counters,
-    stop: &AtomicBool,
-) -> Result<(), String> {
+fn telemetry(x: &Ctx) -> Result<(), String> {
+    let (cell, host, plan, session, c, stop) = (
+        &*x.cell,
+        x.host.as_str(),
+        &*x.plan,
+        &x.session,
+        &*x.counters,
+        &*x.stop,
+    );
     let node = iox(cell, host, "telemetry")?;
     let names = cell.object_names();
     let mut subs = Vec::new();
@@ -648,15 +612,16 @@ fn telemetry(
 /// Answers clock queries and measures the offset to the other hosts' gateways once a second:
 /// `offset = t_remote - (t_sent + t_received) / 2`, from the round trip with the smallest delay
 /// of five.
-fn clock(
-    cell: &Cell,
-    host: &str,
-    h: usize,
-    plan: &Plan,
-    session: &zenoh::Session,
-    c: &Counters,
-    stop: &AtomicBool,
-) -> Result<(), String> {
+fn clock(x: &Ctx) -> Result<(), String> {
+    let (cell, host, h, plan, session, c, stop) = (
+        &*x.cell,
+        x.host.as_str(),
+        x.h,
+        &*x.plan,
+        &x.session,
+        &*x.counters,
+        &*x.stop,
+    );
     let _q = session
         .declare_queryable(keys::clock(&cell.name, host))
         .callback(|q| {
