@@ -724,7 +724,24 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), F
                         slot.started = Instant::now();
                     }
                     Err(e) => {
-                        fatal = Some(Fail(4, format!("cannot start {name}: {e}")));
+                        let program = if slot.node.is_some() {
+                            "tandem-node"
+                        } else {
+                            "tandem-gateway"
+                        };
+                        fatal = Some(Fail(
+                            4,
+                            format!(
+                                "cannot start {name} ({}): {e}; build it beside tandem \
+                                 (cargo build --release --bins){}",
+                                binary(program).display(),
+                                if slot.node.is_some() {
+                                    ""
+                                } else {
+                                    ", or run without it: --no-gateway"
+                                }
+                            ),
+                        ));
                     }
                 }
             }
