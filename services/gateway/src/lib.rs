@@ -88,6 +88,20 @@ struct Ctx {
     stop: Arc<AtomicBool>,
 }
 
+impl Ctx {
+    /// What a thread works with: cell, host, plan, session, counters, stop flag.
+    fn parts(&self) -> (&Cell, &str, &Plan, &zenoh::Session, &Counters, &AtomicBool) {
+        (
+            &self.cell,
+            &self.host,
+            &self.plan,
+            &self.session,
+            &self.counters,
+            &self.stop,
+        )
+    }
+}
+
 fn plan(cell: &Cell, h: usize) -> Plan {
     let mut p = Plan {
         nodes: (0..cell.nodes.len())
@@ -260,14 +274,7 @@ fn iox(cell: &Cell, host: &str, what: &str) -> Result<IpcNode, String> {
 
 /// iceoryx2 to Zenoh: wakes on each publishing node's event and forwards every new sample.
 fn lv_out(x: &Ctx) -> Result<(), String> {
-    let (cell, host, plan, session, c, stop) = (
-        &*x.cell,
-        x.host.as_str(),
-        &*x.plan,
-        &x.session,
-        &*x.counters,
-        &*x.stop,
-    );
+    let (cell, host, plan, session, c, stop) = x.parts();
     if plan.out.is_empty() {
         return Ok(());
     }
@@ -339,14 +346,7 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
 /// Zenoh to iceoryx2: every sample of a remote leader followed here goes into this host's
 /// leading-value service, timestamp unchanged.
 fn lv_in(x: &Ctx) -> Result<(), String> {
-    let (cell, host, plan, session, c, stop) = (
-        &*x.cell,
-        x.host.as_str(),
-        &*x.plan,
-        &x.session,
-        &*x.counters,
-        &*x.stop,
-    );
+    let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "lv-in")?;
     let names = cell.object_names();
     // (leader name, actual, leader index, publisher): looked up by &str, no allocation per sample.
@@ -410,14 +410,7 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
 
 /// Zenoh queries to the nodes' command services and back.
 fn commands(x: &Ctx) -> Result<(), String> {
-    let (cell, host, plan, session, c, stop) = (
-        &*x.cell,
-        x.host.as_str(),
-        &*x.plan,
-        &x.session,
-        &*x.counters,
-        &*x.stop,
-    );
+    let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "commands")?;
     let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(64);
     let mut queryables = Vec::new();
@@ -521,14 +514,7 @@ fn forward(
 
 /// Per-axis state and node health at the telemetry rate, events and log lines as they happen.
 fn telemetry(x: &Ctx) -> Result<(), String> {
-    let (cell, host, plan, session, c, stop) = (
-        &*x.cell,
-        x.host.as_str(),
-        &*x.plan,
-        &x.session,
-        &*x.counters,
-        &*x.stop,
-    );
+    let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "telemetry")?;
     let names = cell.object_names();
     let mut subs = Vec::new();
@@ -613,15 +599,8 @@ fn telemetry(x: &Ctx) -> Result<(), String> {
 /// `offset = t_remote - (t_sent + t_received) / 2`, from the round trip with the smallest delay
 /// of five.
 fn clock(x: &Ctx) -> Result<(), String> {
-    let (cell, host, h, plan, session, c, stop) = (
-        &*x.cell,
-        x.host.as_str(),
-        x.h,
-        &*x.plan,
-        &x.session,
-        &*x.counters,
-        &*x.stop,
-    );
+    let (cell, host, plan, session, c, stop) = x.parts();
+    let h = x.h;
     let _q = session
         .declare_queryable(keys::clock(&cell.name, host))
         .callback(|q| {
