@@ -101,6 +101,40 @@ impl Drop for Hosts {
     }
 }
 
+/// `tandem up` on hosts h1 and h2 (namespaces 0 and 1) with `script`, recording into
+/// `dir/<host>`, both on one epoch a few seconds ahead (time for the gateways to connect).
+fn up_both(
+    hosts: &Hosts,
+    cell: &Path,
+    script: &Path,
+    dir: &Path,
+) -> Vec<(Child, std::thread::JoinHandle<String>)> {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos() as i64;
+    let epoch = (now / 1_000_000_000 + 4) * 1_000_000_000;
+    let mut runs = Vec::new();
+    for (i, host) in ["h1", "h2"].iter().enumerate() {
+        let mut c = hosts.exec(i, &bin("tandem"));
+        c.arg("up")
+            .arg(cell)
+            .args([
+                "--host",
+                host,
+                "--no-view",
+                "--epoch-ns",
+                &epoch.to_string(),
+            ])
+            .arg("--script")
+            .arg(script)
+            .arg("--record")
+            .arg(dir.join(host));
+        runs.push(spawn_collect(c));
+    }
+    runs
+}
+
 /// `time -> value` of a column of a node trace.
 fn column(p: &Path, col: &str) -> HashMap<i64, f64> {
     let s = std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
@@ -311,32 +345,9 @@ fn followers_on_two_hosts_move_in_phase() {
     let sc = dir.join("script.toml");
     std::fs::write(&sc, script(seconds)).unwrap();
     // One epoch for both hosts, far enough ahead for both gateways to connect.
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .as_nanos() as i64;
-    let epoch = (now / 1_000_000_000 + 4) * 1_000_000_000;
-    let tandem = bin("tandem");
     bin("tandem-node");
     bin("tandem-gateway");
-    let mut runs = Vec::new();
-    for (i, host) in ["h1", "h2"].iter().enumerate() {
-        let mut c = hosts.exec(i, &tandem);
-        c.arg("up")
-            .arg(&cell)
-            .args([
-                "--host",
-                host,
-                "--no-view",
-                "--epoch-ns",
-                &epoch.to_string(),
-            ])
-            .arg("--script")
-            .arg(&sc)
-            .arg("--record")
-            .arg(dir.join(host));
-        runs.push(spawn_collect(c));
-    }
+    let runs = up_both(&hosts, &cell, &sc, &dir);
     let mut outputs = Vec::new();
     for (mut child, reader) in runs {
         let status = wait_for(&mut child, Duration::from_secs(90), "tandem up");
@@ -559,29 +570,7 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
             + "[[at]]\nt = 0.5\naxis = \"master\"\ninstruction = \"MC_MoveVelocity\"\nvelocity = 200.0\n",
     )
     .unwrap();
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .as_nanos() as i64;
-    let epoch = (now / 1_000_000_000 + 4) * 1_000_000_000;
-    let mut runs = Vec::new();
-    for (i, host) in ["h1", "h2"].iter().enumerate() {
-        let mut c = hosts.exec(i, &bin("tandem"));
-        c.arg("up")
-            .arg(&cell)
-            .args([
-                "--host",
-                host,
-                "--no-view",
-                "--epoch-ns",
-                &epoch.to_string(),
-            ])
-            .arg("--script")
-            .arg(&sc)
-            .arg("--record")
-            .arg(dir.join(host));
-        runs.push(spawn_collect(c));
-    }
+    let runs = up_both(&hosts, &cell, &sc, &dir);
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         until(Duration::from_secs(40), "fb geared on host 2", || {
             let r = row(&hosts, 1, &cell, "h2", "fb");
