@@ -9,13 +9,13 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use tandem_config::Cell;
 use tandem_motion::error_id::ErrorId;
-use tandem_node::rt;
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::wire::{
     AxisTelemetry, CommandRequest, Event, NodeHealth, Text, EVENT_JOB, EVENT_LOG, JOB_ABORTED,
     JOB_DONE, JOB_ERROR, JOB_REACHED, OUTCOME_ACCEPTED, OUTCOME_BUSY, OUTCOME_INVALID,
     OUTCOME_REJECTED,
 };
+use tandem_rt as rt;
 
 type TelemetrySub = iceoryx2::port::subscriber::Subscriber<
     iceoryx2::prelude::ipc::Service,

@@ -740,7 +740,7 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
         std::thread::sleep(Duration::from_secs(3));
         let cell_s = cell.to_string_lossy().to_string();
         let pid = pid_of(&["tandem-gateway", &cell_s, "h2"]).expect("host 2's gateway");
-        tandem_node::rt::send_signal(pid, libc::SIGKILL).unwrap();
+        tandem_rt::send_signal(pid, libc::SIGKILL).unwrap();
         let seen = observed(watcher);
         let events: Vec<(String, String)> = seen["alive_events"]
             .as_array()
@@ -756,7 +756,7 @@ fn a_python_observer_commands_and_the_cell_survives_a_cut_link_and_a_killed_gate
         );
     }));
     for (child, _) in &runs {
-        let _ = tandem_node::rt::send_signal(child.id(), libc::SIGTERM);
+        let _ = tandem_rt::send_signal(child.id(), libc::SIGTERM);
     }
     let mut outputs = Vec::new();
     for (mut child, reader) in runs {

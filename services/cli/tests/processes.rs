@@ -421,7 +421,7 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
             .and_then(|l| l.split_whitespace().nth(2))
             .and_then(|p| p.parse().ok())
             .unwrap_or_else(|| panic!("no pid of leaders in\n{s}"));
-        tandem_node::rt::send_signal(pid, libc::SIGKILL).unwrap();
+        tandem_rt::send_signal(pid, libc::SIGKILL).unwrap();
         // The followers: alarm 601, ErrorStop, braked to standstill.
         until(
             Duration::from_secs(10),
@@ -467,7 +467,7 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
                 && r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(300.0)
         });
     }));
-    let _ = tandem_node::rt::send_signal(up.id(), libc::SIGTERM);
+    let _ = tandem_rt::send_signal(up.id(), libc::SIGTERM);
     let stopped = wait_for(&mut up, Duration::from_secs(20), "tandem up after SIGTERM");
     let up_log = reader.join().unwrap();
     if let Err(e) = result {

@@ -10,7 +10,7 @@
 //! thread, log lines go into a fixed ring and out as iceoryx2 events, trace rows go to the
 //! recorder thread through a fixed pool.
 
-pub mod rt;
+use tandem_rt as rt;
 
 use std::collections::VecDeque;
 use std::io::{self, Write};
@@ -19,8 +19,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};
 use std::sync::Arc;
 use std::time::Duration;
-use tandem_config::script::{split_command, Action, ScriptEntry};
+use tandem_config::script::{split_command, ScriptEntry};
 use tandem_config::{Cell, Coupling};
+use tandem_motion::action::Action;
 use tandem_motion::axis::AxisStatus;
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::names;

@@ -6,6 +6,7 @@
 //! allocate when they are built, never per cycle.
 #![cfg_attr(not(test), warn(missing_docs))]
 
+pub mod action;
 pub mod alarm;
 pub mod axis;
 pub mod cam;

@@ -3,8 +3,8 @@
 
 use crate::exec::{Describe, IoNote, Secs, NOTES};
 use std::io::{self, Write};
-use tandem_config::script::Action;
 use tandem_config::Cell;
+use tandem_motion::action::Action;
 use tandem_motion::alarm::AlarmInstance;
 use tandem_motion::axis::AxisStatus;
 use tandem_motion::cam_track::{CamTrack, CamTrackMode, McCamTrack};

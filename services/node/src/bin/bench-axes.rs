@@ -19,9 +19,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tandem_node::{rt, Options, Report};
+use tandem_node::{Options, Report};
 use tandem_protocol::ipc as tipc;
 use tandem_protocol::wire::STATE_NAMES;
+use tandem_rt as rt;
 
 /// The node's cycle (µs).
 const CYCLE_US: i64 = 1000;

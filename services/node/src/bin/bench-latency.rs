@@ -25,9 +25,9 @@ use iceoryx2::prelude::*;
 use std::process::{Child, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 use tandem_motion::leading::{LeadingSample, LeadingValue, LeadingValueBuffer};
-use tandem_node::rt;
 use tandem_protocol::ipc as tipc;
 use tandem_protocol::wire::LeadingValueSample;
+use tandem_rt as rt;
 
 /// The ping period of `period` mode (ns).
 const PERIOD_NS: i64 = 1_000_000;

@@ -3,9 +3,11 @@
 //! this is the only module of tandem with `unsafe` code, and each block says why it is sound.
 #![allow(unsafe_code)]
 
+pub mod diag;
+
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// The cell clock: CLOCK_REALTIME in ns (PTP-disciplined on a real cell, design §4).
+/// The cell clock: CLOCK_REALTIME in ns (PTP-disciplined on a real cell; see deploy/README.md).
 pub fn now_ns() -> i64 {
     let mut ts = libc::timespec {
         tv_sec: 0,

@@ -1,0 +1,68 @@
+//! The instruction for one technology object, as the runtime applies it.
+
+use crate::axis::{CamId, Command};
+
+/// What an instruction does to a technology object: an axis or encoder command, or one of the
+/// instructions of the cam, output cam, cam track and measuring input objects. Script files,
+/// the CLI and the command services parse into it; the runtime applies it.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Action {
+    /// An instruction for an axis or an external encoder.
+    Command(Command),
+    /// `MC_InterpolateCam`: interpolate the cam `cam` again from the definition of the cam
+    /// `from` (itself by default); refused while a job uses the cam (16#80AB).
+    InterpolateCam {
+        /// The cam replaced.
+        cam: CamId,
+        /// The cam whose definition is interpolated.
+        from: CamId,
+    },
+    /// `MC_OutputCam` on the output cam named by the entry (Enable-type: the inputs hold until
+    /// a later entry changes them). Codes are checked when applied (16#800A, 16#8007...).
+    OutputCam {
+        /// `Enable`.
+        enable: bool,
+        /// `OnPosition`.
+        on_position: f64,
+        /// `OffPosition`.
+        off_position: f64,
+        /// `Duration` (s).
+        duration: f64,
+        /// `Mode` (1, 2, 3).
+        mode: i32,
+        /// `Direction` (1, 2, 3).
+        direction: i32,
+    },
+    /// `MC_Reset` on the output cam, cam track or measuring input named by the entry:
+    /// acknowledges its alarms; `Restart` also clears a measuring input's data block.
+    ResetObject {
+        /// `Restart`.
+        restart: bool,
+    },
+    /// `MC_CamTrack` on the cam track named by the entry (Enable-type).
+    CamTrack {
+        /// `Enable`.
+        enable: bool,
+        /// `Mode` (0, 1, 2).
+        mode: i32,
+        /// `InvertOutput`.
+        invert_output: bool,
+    },
+    /// `MC_MeasuringInput` (one-time) or `MC_MeasuringInputCyclic` on the measuring input
+    /// named by the entry.
+    MeasuringInput {
+        /// Cyclic measuring.
+        cyclic: bool,
+        /// `Mode`.
+        mode: i32,
+        /// `MeasuringRange`: `(StartPosition, EndPosition)`.
+        window: Option<(f64, f64)>,
+    },
+    /// `MC_AbortMeasuringInput` on the measuring input named by the entry.
+    AbortMeasuringInput,
+    /// An edge of the measuring input named by the entry, at the entry's time exactly.
+    InputEdge {
+        /// Rising (true) or falling edge.
+        rising: bool,
+    },
+}
