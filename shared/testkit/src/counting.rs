@@ -101,6 +101,11 @@ pub struct Counts {
 /// # Panics
 /// When [`Counting`] is not the global allocator of this binary (a probe allocation went
 /// uncounted): a zero-allocation test would otherwise pass without counting anything.
+///
+/// ```should_panic
+/// // A binary without `tandem_testkit::counting_allocator!();`:
+/// tandem_testkit::counting::arm();
+/// ```
 pub fn arm() {
     ARMED.with(|a| a.set(true));
     let before = ALLOCS.load(Ordering::SeqCst);
