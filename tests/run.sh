@@ -3,8 +3,10 @@
 #  1. Python oracles: installs the pinned `ruckig` and `pyplcopen` packages and regenerates the
 #     committed fixtures into temp files; they must match byte for byte (the oracles are real).
 #     It also installs `eclipse-zenoh`, the Python observer of the multi-host tests.
-#  2. All binaries (the process tests run `tandem up`, which starts `tandem-node` from beside
-#     itself), then all Rust tests of the workspace, in release.
+#  2. All binaries (the system tests of tests/system run `tandem`, `tandem-node` and
+#     `tandem-gateway` from the target directory: `tandem up` starts the node and the gateway
+#     from beside itself), then all Rust tests of the workspace, the system tests among them,
+#     in release.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

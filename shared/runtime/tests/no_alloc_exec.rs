@@ -4,14 +4,11 @@
 //! do, with 0 allocations once the commands are applied.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-#[path = "../../motion/tests/common/counting.rs"]
-mod counting;
-use counting::{arm, disarm, Counting};
 use tandem_config::Coupling;
 use tandem_runtime::exec::Executive;
+use tandem_testkit::counting::{arm, disarm};
 
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+tandem_testkit::counting_allocator!();
 
 #[test]
 fn three_executives_step_without_allocating() {

@@ -7,30 +7,21 @@
 //! Every wait has a timeout. The tests run one at a time (they share two CPU cores).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-mod common;
-use common::{spawn_collect, until, wait_for};
 use std::collections::HashMap;
-use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::Output;
 use std::sync::Mutex;
 use std::time::Duration;
+use tandem_testkit::node_log::{log_time, missing_leader};
+use tandem_testkit::process::{run, text, until, Spawned};
+use tandem_testkit::scratch::{fresh_dir, remove_dir};
+use tandem_testkit::tandem::tandem;
+use tandem_testkit::workspace::root;
 
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn tandem() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tandem"))
-}
-
 fn tmp(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tandem-proc-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    fresh_dir(&format!("tandem-proc-{tag}-{}", std::process::id()))
 }
 
 /// The bundled example cell under a cell name of its own (no clash with another run), with a
@@ -47,41 +38,6 @@ fn cell(dir: &Path, name: &str) -> PathBuf {
     let p = dir.join("cell.toml");
     std::fs::write(&p, src).unwrap();
     p
-}
-
-/// Runs a short command with a timeout.
-fn run(mut c: Command, limit: Duration) -> Output {
-    let mut child = c
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = child.stdout.take().unwrap();
-    let mut err = child.stderr.take().unwrap();
-    let t_out = std::thread::spawn(move || {
-        let mut s = Vec::new();
-        let _ = out.read_to_end(&mut s);
-        s
-    });
-    let t_err = std::thread::spawn(move || {
-        let mut s = Vec::new();
-        let _ = err.read_to_end(&mut s);
-        s
-    });
-    let status = wait_for(&mut child, limit, "a tandem command");
-    Output {
-        status,
-        stdout: t_out.join().unwrap(),
-        stderr: t_err.join().unwrap(),
-    }
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 /// A CSV trace: column names and rows by time string.
@@ -129,30 +85,14 @@ impl Trace {
 fn edges(log: &str, object: &str) -> Vec<(i64, bool)> {
     log.lines()
         .filter(|l| l.contains(&format!(" {object} output ")))
-        .map(|l| {
-            let t: f64 = l[2..].split(' ').next().unwrap().parse().unwrap();
-            ((t * 1e9).round() as i64, l.ends_with("ON"))
-        })
+        .map(|l| ((log_time(l) * 1e9).round() as i64, l.ends_with("ON")))
         .collect()
 }
 
-/// Starts `tandem up` on `cell`, recording into `rec`, without the live view; the second value
-/// collects its output.
-fn up(cell: &Path, rec: &Path, extra: &[&str]) -> (Child, std::thread::JoinHandle<String>) {
-    let node = Path::new(env!("CARGO_BIN_EXE_tandem")).with_file_name("tandem-node");
-    assert!(
-        node.exists(),
-        "{} is missing: build it first (cargo build --release --bins, as tests/run.sh does)",
-        node.display()
-    );
-    let mut c = tandem();
-    c.arg("up")
-        .arg(cell)
-        .arg("--record")
-        .arg(rec)
-        .arg("--no-view")
-        .args(extra);
-    spawn_collect(c)
+/// Starts `tandem up` on `cell`, recording into `rec`, without the live view, collecting its
+/// output.
+fn up(cell: &Path, rec: &Path, extra: &[&str]) -> Spawned {
+    Spawned::start(tandem_testkit::tandem::up(tandem(), cell, rec).args(extra))
 }
 
 /// Three processes on a 1 ms cycle for 7 s: over the 6.5 s after synchronization every follower
@@ -168,9 +108,8 @@ fn three_processes_follow_the_leader_at_t_minus_d_like_the_simulator() {
     let src = std::fs::read_to_string(root().join("config/line-script.toml")).unwrap();
     std::fs::write(&script, src.replace("duration = 6.0", "duration = 7.0")).unwrap();
     let rec = dir.join("rec");
-    let (mut up, reader) = up(&cell, &rec, &["--script", script.to_str().unwrap()]);
-    let status = wait_for(&mut up, Duration::from_secs(60), "tandem up");
-    let up_log = reader.join().unwrap();
+    let up = up(&cell, &rec, &["--script", script.to_str().unwrap()]);
+    let (status, up_log) = up.wait(Duration::from_secs(60), "tandem up");
     assert!(status.success(), "tandem up failed: {status}\n{up_log}");
     assert!(!up_log.contains("panicked"), "{up_log}");
     assert!(!up_log.contains("crashed"), "{up_log}");
@@ -285,7 +224,7 @@ fn three_processes_follow_the_leader_at_t_minus_d_like_the_simulator() {
             b.0
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    remove_dir(&dir);
 }
 
 /// `tandem cmd` with the cell given by `--cell`.
@@ -331,7 +270,7 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
     let dir = tmp("kill");
     let cell = cell(&dir, &format!("kill{}", std::process::id()));
     let rec = dir.join("rec");
-    let (mut up, reader) = up(&cell, &rec, &["--duration", "120"]);
+    let up = up(&cell, &rec, &["--duration", "120"]);
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         until(Duration::from_secs(20), "all three nodes up", || {
             status(&cell).status.success()
@@ -467,9 +406,9 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
                 && r.get(4).and_then(|v| v.parse::<f64>().ok()) == Some(300.0)
         });
     }));
+    // It may have ended already; its status is checked below.
     let _ = tandem_rt::send_signal(up.id(), libc::SIGTERM);
-    let stopped = wait_for(&mut up, Duration::from_secs(20), "tandem up after SIGTERM");
-    let up_log = reader.join().unwrap();
+    let (stopped, up_log) = up.wait(Duration::from_secs(20), "tandem up after SIGTERM");
     if let Err(e) = result {
         eprintln!("tandem up said:\n{up_log}");
         std::panic::resume_unwind(e);
@@ -483,31 +422,23 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
     assert!(!up_log.contains("panicked"), "{up_log}");
     // The follower saw the leader go missing within the tolerance after its newest sample.
     let log = std::fs::read_to_string(rec.join("followers.log")).unwrap();
-    let missing = log
-        .lines()
-        .find(|l| l.contains("leading value of line missing"))
-        .unwrap_or_else(|| panic!("{log}"));
-    let t_of = |l: &str| -> f64 { l[2..].split(' ').next().unwrap().parse().unwrap() };
-    let newest: f64 = missing
-        .split("newest sample t=")
-        .nth(1)
-        .and_then(|x| x.split(',').next())
-        .and_then(|x| x.parse().ok())
-        .unwrap_or_else(|| panic!("{missing}"));
-    let late = t_of(missing) - 0.010 - newest;
+    let missing = missing_leader(&log, "line");
+    let late = missing.t - 0.010 - missing.newest;
     assert!(
         late > 0.030 && late <= 0.030 + 0.0015,
-        "missing {late} s after the newest sample; tolerance 0.030 s: {missing}"
+        "missing {late} s after the newest sample; tolerance 0.030 s: {}",
+        missing.line
     );
     let alarm = log
         .lines()
         .find(|l| l.contains("feed alarm 601"))
         .unwrap_or_else(|| panic!("{log}"));
     assert!(
-        (t_of(alarm) - t_of(missing)).abs() < 0.0015,
-        "{alarm}\n{missing}"
+        (log_time(alarm) - missing.t).abs() < 0.0015,
+        "{alarm}\n{}",
+        missing.line
     );
-    let _ = std::fs::remove_dir_all(&dir);
+    remove_dir(&dir);
 }
 
 /// A delay shorter than the link needs: `tandem check` and `tandem up` refuse the cell,
@@ -543,5 +474,5 @@ fn a_bad_config_is_refused_naming_the_key() {
         );
         assert!(t.contains("shorter than the link"), "{sub}: {t}");
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    remove_dir(&dir);
 }
