@@ -12,6 +12,14 @@
 //! summary, `error: ...`) goes to the writers given to [`run`]. Diagnostics (what `up`'s
 //! supervision does: a node started, crashed with its reason, restarted) go through `tracing`
 //! to stderr, as text or JSON (`--log-format`), filtered by `TANDEM_LOG` or `RUST_LOG`.
+//!
+//! ```no_run
+//! // `tandem check config/line.toml`, its output captured.
+//! let args = ["tandem", "check", "config/line.toml"].map(std::ffi::OsString::from);
+//! let (mut out, mut err) = (Vec::new(), Vec::new());
+//! let code = tandem_cli::run(args.to_vec(), &mut out, &mut err);
+//! assert_eq!(code, std::process::ExitCode::SUCCESS, "{}", String::from_utf8_lossy(&err));
+//! ```
 
 /// Writes one line of user output. A failed write (stdout closed: `tandem status | head`) is
 /// dropped: it must not turn into another error or hide the command's exit code.

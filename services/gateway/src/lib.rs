@@ -22,6 +22,22 @@
 //! Diagnostics go through `tracing` (the binary installs `tandem_rt::diag`): a span `gateway`
 //! (host, cell) with one span per thread (`task`) and one per command query (`command`: node,
 //! object, instruction, job); failures are [`GatewayError`]s with their exit code.
+//!
+//! ```no_run
+//! // The gateway of host `h1` for ten seconds, as `tandem-gateway cell.toml --host h1` runs it.
+//! let o = tandem_gateway::Options {
+//!     cell: "cell.toml".into(),
+//!     host: Some("h1".into()),
+//!     duration_s: Some(10.0),
+//! };
+//! match tandem_gateway::run(&o) {
+//!     Ok(counters) => println!("{counters:?}"),
+//!     Err(e) => {
+//!         eprintln!("{e}");
+//!         std::process::exit(e.exit_code().into());
+//!     }
+//! }
+//! ```
 
 mod error;
 
