@@ -226,6 +226,7 @@ pub(crate) fn render(
 pub fn status(cell_path: &Path, host: Option<&str>, out: &mut impl Write) -> Result<(), CliError> {
     let cell = load(cell_path)?;
     let (host, nodes) = host_nodes(&cell, host)?;
+    let _span = tracing::info_span!("status", cell = %cell.name, host = %host).entered();
     let iox = cli_node(&cell, "status", &host)?;
     let mut obs = Observer::new(&iox, &cell, &nodes, false)?;
     let deadline = Instant::now() + Duration::from_millis(1500);
@@ -259,6 +260,7 @@ pub fn watch(
 ) -> Result<(), CliError> {
     let cell = load(cell_path)?;
     let (host, nodes) = host_nodes(&cell, host)?;
+    let _span = tracing::info_span!("watch", cell = %cell.name, host = %host).entered();
     let iox = cli_node(&cell, "watch", &host)?;
     let mut obs = Observer::new(&iox, &cell, &nodes, false)?;
     rt::install_termination_handler();
