@@ -2,98 +2,81 @@
 //! `cmd` work on a running cell, `sim` runs a cell on virtual time, `check` validates a cell
 //! file.
 //!
-//! Exit codes: 0 success; 1 the command failed (`cmd`: rejected with an ErrorID, or the job
-//! ended in error or was aborted; `sim --strict`: a command was rejected or an alarm is
-//! pending); 2 the input is wrong (usage, config, script or command error); 3 the cell is not
-//! reachable (a node not running, a timeout) or an IO error of `sim`; 4 an iceoryx2 error.
+//! Exit codes ([`CliError::exit_code`]): 0 success; 1 the command failed (`cmd`: rejected with
+//! an ErrorID, or the job ended in error or was aborted; `sim --strict`: a command was rejected
+//! or an alarm is pending); 2 the input is wrong (usage, config, script or command error); 3 the
+//! cell is not reachable (a node not running, a timeout) or an IO error of `sim`; 4 an iceoryx2
+//! error.
+//!
+//! What a command prints for its user (tables, the live view, `cmd`'s outcome, `sim`'s log and
+//! summary, `error: ...`) goes to the writers given to [`run`]. Diagnostics (what `up`'s
+//! supervision does: a node started, crashed with its reason, restarted) go through `tracing`
+//! to stderr, as text or JSON (`--log-format`), filtered by `TANDEM_LOG` or `RUST_LOG`.
+//!
+//! ```no_run
+//! // `tandem check config/line.toml`, its output captured.
+//! let args = ["tandem", "check", "config/line.toml"].map(std::ffi::OsString::from);
+//! let (mut out, mut err) = (Vec::new(), Vec::new());
+//! let code = tandem_cli::run(args.to_vec(), &mut out, &mut err);
+//! assert_eq!(code, std::process::ExitCode::SUCCESS, "{}", String::from_utf8_lossy(&err));
+//! ```
 
+/// Writes one line of user output. A failed write (stdout closed: `tandem status | head`) is
+/// dropped: it must not turn into another error or hide the command's exit code.
+macro_rules! outln {
+    ($out:expr) => {
+        $crate::output::write($out, format_args!("\n"))
+    };
+    ($out:expr, $($arg:tt)*) => {
+        $crate::output::write($out, format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// Writes user output without a newline (see [`outln`]).
+macro_rules! out {
+    ($out:expr, $($arg:tt)*) => {
+        $crate::output::write($out, format_args!($($arg)*))
+    };
+}
+
+pub mod cmd;
+pub mod error;
 pub mod live;
+pub mod offline;
+mod output;
+pub mod remote;
+pub mod up;
+
+pub use error::CliError;
 
 use clap::{Arg, ArgAction, Command};
 use std::ffi::OsString;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tandem_rt::diag::{self, LogFormat};
+
+/// The diagnostics filter of `up` when neither `TANDEM_LOG` nor `RUST_LOG` is set: its
+/// supervision events at `info`; Zenoh's own logging off.
+const UP_LOG: &str = "info,zenoh=off";
+/// The diagnostics filter of the other commands: warnings and errors only, so their output is
+/// what they print.
+const QUIET_LOG: &str = "warn,zenoh=off";
 
 fn cli() -> Command {
     Command::new("tandem")
         .about("tandem: a motion controller for machines that span several controllers")
         .subcommand_required(true)
         .arg_required_else_help(true)
-        .subcommand(
-            Command::new("sim")
-                .about("Run a cell on virtual time with a script; write a CSV trace")
-                .arg(Arg::new("cell").required(true).value_parser(clap::value_parser!(PathBuf)))
-                .arg(
-                    Arg::new("script")
-                        .long("script")
-                        .required(true)
-                        .value_parser(clap::value_parser!(PathBuf))
-                        .help("Script of timed instructions (TOML)"),
-                )
-                .arg(
-                    Arg::new("trace")
-                        .long("trace")
-                        .required(true)
-                        .value_parser(clap::value_parser!(PathBuf))
-                        .help("CSV file to write (every signal of every axis, every cycle)"),
-                )
-                .arg(
-                    Arg::new("strict")
-                        .long("strict")
-                        .action(ArgAction::SetTrue)
-                        .help("Exit with 1 if a command was rejected or an alarm is pending at the end"),
-                )
-                .arg(
-                    Arg::new("quiet")
-                        .long("quiet")
-                        .short('q')
-                        .action(ArgAction::SetTrue)
-                        .help("Do not print job events and alarms"),
-                ),
+        .arg(
+            Arg::new("log-format")
+                .long("log-format")
+                .global(true)
+                .value_parser(["text", "json"])
+                .help("Diagnostics on stderr as text lines or one JSON object per line (filter: TANDEM_LOG or RUST_LOG)"),
         )
-        .subcommand(
-            Command::new("up")
-                .about("Start this host's nodes of a cell, supervise them (restart on a crash), stop them on Ctrl-C")
-                .arg(Arg::new("cell").required(true).value_parser(clap::value_parser!(PathBuf)))
-                .arg(Arg::new("host").long("host").help("The host whose nodes to start (default: the cell's only host)"))
-                .arg(
-                    Arg::new("script")
-                        .long("script")
-                        .value_parser(clap::value_parser!(PathBuf))
-                        .help("Script of timed instructions, applied by each node to its objects on the cell clock"),
-                )
-                .arg(
-                    Arg::new("record")
-                        .long("record")
-                        .value_parser(clap::value_parser!(PathBuf))
-                        .help("Directory for each node's CSV trace and log (<node>.csv, <node>.log)"),
-                )
-                .arg(
-                    Arg::new("duration")
-                        .long("duration")
-                        .value_parser(clap::value_parser!(f64))
-                        .help("Stop at this engine time in seconds, counted from the epoch (default: the script's duration, else Ctrl-C)"),
-                )
-                .arg(
-                    Arg::new("no-view")
-                        .long("no-view")
-                        .action(ArgAction::SetTrue)
-                        .help("Print events as they happen instead of the live table"),
-                )
-                .arg(
-                    Arg::new("epoch-ns")
-                        .long("epoch-ns")
-                        .value_parser(clap::value_parser!(i64))
-                        .help("Cell clock time of cycle 0 (ns since 1970, CLOCK_REALTIME); every host of a cell must start with the same (default: the next whole second plus one)"),
-                )
-                .arg(
-                    Arg::new("no-gateway")
-                        .long("no-gateway")
-                        .action(ArgAction::SetTrue)
-                        .help("Do not start the host's gateway (no Zenoh: nothing crosses to other hosts or observers)"),
-                ),
-        )
+        .subcommand(sim_command())
+        .subcommand(up_command())
         .subcommand(
             Command::new("status")
                 .about("One snapshot of the running nodes of this host: axes and node health (with --zenoh: of every host, through the gateways)")
@@ -114,25 +97,110 @@ fn cli() -> Command {
                         .help("Stop after this many refreshes (4 per second)"),
                 ),
         )
-        .subcommand(
-            Command::new("cmd")
-                .about("Send an instruction to an object of a running node: tandem cmd <node>/<object> <instruction> [--param value]... [--wait]")
-                .arg(cell_arg())
-                .arg(zenoh_arg())
-                .arg(Arg::new("target").required(true).help("<node>/<object>"))
-                .arg(Arg::new("instruction").required(true).help("e.g. MC_MoveAbsolute, MoveVelocity, gear_in"))
-                .arg(
-                    Arg::new("params")
-                        .num_args(0..)
-                        .allow_hyphen_values(true)
-                        .trailing_var_arg(true)
-                        .help("--param value pairs (the script's parameter names); --wait follows the job; --timeout <s> (default 60)"),
-                ),
-        )
+        .subcommand(cmd_command())
         .subcommand(
             Command::new("check")
                 .about("Validate a cell file; errors name file, line and key")
                 .arg(Arg::new("cell").required(true).value_parser(clap::value_parser!(PathBuf))),
+        )
+}
+
+/// `tandem sim`'s arguments.
+fn sim_command() -> Command {
+    Command::new("sim")
+        .about("Run a cell on virtual time with a script; write a CSV trace")
+        .arg(
+            Arg::new("cell")
+                .required(true)
+                .value_parser(clap::value_parser!(PathBuf)),
+        )
+        .arg(
+            Arg::new("script")
+                .long("script")
+                .required(true)
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("Script of timed instructions (TOML)"),
+        )
+        .arg(
+            Arg::new("trace")
+                .long("trace")
+                .required(true)
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("CSV file to write (every signal of every axis, every cycle)"),
+        )
+        .arg(
+            Arg::new("strict")
+                .long("strict")
+                .action(ArgAction::SetTrue)
+                .help("Exit with 1 if a command was rejected or an alarm is pending at the end"),
+        )
+        .arg(
+            Arg::new("quiet")
+                .long("quiet")
+                .short('q')
+                .action(ArgAction::SetTrue)
+                .help("Do not print job events and alarms"),
+        )
+}
+
+/// `tandem up`'s arguments.
+fn up_command() -> Command {
+    Command::new("up")
+        .about("Start this host's nodes of a cell, supervise them (restart on a crash), stop them on Ctrl-C")
+        .arg(Arg::new("cell").required(true).value_parser(clap::value_parser!(PathBuf)))
+        .arg(Arg::new("host").long("host").help("The host whose nodes to start (default: the cell's only host)"))
+        .arg(
+            Arg::new("script")
+                .long("script")
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("Script of timed instructions, applied by each node to its objects on the cell clock"),
+        )
+        .arg(
+            Arg::new("record")
+                .long("record")
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("Directory for each node's CSV trace and log (<node>.csv, <node>.log)"),
+        )
+        .arg(
+            Arg::new("duration")
+                .long("duration")
+                .value_parser(clap::value_parser!(f64))
+                .help("Stop at this engine time in seconds, counted from the epoch (default: the script's duration, else Ctrl-C)"),
+        )
+        .arg(
+            Arg::new("no-view")
+                .long("no-view")
+                .action(ArgAction::SetTrue)
+                .help("Print events as they happen instead of the live table"),
+        )
+        .arg(
+            Arg::new("epoch-ns")
+                .long("epoch-ns")
+                .value_parser(clap::value_parser!(i64))
+                .help("Cell clock time of cycle 0 (ns since 1970, CLOCK_REALTIME); every host of a cell must start with the same (default: the next whole second plus one)"),
+        )
+        .arg(
+            Arg::new("no-gateway")
+                .long("no-gateway")
+                .action(ArgAction::SetTrue)
+                .help("Do not start the host's gateway (no Zenoh: nothing crosses to other hosts or observers)"),
+        )
+}
+
+/// `tandem cmd`'s arguments.
+fn cmd_command() -> Command {
+    Command::new("cmd")
+        .about("Send an instruction to an object of a running node: tandem cmd <node>/<object> <instruction> [--param value]... [--wait]")
+        .arg(cell_arg())
+        .arg(zenoh_arg())
+        .arg(Arg::new("target").required(true).help("<node>/<object>"))
+        .arg(Arg::new("instruction").required(true).help("e.g. MC_MoveAbsolute, MoveVelocity, gear_in"))
+        .arg(
+            Arg::new("params")
+                .num_args(0..)
+                .allow_hyphen_values(true)
+                .trailing_var_arg(true)
+                .help("--param value pairs (the script's parameter names); --wait follows the job; --timeout <s> (default 60)"),
         )
 }
 
@@ -142,55 +210,144 @@ pub fn run(args: Vec<OsString>, out: &mut impl Write, err: &mut impl Write) -> E
         Ok(m) => m,
         Err(e) => {
             let code = if e.use_stderr() { 2 } else { 0 };
-            let _ = write!(
-                if e.use_stderr() {
-                    err as &mut dyn Write
-                } else {
-                    out as &mut dyn Write
-                },
-                "{}",
-                e.render()
-            );
+            let to: &mut dyn Write = if e.use_stderr() { err } else { out };
+            out!(to, "{}", e.render());
             return ExitCode::from(code);
         }
     };
-    match m.subcommand() {
-        Some(("check", sub)) => {
-            let Some(path) = sub.get_one::<PathBuf>("cell") else {
-                return ExitCode::from(2);
-            };
-            match tandem_config::load(path) {
-                Ok(cell) => {
-                    let _ = writeln!(
-                        out,
-                        "{}: cell `{}` is valid: {} node(s), {} axis/axes, {} external encoder(s), {} output cam(s), {} cam track(s), {} measuring input(s)",
-                        path.display(),
-                        cell.name,
-                        cell.nodes.len(),
-                        cell.axes.len(),
-                        cell.encoders.len(),
-                        cell.output_cams.len(),
-                        cell.cam_tracks.len(),
-                        cell.measuring_inputs.len()
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    let _ = writeln!(err, "error: {e}");
-                    ExitCode::from(2)
-                }
+    let Some((name, sub)) = m.subcommand() else {
+        return ExitCode::from(2);
+    };
+    let format = m
+        .get_one::<String>("log-format")
+        .and_then(|f| LogFormat::parse(f))
+        .unwrap_or_default();
+    // Only the first call of a process installs a subscriber (the tests run many commands in
+    // one process); later ones keep it, which is what they need.
+    let _ = diag::init(if name == "up" { UP_LOG } else { QUIET_LOG }, format);
+    match dispatch(name, sub, format, out, err) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if e.is_printed() {
+                outln!(err, "error: {e}");
+            }
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+/// Runs subcommand `name` with its arguments `m`.
+fn dispatch(
+    name: &str,
+    m: &clap::ArgMatches,
+    format: LogFormat,
+    out: &mut impl Write,
+    err: &mut impl Write,
+) -> Result<(), CliError> {
+    let host = m.get_one::<String>("host").map(String::as_str);
+    match name {
+        "check" => offline::check(required(m, "cell")?, out),
+        "sim" => offline::sim(&sim_options(m)?, out, err),
+        "up" => {
+            let cell = required(m, "cell")?;
+            up::up(cell, &up_options(m, format), out)
+        }
+        "status" => {
+            let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
+            match zenoh_endpoints(m) {
+                Some(e) => remote::status_zenoh(&cell, &e, out),
+                None => live::status(&cell, host, out),
             }
         }
-        Some(("sim", sub)) => sim(sub, out, err),
-        Some((name, sub)) => match running(name, sub, out) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(live::Fail(code, message)) => {
-                let _ = writeln!(err, "error: {message}");
-                ExitCode::from(code)
+        "watch" => live::watch(
+            &live::cell_path(m.get_one::<PathBuf>("cell"))?,
+            host,
+            m.get_one::<String>("pattern").map(String::as_str),
+            m.get_one::<u64>("count").copied(),
+            out,
+        ),
+        "cmd" => {
+            let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
+            let request = cmd_request(m)?;
+            match zenoh_endpoints(m) {
+                Some(e) => remote::cmd_zenoh(&cell, &e, &request, out),
+                None => cmd::cmd(&cell, &request, out),
             }
-        },
-        _ => ExitCode::from(2),
+        }
+        _ => Err(CliError::UnknownCommand(name.to_string())),
     }
+}
+
+/// A required path argument (clap checked it is there).
+fn required<'a>(m: &'a clap::ArgMatches, name: &'static str) -> Result<&'a PathBuf, CliError> {
+    m.get_one::<PathBuf>(name).ok_or(CliError::Missing(name))
+}
+
+/// `tandem sim`'s options from its arguments.
+fn sim_options(m: &clap::ArgMatches) -> Result<offline::SimOptions, CliError> {
+    Ok(offline::SimOptions {
+        cell: required(m, "cell")?.clone(),
+        script: required(m, "script")?.clone(),
+        trace: required(m, "trace")?.clone(),
+        strict: m.get_flag("strict"),
+        quiet: m.get_flag("quiet"),
+    })
+}
+
+/// `tandem up`'s options from its arguments.
+fn up_options(m: &clap::ArgMatches, format: LogFormat) -> up::UpOptions {
+    up::UpOptions {
+        host: m.get_one::<String>("host").cloned(),
+        script: m.get_one::<PathBuf>("script").cloned(),
+        record: m.get_one::<PathBuf>("record").cloned(),
+        view: !m.get_flag("no-view") && std::io::IsTerminal::is_terminal(&std::io::stdout()),
+        duration_s: m.get_one::<f64>("duration").copied(),
+        gateway: !m.get_flag("no-gateway"),
+        epoch_ns: m.get_one::<i64>("epoch-ns").copied(),
+        log_format: format,
+    }
+}
+
+/// `tandem cmd`'s request from its arguments: the target, the instruction, `--param value`
+/// pairs, `--wait` and `--timeout <s>`.
+fn cmd_request(m: &clap::ArgMatches) -> Result<cmd::CmdRequest, CliError> {
+    let target = m.get_one::<String>("target").cloned().unwrap_or_default();
+    let instruction = m
+        .get_one::<String>("instruction")
+        .cloned()
+        .unwrap_or_default();
+    let rest: Vec<String> = m
+        .get_many::<String>("params")
+        .map(|v| v.cloned().collect())
+        .unwrap_or_default();
+    let mut wait = false;
+    let mut timeout = std::time::Duration::from_secs(60);
+    let mut words = Vec::new();
+    let mut it = rest.into_iter();
+    while let Some(w) = it.next() {
+        match w.as_str() {
+            "--wait" => wait = true,
+            "--timeout" => {
+                let v = it
+                    .next()
+                    .and_then(|x| x.parse::<f64>().ok())
+                    .filter(|x| *x > 0.0);
+                timeout = std::time::Duration::from_secs_f64(
+                    v.ok_or(CliError::Usage("--timeout needs a number of seconds > 0"))?,
+                );
+            }
+            _ => words.push(w),
+        }
+    }
+    let line = format!("{target} {instruction} {}", words.join(" "));
+    let parsed = tandem_config::script::split_command(&line).map_err(CliError::command)?;
+    Ok(cmd::CmdRequest {
+        target,
+        instruction,
+        params: parsed.params,
+        wait,
+        timeout,
+    })
 }
 
 fn zenoh_arg() -> Arg {
@@ -216,167 +373,4 @@ fn cell_arg() -> Arg {
         .long("cell")
         .value_parser(clap::value_parser!(PathBuf))
         .help("The cell file (default: $TANDEM_CELL)")
-}
-
-/// `up`, `status`, `watch`, `cmd`.
-fn running(name: &str, m: &clap::ArgMatches, out: &mut impl Write) -> Result<(), live::Fail> {
-    let host = m.get_one::<String>("host").map(String::as_str);
-    match name {
-        "up" => {
-            let cell = m
-                .get_one::<PathBuf>("cell")
-                .ok_or_else(|| live::Fail(2, "a cell file is required".into()))?;
-            let o = live::UpOptions {
-                host: host.map(str::to_string),
-                script: m.get_one::<PathBuf>("script").cloned(),
-                record: m.get_one::<PathBuf>("record").cloned(),
-                view: !m.get_flag("no-view")
-                    && std::io::IsTerminal::is_terminal(&std::io::stdout()),
-                duration_s: m.get_one::<f64>("duration").copied(),
-                gateway: !m.get_flag("no-gateway"),
-                epoch_ns: m.get_one::<i64>("epoch-ns").copied(),
-            };
-            live::up(cell, &o, out)
-        }
-        "status" => {
-            let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
-            match zenoh_endpoints(m) {
-                Some(e) => live::status_zenoh(&cell, &e, out),
-                None => live::status(&cell, host, out),
-            }
-        }
-        "watch" => live::watch(
-            &live::cell_path(m.get_one::<PathBuf>("cell"))?,
-            host,
-            m.get_one::<String>("pattern").map(String::as_str),
-            m.get_one::<u64>("count").copied(),
-            out,
-        ),
-        "cmd" => {
-            let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
-            let target = m.get_one::<String>("target").cloned().unwrap_or_default();
-            let instruction = m
-                .get_one::<String>("instruction")
-                .cloned()
-                .unwrap_or_default();
-            let rest: Vec<String> = m
-                .get_many::<String>("params")
-                .map(|v| v.cloned().collect())
-                .unwrap_or_default();
-            let mut wait = false;
-            let mut timeout = std::time::Duration::from_secs(60);
-            let mut words = Vec::new();
-            let mut it = rest.into_iter();
-            while let Some(w) = it.next() {
-                match w.as_str() {
-                    "--wait" => wait = true,
-                    "--timeout" => {
-                        let v = it
-                            .next()
-                            .and_then(|x| x.parse::<f64>().ok())
-                            .filter(|x| *x > 0.0);
-                        timeout = std::time::Duration::from_secs_f64(v.ok_or_else(|| {
-                            live::Fail(2, "--timeout needs a number of seconds > 0".into())
-                        })?);
-                    }
-                    _ => words.push(w),
-                }
-            }
-            let line = format!("{target} {instruction} {}", words.join(" "));
-            let parsed =
-                tandem_config::script::split_command(&line).map_err(|m| live::Fail(2, m))?;
-            live::cmd(
-                &cell,
-                &target,
-                &instruction,
-                &parsed.params,
-                wait,
-                timeout,
-                out,
-            )
-        }
-        _ => Err(live::Fail(2, format!("unknown command `{name}`"))),
-    }
-}
-
-fn sim(m: &clap::ArgMatches, out: &mut impl Write, err: &mut impl Write) -> ExitCode {
-    let (Some(cell_path), Some(script_path), Some(trace_path)) = (
-        m.get_one::<PathBuf>("cell"),
-        m.get_one::<PathBuf>("script"),
-        m.get_one::<PathBuf>("trace"),
-    ) else {
-        return ExitCode::from(2);
-    };
-    let cell = match tandem_config::load(cell_path) {
-        Ok(c) => c,
-        Err(e) => {
-            let _ = writeln!(err, "error: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let src = match std::fs::read_to_string(script_path) {
-        Ok(s) => s,
-        Err(e) => {
-            let _ = writeln!(err, "error: {}: cannot read: {e}", script_path.display());
-            return ExitCode::from(2);
-        }
-    };
-    let script =
-        match tandem_config::script::parse_cell(&script_path.display().to_string(), &src, &cell) {
-            Ok(s) => s,
-            Err(e) => {
-                let _ = writeln!(err, "error: {e}");
-                return ExitCode::from(2);
-            }
-        };
-    let file = match std::fs::File::create(trace_path) {
-        Ok(f) => f,
-        Err(e) => {
-            let _ = writeln!(err, "error: {}: cannot create: {e}", trace_path.display());
-            return ExitCode::from(3);
-        }
-    };
-    let mut trace = std::io::BufWriter::new(file);
-    let quiet = m.get_flag("quiet");
-    let mut sink = std::io::sink();
-    let log: &mut dyn Write = if quiet { &mut sink } else { out };
-    let result = tandem_runtime::sim::run(&cell, &script, &mut trace, &mut LogAdapter(log))
-        .and_then(|s| {
-            trace.flush()?;
-            Ok(s)
-        });
-    match result {
-        Ok(s) => {
-            let _ = writeln!(
-                err,
-                "tandem sim: {} rows written to {}; {} command(s), {} rejected; {} axis/axes with a pending alarm",
-                s.rows,
-                trace_path.display(),
-                s.commands,
-                s.rejected,
-                s.axes_in_alarm
-            );
-            if m.get_flag("strict") && (s.rejected > 0 || s.axes_in_alarm > 0) {
-                ExitCode::from(1)
-            } else {
-                ExitCode::SUCCESS
-            }
-        }
-        Err(e) => {
-            let _ = writeln!(err, "error: {e}");
-            ExitCode::from(3)
-        }
-    }
-}
-
-/// `&mut dyn Write` as a sized `Write`.
-struct LogAdapter<'a>(&'a mut dyn Write);
-
-impl Write for LogAdapter<'_> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0.write(buf)
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.0.flush()
-    }
 }

@@ -1,5 +1,5 @@
-//! tandem-gateway: one per host, the bridge between the host's iceoryx2 domain and Zenoh
-//! (design §5).
+//! tandem-gateway: one per host, the bridge between the host's iceoryx2 domain and Zenoh (the
+//! keys and payloads are listed in docs/gateway.md).
 //!
 //! - **Leading values out**: for each leader of this host that a follower on another host
 //!   follows, every sample its node publishes is put on `tandem/<cell>/lv/<leader>` (binary,
@@ -18,6 +18,30 @@
 //!   coupling between the two hosts.
 //!
 //! A malformed payload on any key is dropped and counted; it never stops the gateway.
+//!
+//! Diagnostics go through `tracing` (the binary installs `tandem_rt::diag`): a span `gateway`
+//! (host, cell) with one span per thread (`task`) and one per command query (`command`: node,
+//! object, instruction, job); failures are [`GatewayError`]s with their exit code.
+//!
+//! ```no_run
+//! // The gateway of host `h1` for ten seconds, as `tandem-gateway cell.toml --host h1` runs it.
+//! let o = tandem_gateway::Options {
+//!     cell: "cell.toml".into(),
+//!     host: Some("h1".into()),
+//!     duration_s: Some(10.0),
+//! };
+//! match tandem_gateway::run(&o) {
+//!     Ok(counters) => println!("{counters:?}"),
+//!     Err(e) => {
+//!         eprintln!("{e}");
+//!         std::process::exit(e.exit_code().into());
+//!     }
+//! }
+//! ```
+
+mod error;
+
+pub use error::GatewayError;
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -31,6 +55,7 @@ use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
 use tandem_protocol::keys;
 use tandem_protocol::wire::{CommandRequest, Text, EVENT_JOB, EVENT_LOG};
 use tandem_rt as rt;
+use tracing::{debug, error, info, warn};
 use zenoh::qos::{CongestionControl, Priority};
 use zenoh::sample::Locality;
 use zenoh::Wait;
@@ -143,11 +168,11 @@ fn plan(cell: &Cell, h: usize) -> Plan {
 
 /// The Zenoh configuration of host `h`: peer mode, listening on the host's endpoints and
 /// connecting to the other hosts'; multicast scouting only when no endpoint is configured.
-pub fn zenoh_config(cell: &Cell, h: usize) -> Result<zenoh::Config, String> {
+pub fn zenoh_config(cell: &Cell, h: usize) -> Result<zenoh::Config, GatewayError> {
     let mut c = zenoh::Config::default();
-    let set = |c: &mut zenoh::Config, k: &str, v: String| {
-        c.insert_json5(k, &v)
-            .map_err(|e| format!("zenoh config {k} = {v}: {e}"))
+    let set = |c: &mut zenoh::Config, key: &'static str, value: String| {
+        c.insert_json5(key, &value)
+            .map_err(|source| GatewayError::ZenohConfig { key, value, source })
     };
     set(&mut c, "mode", "\"peer\"".into())?;
     let listen = cell.host_listen.get(h).cloned().unwrap_or_default();
@@ -174,41 +199,32 @@ pub fn zenoh_config(cell: &Cell, h: usize) -> Result<zenoh::Config, String> {
 }
 
 /// Runs the gateway until SIGINT/SIGTERM or the end of its duration.
-pub fn run(o: &Options) -> Result<Arc<Counters>, String> {
-    let cell = Arc::new(tandem_config::load(&o.cell).map_err(|e| e.to_string())?);
-    let h = match &o.host {
-        Some(name) => cell.hosts.iter().position(|x| x == name).ok_or_else(|| {
-            format!(
-                "{}: no host `{name}`; the cell has: {}",
-                o.cell.display(),
-                cell.hosts.join(", ")
-            )
-        })?,
-        None if cell.hosts.len() == 1 => 0,
-        None => {
-            return Err(format!(
-                "{}: the cell has several hosts ({}): say which with --host",
-                o.cell.display(),
-                cell.hosts.join(", ")
-            ))
-        }
-    };
+pub fn run(o: &Options) -> Result<Arc<Counters>, GatewayError> {
+    let cell = Arc::new(tandem_config::load(&o.cell)?);
+    let h = select_host(&cell, o)?;
     let host = cell.hosts[h].clone();
+    let span = tracing::info_span!("gateway", host = %host, cell = %cell.name);
+    let _entered = span.enter();
     rt::install_termination_handler();
-    ipc::cleanup_dead_nodes(&host);
+    let removed = ipc::cleanup_dead_nodes(&host);
+    if removed > 0 {
+        info!(
+            removed,
+            "removed the iceoryx2 resources of crashed processes"
+        );
+    }
     let plan = Arc::new(plan(&cell, h));
     let session = zenoh::open(zenoh_config(&cell, h)?)
         .wait()
-        .map_err(|e| format!("opening the Zenoh session: {e}"))?;
+        .map_err(GatewayError::zenoh("opening the Zenoh session"))?;
     let _token = session
         .liveliness()
         .declare_token(keys::alive(&cell.name, &host))
         .wait()
-        .map_err(|e| format!("liveliness token: {e}"))?;
-    let counters = Arc::new(Counters::default());
-    let stop = Arc::new(AtomicBool::new(false));
-    eprintln!(
-        "tandem-gateway {host}: cell `{}`, {} node(s); {} leader(s) out, {} in; Zenoh id {}",
+        .map_err(GatewayError::zenoh("liveliness token"))?;
+    info!(
+        zenoh_id = %session.zid(),
+        "cell `{}`, {} node(s); {} leader(s) out, {} in; Zenoh id {}",
         cell.name,
         plan.nodes.len(),
         plan.out.len(),
@@ -221,11 +237,68 @@ pub fn run(o: &Options) -> Result<Arc<Counters>, String> {
         h,
         plan,
         session: session.clone(),
-        counters: Arc::clone(&counters),
-        stop: Arc::clone(&stop),
+        counters: Arc::new(Counters::default()),
+        stop: Arc::new(AtomicBool::new(false)),
     };
-    type Task = fn(&Ctx) -> Result<(), String>;
-    let tasks: [(&str, Task); 5] = [
+    let threads = start_tasks(&ctx, &span)?;
+    wait_for_stop(o.duration_s);
+    ctx.stop.store(true, Ordering::SeqCst);
+    for (name, t) in threads {
+        if t.join().is_err() {
+            error!(task = name, "the {name} thread panicked");
+        }
+    }
+    let c = &ctx.counters;
+    info!(
+        lv_out = c.lv_out.load(Ordering::Relaxed),
+        lv_in = c.lv_in.load(Ordering::Relaxed),
+        malformed = c.malformed.load(Ordering::Relaxed),
+        commands = c.commands.load(Ordering::Relaxed),
+        "stopped; leading values out {}, in {}, malformed payloads {}, commands {}",
+        c.lv_out.load(Ordering::Relaxed),
+        c.lv_in.load(Ordering::Relaxed),
+        c.malformed.load(Ordering::Relaxed),
+        c.commands.load(Ordering::Relaxed)
+    );
+    if let Err(e) = session.close().wait() {
+        // The process ends next: the peers see the liveliness token go either way.
+        debug!(error = %e, "closing the Zenoh session");
+    }
+    Ok(Arc::clone(&ctx.counters))
+}
+
+/// The index of this gateway's host: `--host`, else the cell's only host.
+fn select_host(cell: &Cell, o: &Options) -> Result<usize, GatewayError> {
+    match &o.host {
+        Some(name) => {
+            cell.hosts
+                .iter()
+                .position(|x| x == name)
+                .ok_or_else(|| GatewayError::UnknownHost {
+                    cell: o.cell.clone(),
+                    host: name.clone(),
+                    hosts: cell.hosts.clone(),
+                })
+        }
+        None if cell.hosts.len() == 1 => Ok(0),
+        None => Err(GatewayError::HostRequired {
+            cell: o.cell.clone(),
+            hosts: cell.hosts.clone(),
+        }),
+    }
+}
+
+/// A thread of the gateway: runs until the stop flag is set.
+type Task = fn(&Ctx) -> Result<(), GatewayError>;
+
+/// Starts the gateway's threads (leading values out and in, commands, telemetry, clock), each in
+/// a span named after it under `parent`. A thread that fails logs its error and ends; the
+/// others go on.
+fn start_tasks(
+    ctx: &Ctx,
+    parent: &tracing::Span,
+) -> Result<Vec<(&'static str, std::thread::JoinHandle<()>)>, GatewayError> {
+    let tasks: [(&'static str, Task); 5] = [
         ("lv-out", lv_out),
         ("lv-in", lv_in),
         ("commands", commands),
@@ -235,45 +308,45 @@ pub fn run(o: &Options) -> Result<Arc<Counters>, String> {
     let mut threads = Vec::new();
     for (name, task) in tasks {
         let x = ctx.clone();
-        threads.push(
-            std::thread::Builder::new()
-                .name(name.into())
-                .spawn(move || {
-                    if let Err(e) = task(&x) {
-                        eprintln!("tandem-gateway {}: {name}: {e}", x.host);
-                    }
-                })
-                .map_err(|e| format!("cannot start the {name} thread: {e}"))?,
-        );
+        let span = tracing::info_span!(parent: parent, "task", name);
+        let spawned = std::thread::Builder::new()
+            .name(name.into())
+            .spawn(move || {
+                let _entered = span.enter();
+                if let Err(e) = task(&x) {
+                    error!(task = name, error = %e, "{name}: {e}");
+                }
+            });
+        match spawned {
+            Ok(t) => threads.push((name, t)),
+            Err(source) => {
+                ctx.stop.store(true, Ordering::SeqCst);
+                return Err(GatewayError::Thread { name, source });
+            }
+        }
     }
+    Ok(threads)
+}
+
+/// Returns on SIGINT/SIGTERM or when `duration_s` has passed.
+fn wait_for_stop(duration_s: Option<f64>) {
     let started = Instant::now();
     while !rt::termination_requested()
-        && o.duration_s
-            .is_none_or(|d| started.elapsed().as_secs_f64() < d)
+        && duration_s.is_none_or(|d| started.elapsed().as_secs_f64() < d)
     {
         std::thread::sleep(Duration::from_millis(20));
     }
-    stop.store(true, Ordering::SeqCst);
-    for t in threads {
-        let _ = t.join();
-    }
-    eprintln!(
-        "tandem-gateway {host}: stopped; leading values out {}, in {}, malformed payloads {}, commands {}",
-        counters.lv_out.load(Ordering::Relaxed),
-        counters.lv_in.load(Ordering::Relaxed),
-        counters.malformed.load(Ordering::Relaxed),
-        counters.commands.load(Ordering::Relaxed)
-    );
-    let _ = session.close().wait();
-    Ok(counters)
 }
 
-fn iox(cell: &Cell, host: &str, what: &str) -> Result<IpcNode, String> {
-    ipc::node(&format!("tandem/{}/gateway-{what}", cell.name), host).map_err(|e| e.to_string())
+fn iox(cell: &Cell, host: &str, what: &str) -> Result<IpcNode, GatewayError> {
+    Ok(ipc::node(
+        &format!("tandem/{}/gateway-{what}", cell.name),
+        host,
+    )?)
 }
 
 /// iceoryx2 to Zenoh: wakes on each publishing node's event and forwards every new sample.
-fn lv_out(x: &Ctx) -> Result<(), String> {
+fn lv_out(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     if plan.out.is_empty() {
         return Ok(());
@@ -288,12 +361,11 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
         .map(|(_, _, n)| *n)
         .collect::<std::collections::BTreeSet<_>>()
     {
-        let svc =
-            ipc::published(&node, &cell.name, &cell.nodes[n].name).map_err(|e| e.to_string())?;
+        let svc = ipc::published(&node, &cell.name, &cell.nodes[n].name)?;
         listeners.push(
             svc.listener_builder()
                 .create()
-                .map_err(|e| format!("listener: {e}"))?,
+                .map_err(GatewayError::port("listener"))?,
         );
     }
     let mut routes = Vec::new();
@@ -305,13 +377,12 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
             names[*l],
             actual,
             cell.leading_history(*l),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let sub = svc
             .subscriber_builder()
             .buffer_size(cell.leading_history(*l))
             .create()
-            .map_err(|e| format!("subscriber: {e}"))?;
+            .map_err(GatewayError::port("subscriber"))?;
         let key = keys::leading_value(&cell.name, names[*l], actual);
         let publisher = session
             .declare_publisher(key.clone())
@@ -320,12 +391,13 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
             .congestion_control(CongestionControl::Drop)
             .allowed_destination(Locality::Remote)
             .wait()
-            .map_err(|e| format!("publisher {key}: {e}"))?;
+            .map_err(GatewayError::zenoh(format!("publisher {key}")))?;
         routes.push((sub, publisher));
     }
     let each = Duration::from_millis(5) / listeners.len().max(1) as u32;
     while !stop.load(Ordering::SeqCst) {
         for l in &listeners {
+            // Woken or timed out, the routes are drained the same; a failed wait is a timeout.
             let _ = l.timed_wait(|_| {}, each);
             for (sub, publisher) in &routes {
                 while let Ok(Some(s)) = sub.receive() {
@@ -345,7 +417,7 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
 
 /// Zenoh to iceoryx2: every sample of a remote leader followed here goes into this host's
 /// leading-value service, timestamp unchanged.
-fn lv_in(x: &Ctx) -> Result<(), String> {
+fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "lv-in")?;
     let names = cell.object_names();
@@ -359,12 +431,11 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
             names[*l],
             actual,
             cell.leading_history(*l),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let p = svc
             .publisher_builder()
             .create()
-            .map_err(|e| format!("publisher: {e}"))?;
+            .map_err(GatewayError::port("publisher"))?;
         publishers.push((names[*l], actual, *l, p));
     }
     // Every leading value of the cell, so that a malformed one on any lv key is counted.
@@ -372,15 +443,15 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
         .declare_subscriber(keys::leading_values(&cell.name))
         .allowed_origin(Locality::Remote)
         .wait()
-        .map_err(|e| format!("subscriber: {e}"))?;
+        .map_err(GatewayError::zenoh("subscriber"))?;
     while !stop.load(Ordering::SeqCst) {
         let Ok(Some(sample)) = sub.recv_timeout(Duration::from_millis(50)) else {
             continue;
         };
-        let Some((leader, actual)) =
-            keys::parse_leading_value(&cell.name, sample.key_expr().as_str())
-        else {
+        let key = sample.key_expr().as_str();
+        let Some((leader, actual)) = keys::parse_leading_value(&cell.name, key) else {
             c.malformed.fetch_add(1, Ordering::Relaxed);
+            debug!(key, "not a leading-value key: dropped");
             continue;
         };
         let decoded = json::decode_leading_value(&sample.payload().to_bytes());
@@ -391,6 +462,7 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
             // A leader nobody here follows: not ours to forward (but still checked).
             if decoded.is_err() {
                 c.malformed.fetch_add(1, Ordering::Relaxed);
+                debug!(key, "malformed leading value: dropped");
             }
             continue;
         };
@@ -402,19 +474,29 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
             }
             _ => {
                 c.malformed.fetch_add(1, Ordering::Relaxed);
+                debug!(key, "malformed leading value: dropped");
             }
         }
     }
     Ok(())
 }
 
+/// The iceoryx2 command client of one node.
+type CommandClient = iceoryx2::port::client::Client<
+    iceoryx2::prelude::ipc::Service,
+    CommandRequest,
+    (),
+    tandem_protocol::wire::CommandReply,
+    (),
+>;
+
 /// Zenoh queries to the nodes' command services and back.
-fn commands(x: &Ctx) -> Result<(), String> {
+fn commands(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "commands")?;
     let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(64);
     let mut queryables = Vec::new();
-    let mut clients = HashMap::new();
+    let mut clients: HashMap<String, CommandClient> = HashMap::new();
     for n in &plan.nodes {
         let name = &cell.nodes[*n].name;
         let tx = tx.clone();
@@ -422,17 +504,18 @@ fn commands(x: &Ctx) -> Result<(), String> {
             session
                 .declare_queryable(keys::commands(&cell.name, name))
                 .callback(move |q| {
+                    // A full queue drops the query: its sender gets no reply and times out.
                     let _ = tx.try_send(q);
                 })
                 .wait()
-                .map_err(|e| format!("queryable: {e}"))?,
+                .map_err(GatewayError::zenoh("queryable"))?,
         );
-        let svc = ipc::commands(&node, &cell.name, name).map_err(|e| e.to_string())?;
+        let svc = ipc::commands(&node, &cell.name, name)?;
         clients.insert(
             name.clone(),
             svc.client_builder()
                 .create()
-                .map_err(|e| format!("command client: {e}"))?,
+                .map_err(GatewayError::port("command client"))?,
         );
     }
     while !stop.load(Ordering::SeqCst) {
@@ -440,54 +523,80 @@ fn commands(x: &Ctx) -> Result<(), String> {
             continue;
         };
         c.commands.fetch_add(1, Ordering::Relaxed);
-        let key = q.key_expr().as_str().to_string();
-        let reply = match keys::parse_command(&cell.name, &key) {
-            None => ReplyJson::failed("invalid", format!("`{key}` is not a command key")),
-            Some((node_name, object)) => {
-                let text = q
-                    .payload()
-                    .map(|p| p.try_to_string().map(|s| s.to_string()))
-                    .unwrap_or(Ok(String::new()));
-                let line = match text {
-                    Err(_) => Err("the payload is not UTF-8".to_string()),
-                    Ok(t) if t.trim_start().starts_with('{') => {
-                        serde_json::from_str::<json::CommandJson>(&t)
-                            .map_err(|e| format!("the JSON command is malformed: {e}"))
-                            .and_then(|c| c.to_line())
-                    }
-                    Ok(t) => Ok(t),
-                };
-                match (line, clients.get(node_name)) {
-                    (Err(m), _) => {
-                        c.malformed.fetch_add(1, Ordering::Relaxed);
-                        ReplyJson::failed("invalid", m)
-                    }
-                    (Ok(_), None) => ReplyJson::failed(
-                        "invalid",
-                        format!("node `{node_name}` is not on host `{host}`"),
-                    ),
-                    (Ok(line), Some(client)) => forward(client, &format!("{object} {line}")),
-                }
-            }
-        };
+        let reply = answer(&q, cell, host, &clients, c);
         let body = serde_json::to_string(&reply).unwrap_or_default();
-        let _ = q.reply(q.key_expr().clone(), body).wait();
+        if let Err(e) = q.reply(q.key_expr().clone(), body).wait() {
+            warn!(key = q.key_expr().as_str(), error = %e, "the reply to a command query could not be sent");
+        }
     }
     drop(queryables);
     Ok(())
 }
 
-/// Sends one command line to a node and waits up to 5 s for its reply.
-fn forward(
-    client: &iceoryx2::port::client::Client<
-        iceoryx2::prelude::ipc::Service,
-        CommandRequest,
-        (),
-        tandem_protocol::wire::CommandReply,
-        (),
-    >,
-    line: &str,
+/// The reply to one command query, in a `command` span (node, object, instruction, job):
+/// the node's, or why it was not forwarded.
+fn answer(
+    q: &zenoh::query::Query,
+    cell: &Cell,
+    host: &str,
+    clients: &HashMap<String, CommandClient>,
+    c: &Counters,
 ) -> ReplyJson {
+    let key = q.key_expr().as_str();
+    let Some((node_name, object)) = keys::parse_command(&cell.name, key) else {
+        debug!(key, "not a command key");
+        return ReplyJson::failed("invalid", format!("`{key}` is not a command key"));
+    };
+    let span = tracing::info_span!(
+        "command",
+        node = node_name,
+        object,
+        instruction = tracing::field::Empty,
+        job = tracing::field::Empty
+    );
+    let _entered = span.enter();
+    let line = command_line(q);
+    if let Ok(l) = &line {
+        span.record("instruction", l.split_whitespace().next().unwrap_or(""));
+    }
+    let reply = match (line, clients.get(node_name)) {
+        (Err(m), _) => {
+            c.malformed.fetch_add(1, Ordering::Relaxed);
+            ReplyJson::failed("invalid", m)
+        }
+        (Ok(_), None) => ReplyJson::failed(
+            "invalid",
+            format!("node `{node_name}` is not on host `{host}`"),
+        ),
+        (Ok(line), Some(client)) => forward(client, &format!("{object} {line}")),
+    };
+    span.record("job", reply.job);
+    debug!(
+        outcome = %reply.outcome,
+        error_id = %reply.error_id,
+        message = %reply.message,
+        "command answered"
+    );
+    reply
+}
+
+/// The command line of a query's payload: text as it is, or the JSON form turned into text.
+fn command_line(q: &zenoh::query::Query) -> Result<String, String> {
+    let text = q
+        .payload()
+        .map(|p| p.try_to_string().map(|s| s.to_string()))
+        .unwrap_or(Ok(String::new()));
+    match text {
+        Err(_) => Err("the payload is not UTF-8".to_string()),
+        Ok(t) if t.trim_start().starts_with('{') => serde_json::from_str::<json::CommandJson>(&t)
+            .map_err(|e| format!("the JSON command is malformed: {e}"))
+            .and_then(|c| c.to_line().map_err(|e| e.to_string())),
+        Ok(t) => Ok(t),
+    }
+}
+
+/// Sends one command line to a node and waits up to 5 s for its reply.
+fn forward(client: &CommandClient, line: &str) -> ReplyJson {
     let pending = match client.send_copy(CommandRequest {
         text: Text::new(line),
     }) {
@@ -512,79 +621,60 @@ fn forward(
     )
 }
 
+/// The telemetry and event subscribers of one node.
+struct NodeFeeds<'a> {
+    name: &'a str,
+    telemetry: iceoryx2::port::subscriber::Subscriber<
+        iceoryx2::prelude::ipc::Service,
+        [tandem_protocol::wire::AxisTelemetry],
+        tandem_protocol::wire::NodeHealth,
+    >,
+    events: iceoryx2::port::subscriber::Subscriber<
+        iceoryx2::prelude::ipc::Service,
+        tandem_protocol::wire::Event,
+        (),
+    >,
+}
+
+/// Puts `value` on `key`; a failed put is counted by Zenoh's own statistics and the next
+/// telemetry period puts a newer value, so it is only logged at debug level.
+fn put(session: &zenoh::Session, key: String, value: String) {
+    if let Err(e) = session.put(key.as_str(), value).wait() {
+        debug!(key = %key, error = %e, "put failed");
+    }
+}
+
 /// Per-axis state and node health at the telemetry rate, events and log lines as they happen.
-fn telemetry(x: &Ctx) -> Result<(), String> {
+fn telemetry(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "telemetry")?;
     let names = cell.object_names();
-    let mut subs = Vec::new();
+    let mut feeds = Vec::new();
     for n in &plan.nodes {
         let name = &cell.nodes[*n].name;
-        let t = ipc::telemetry(&node, &cell.name, name)
-            .map_err(|e| e.to_string())?
-            .subscriber_builder()
-            .buffer_size(4)
-            .create()
-            .map_err(|e| format!("telemetry subscriber: {e}"))?;
-        let e = ipc::events(&node, &cell.name, name)
-            .map_err(|e| e.to_string())?
-            .subscriber_builder()
-            .buffer_size(1024)
-            .create()
-            .map_err(|e| format!("event subscriber: {e}"))?;
-        subs.push((name.as_str(), t, e));
+        feeds.push(NodeFeeds {
+            name,
+            telemetry: ipc::telemetry(&node, &cell.name, name)?
+                .subscriber_builder()
+                .buffer_size(4)
+                .create()
+                .map_err(GatewayError::port("telemetry subscriber"))?,
+            events: ipc::events(&node, &cell.name, name)?
+                .subscriber_builder()
+                .buffer_size(1024)
+                .create()
+                .map_err(GatewayError::port("event subscriber"))?,
+        });
     }
     let period = Duration::from_secs_f64(1.0 / cell.telemetry_hz);
-    let put = |key: String, value: String| {
-        let _ = session.put(key, value).wait();
-    };
     let mut next = Instant::now();
     while !stop.load(Ordering::SeqCst) {
         next += period;
-        for (name, t, e) in &subs {
-            let mut newest = None;
-            while let Ok(Some(s)) = t.receive() {
-                newest = Some((*s.user_header(), s.payload().to_vec()));
-            }
-            if let Some((h, axes)) = newest {
-                for a in &axes {
-                    let axis = names.get(a.axis as usize).copied().unwrap_or("?");
-                    let state = AxisState::new(&h, name, axis, a);
-                    put(
-                        keys::state(&cell.name, name, axis),
-                        serde_json::to_string(&state).unwrap_or_default(),
-                    );
-                }
-                put(
-                    keys::health(&cell.name, name),
-                    serde_json::to_string(&Health::new(name, &h)).unwrap_or_default(),
-                );
-            }
-            while let Ok(Some(s)) = e.receive() {
-                let ev = s.payload();
-                let object = if ev.kind == EVENT_JOB {
-                    names.get(ev.object as usize).copied().unwrap_or("?")
-                } else {
-                    ""
-                };
-                let body = serde_json::to_string(&EventJson::new(ev, object)).unwrap_or_default();
-                match ev.kind {
-                    EVENT_JOB => put(keys::events(&cell.name, name, object), body),
-                    EVENT_LOG => put(keys::log(&cell.name, name), body),
-                    _ => {}
-                }
-            }
+        for f in &feeds {
+            put_state(session, cell, &names, f);
+            put_events(session, cell, &names, f);
         }
-        let own = serde_json::json!({
-            "host": host,
-            "lv_out": c.lv_out.load(Ordering::Relaxed),
-            "lv_in": c.lv_in.load(Ordering::Relaxed),
-            "malformed": c.malformed.load(Ordering::Relaxed),
-            "commands": c.commands.load(Ordering::Relaxed),
-            "clock_offset_us": c.clock_offset_ns.load(Ordering::Relaxed) as f64 * 1e-3,
-            "clock_warnings": c.clock_warnings.load(Ordering::Relaxed),
-        });
-        put(keys::gateway(&cell.name, host), own.to_string());
+        put_counters(session, cell, host, c);
         let now = Instant::now();
         if next > now {
             std::thread::sleep(next - now);
@@ -595,57 +685,85 @@ fn telemetry(x: &Ctx) -> Result<(), String> {
     Ok(())
 }
 
+/// The newest telemetry of one node: each axis' state and the node's health.
+fn put_state(session: &zenoh::Session, cell: &Cell, names: &[&str], f: &NodeFeeds) {
+    let mut newest = None;
+    while let Ok(Some(s)) = f.telemetry.receive() {
+        newest = Some((*s.user_header(), s.payload().to_vec()));
+    }
+    let Some((h, axes)) = newest else {
+        return;
+    };
+    for a in &axes {
+        let axis = names.get(a.axis as usize).copied().unwrap_or("?");
+        let state = AxisState::new(&h, f.name, axis, a);
+        put(
+            session,
+            keys::state(&cell.name, f.name, axis),
+            serde_json::to_string(&state).unwrap_or_default(),
+        );
+    }
+    put(
+        session,
+        keys::health(&cell.name, f.name),
+        serde_json::to_string(&Health::new(f.name, &h)).unwrap_or_default(),
+    );
+}
+
+/// The job events and log lines of one node since the last call.
+fn put_events(session: &zenoh::Session, cell: &Cell, names: &[&str], f: &NodeFeeds) {
+    while let Ok(Some(s)) = f.events.receive() {
+        let ev = s.payload();
+        let object = if ev.kind == EVENT_JOB {
+            names.get(ev.object as usize).copied().unwrap_or("?")
+        } else {
+            ""
+        };
+        let body = serde_json::to_string(&EventJson::new(ev, object)).unwrap_or_default();
+        match ev.kind {
+            EVENT_JOB => put(session, keys::events(&cell.name, f.name, object), body),
+            EVENT_LOG => put(session, keys::log(&cell.name, f.name), body),
+            _ => {}
+        }
+    }
+}
+
+/// The gateway's own counters.
+fn put_counters(session: &zenoh::Session, cell: &Cell, host: &str, c: &Counters) {
+    let own = serde_json::json!({
+        "host": host,
+        "lv_out": c.lv_out.load(Ordering::Relaxed),
+        "lv_in": c.lv_in.load(Ordering::Relaxed),
+        "malformed": c.malformed.load(Ordering::Relaxed),
+        "commands": c.commands.load(Ordering::Relaxed),
+        "clock_offset_us": c.clock_offset_ns.load(Ordering::Relaxed) as f64 * 1e-3,
+        "clock_warnings": c.clock_warnings.load(Ordering::Relaxed),
+    });
+    put(session, keys::gateway(&cell.name, host), own.to_string());
+}
+
 /// Answers clock queries and measures the offset to the other hosts' gateways once a second:
 /// `offset = t_remote - (t_sent + t_received) / 2`, from the round trip with the smallest delay
 /// of five.
-fn clock(x: &Ctx) -> Result<(), String> {
+fn clock(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let h = x.h;
     let _q = session
         .declare_queryable(keys::clock(&cell.name, host))
         .callback(|q| {
+            // An asker whose reply is lost retries on its next round.
             let _ = q
                 .reply(q.key_expr().clone(), rt::now_ns().to_string())
                 .wait();
         })
         .wait()
-        .map_err(|e| format!("clock queryable: {e}"))?;
+        .map_err(GatewayError::zenoh("clock queryable"))?;
     let others: Vec<usize> = (0..cell.hosts.len()).filter(|x| *x != h).collect();
     let mut warned: HashMap<usize, bool> = HashMap::new();
     while !stop.load(Ordering::SeqCst) {
         let mut worst = 0i64;
         for o in &others {
-            let mut best: Option<(i64, i64)> = None;
-            for _ in 0..5 {
-                let t0 = rt::now_ns();
-                let Ok(replies) = session
-                    .get(keys::clock(&cell.name, &cell.hosts[*o]))
-                    .timeout(Duration::from_millis(500))
-                    .wait()
-                else {
-                    continue;
-                };
-                if let Ok(r) = replies.recv() {
-                    let t1 = rt::now_ns();
-                    let remote = r
-                        .result()
-                        .ok()
-                        .and_then(|s| s.payload().try_to_string().ok().map(|x| x.to_string()))
-                        .and_then(|x| x.parse::<i64>().ok());
-                    match remote {
-                        Some(tr) => {
-                            let rtt = t1 - t0;
-                            if best.is_none_or(|(b, _)| rtt < b) {
-                                best = Some((rtt, tr - (t0 + t1) / 2));
-                            }
-                        }
-                        None => {
-                            c.malformed.fetch_add(1, Ordering::Relaxed);
-                        }
-                    }
-                }
-            }
-            let Some((rtt, offset)) = best else {
+            let Some((rtt, offset)) = clock_offset(session, cell, *o, c) else {
                 continue;
             };
             worst = worst.max(offset.abs());
@@ -654,8 +772,11 @@ fn clock(x: &Ctx) -> Result<(), String> {
                 let over = offset.abs() > limit;
                 if over && !warned.get(o).copied().unwrap_or(false) {
                     c.clock_warnings.fetch_add(1, Ordering::Relaxed);
-                    eprintln!(
-                        "tandem-gateway {host}: warning: the clock of host `{}` is {:.1} µs off (round trip {:.1} µs), more than {:.0} % of the {:.1} ms leading-value delay between the hosts: synchronize the clocks (PTP)",
+                    warn!(
+                        other = %cell.hosts[*o],
+                        offset_us = offset as f64 * 1e-3,
+                        round_trip_us = rtt as f64 * 1e-3,
+                        "the clock of host `{}` is {:.1} µs off (round trip {:.1} µs), more than {:.0} % of the {:.1} ms leading-value delay between the hosts: synchronize the clocks (PTP)",
                         cell.hosts[*o],
                         offset as f64 * 1e-3,
                         rtt as f64 * 1e-3,
@@ -673,4 +794,47 @@ fn clock(x: &Ctx) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The clock offset to host `o` (ns) with the round trip it was measured over: the best of
+/// five queries, or `None` when none was answered.
+fn clock_offset(
+    session: &zenoh::Session,
+    cell: &Cell,
+    o: usize,
+    c: &Counters,
+) -> Option<(i64, i64)> {
+    let mut best: Option<(i64, i64)> = None;
+    for _ in 0..5 {
+        let t0 = rt::now_ns();
+        let Ok(replies) = session
+            .get(keys::clock(&cell.name, &cell.hosts[o]))
+            .timeout(Duration::from_millis(500))
+            .wait()
+        else {
+            continue;
+        };
+        let Ok(r) = replies.recv() else {
+            continue;
+        };
+        let t1 = rt::now_ns();
+        let remote = r
+            .result()
+            .ok()
+            .and_then(|s| s.payload().try_to_string().ok().map(|x| x.to_string()))
+            .and_then(|x| x.parse::<i64>().ok());
+        match remote {
+            Some(tr) => {
+                let rtt = t1 - t0;
+                if best.is_none_or(|(b, _)| rtt < b) {
+                    best = Some((rtt, tr - (t0 + t1) / 2));
+                }
+            }
+            None => {
+                c.malformed.fetch_add(1, Ordering::Relaxed);
+                debug!(other = %cell.hosts[o], "malformed clock reply");
+            }
+        }
+    }
+    best
 }

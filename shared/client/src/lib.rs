@@ -8,12 +8,24 @@
 //! ```no_run
 //! # async fn demo() -> Result<(), tandem_client::ClientError> {
 //! use std::time::Duration;
-//! let c = tandem_client::Client::connect("line", &["tcp/10.0.0.1:7447".into()]).await?;
-//! let outcome = c
-//!     .execute("leaders", "line", "MC_MoveVelocity --velocity 800", Duration::from_secs(10))
+//! use tandem_client::{Client, ClientError};
+//! let c = Client::connect("line", &["tcp/10.0.0.1:7447".into()]).await?;
+//! // Send an instruction and return when the node applied it.
+//! let accepted = c
+//!     .command("leaders", "line", "MC_Power", Duration::from_secs(5))
 //!     .await?;
-//! println!("{outcome:?}");
-//! # Ok(()) }
+//! println!("job {} at t = {} ns", accepted.job, accepted.t_ns);
+//! // Send one and await its job: done, or reached its goal (here InVelocity).
+//! match c
+//!     .execute("leaders", "line", "MC_MoveVelocity --velocity 800", Duration::from_secs(10))
+//!     .await
+//! {
+//!     Ok(outcome) => println!("{outcome:?}"),
+//!     Err(ClientError::Rejected { error_id, .. }) => println!("rejected with {error_id}"),
+//!     Err(e) => return Err(e),
+//! }
+//! c.close().await
+//! # }
 //! ```
 
 use std::time::Duration;

@@ -1,0 +1,471 @@
+//! `tandem up`: starts this host's nodes (and its gateway) of a cell, restarts a crashed one
+//! with backoff, stops them all on SIGINT/SIGTERM, and shows the live table or the events.
+//!
+//! Its stages: `prepare` loads and checks the cell, script and recording directory; a
+//! `Supervisor` starts the processes, watches them and restarts a crashed one (doubling its
+//! backoff up to 10 s, back to 0.5 s after 10 s of running), relays their output, and stops
+//! them (SIGTERM, then SIGKILL after 5 s). What the supervision does is a `tracing` event (in
+//! the span `up` with the cell and host, and `node` per process); the live view also lists it.
+
+use crate::error::{describe_exit, CliError};
+use crate::live::{cli_node, host_nodes, load, render, Observer};
+use std::collections::VecDeque;
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+use tandem_config::Cell;
+use tandem_protocol::ipc;
+use tandem_protocol::wire::EVENT_LOG;
+use tandem_rt as rt;
+use tandem_rt::diag::LogFormat;
+use tracing::{info, info_span, warn};
+
+/// The first restart delay of a crashed process, and the delay again after it ran 10 s.
+const FIRST_BACKOFF: Duration = Duration::from_millis(500);
+/// The longest restart delay.
+const MAX_BACKOFF: Duration = Duration::from_secs(10);
+/// How many messages the live view lists.
+const VIEW_MESSAGES: usize = 12;
+
+/// How `up` runs.
+#[derive(Debug, Clone, Default)]
+pub struct UpOptions {
+    /// The host whose nodes to start.
+    pub host: Option<String>,
+    /// A script for the nodes.
+    pub script: Option<PathBuf>,
+    /// Write each node's trace and log into this directory.
+    pub record: Option<PathBuf>,
+    /// Show the live table (else: print events as they happen).
+    pub view: bool,
+    /// Stop after this many seconds of engine time.
+    pub duration_s: Option<f64>,
+    /// Start the host's gateway (Zenoh) too.
+    pub gateway: bool,
+    /// The cell clock's time of cycle 0 (ns). Every host of a cell must use the same; default:
+    /// the next whole second plus one.
+    pub epoch_ns: Option<i64>,
+    /// The diagnostics format, passed on to the gateway.
+    pub log_format: LogFormat,
+}
+
+/// A process of `up` (a node, or the host's gateway), with its restart state.
+struct Slot {
+    /// The node, or `None` for the gateway.
+    node: Option<usize>,
+    /// What `up` calls it in its messages.
+    name: String,
+    child: Option<Child>,
+    restarts: u32,
+    backoff: Duration,
+    start_at: Option<Instant>,
+    started: Instant,
+    finished: bool,
+}
+
+impl Slot {
+    fn new(node: Option<usize>, name: String) -> Self {
+        Self {
+            node,
+            name,
+            child: None,
+            restarts: 0,
+            backoff: FIRST_BACKOFF,
+            start_at: Some(Instant::now()),
+            started: Instant::now(),
+            finished: false,
+        }
+    }
+}
+
+/// Where a tandem program (`tandem-node`, `tandem-gateway`) is: beside this executable, else on
+/// PATH.
+fn binary(name: &str) -> PathBuf {
+    std::env::current_exe()
+        .ok()
+        .and_then(|p| p.parent().map(|d| d.join(name)))
+        .filter(|p| p.exists())
+        .unwrap_or_else(|| PathBuf::from(name))
+}
+
+/// What every process of the set is started with.
+struct Launch<'a> {
+    cell_path: &'a Path,
+    cell: &'a Cell,
+    host: &'a str,
+    /// The cell clock's time of cycle 0 (ns).
+    epoch: i64,
+    o: &'a UpOptions,
+}
+
+impl Launch<'_> {
+    /// The command line of `slot`'s program.
+    fn command(&self, slot: &Slot) -> std::process::Command {
+        let Some(node) = slot.node else {
+            let mut c = std::process::Command::new(binary("tandem-gateway"));
+            c.arg(self.cell_path).arg("--host").arg(self.host);
+            if self.o.log_format == LogFormat::Json {
+                c.arg("--log-format").arg("json");
+            }
+            return c;
+        };
+        let mut c = std::process::Command::new(binary("tandem-node"));
+        c.arg(self.cell_path)
+            .arg("--node")
+            .arg(&self.cell.nodes[node].name)
+            .arg("--epoch-ns")
+            .arg(self.epoch.to_string());
+        if let Some(s) = &self.o.script {
+            c.arg("--script").arg(s);
+        }
+        if let Some(d) = self.o.duration_s {
+            c.arg("--duration").arg(d.to_string());
+        }
+        if let Some(dir) = &self.o.record {
+            let name = &slot.name;
+            let suffix = if slot.restarts == 0 {
+                String::new()
+            } else {
+                format!(".{}", slot.restarts)
+            };
+            c.arg("--trace")
+                .arg(dir.join(format!("{name}{suffix}.csv")))
+                .arg("--log")
+                .arg(dir.join(format!("{name}{suffix}.log")));
+        }
+        c
+    }
+}
+
+/// Starts a program of the set, its stderr lines going to `lines` under `name`.
+fn start(
+    mut c: std::process::Command,
+    name: &str,
+    lines: &mpsc::Sender<(String, String)>,
+) -> std::io::Result<Child> {
+    c.stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    let mut child = c.spawn()?;
+    if let Some(stderr) = child.stderr.take() {
+        let (tx, n) = (lines.clone(), name.to_string());
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(stderr)
+                .lines()
+                .map_while(Result::ok)
+            {
+                if tx.send((n.clone(), line)).is_err() {
+                    break;
+                }
+            }
+        });
+    }
+    Ok(child)
+}
+
+/// Loads the cell and checks what `up` is given before anything starts: the host has nodes,
+/// the script parses, the recording directory exists. Returns the cell, the host's name and
+/// its nodes.
+fn prepare(cell_path: &Path, o: &UpOptions) -> Result<(Cell, String, Vec<usize>), CliError> {
+    let cell = load(cell_path)?;
+    let (host, nodes) = host_nodes(&cell, o.host.as_deref())?;
+    if nodes.is_empty() {
+        return Err(CliError::NoNodesHere);
+    }
+    if let Some(s) = &o.script {
+        let src = std::fs::read_to_string(s).map_err(|source| CliError::Read {
+            path: s.clone(),
+            source,
+        })?;
+        tandem_config::script::parse_cell(&s.display().to_string(), &src, &cell)?;
+    }
+    if let Some(d) = &o.record {
+        std::fs::create_dir_all(d).map_err(|source| CliError::RecordDir {
+            path: d.clone(),
+            source,
+        })?;
+    }
+    Ok((cell, host, nodes))
+}
+
+/// `tandem up`: starts the host's nodes, restarts a crashed one with backoff, stops all on
+/// SIGINT/SIGTERM, and shows the live table or the events.
+pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), CliError> {
+    let (cell, host, nodes) = prepare(cell_path, o)?;
+    let span = info_span!("up", cell = %cell.name, host = %host);
+    let _entered = span.enter();
+    rt::install_termination_handler();
+    let removed = ipc::cleanup_dead_nodes(&host);
+    let iox = cli_node(&cell, "up", &host)?;
+    let obs = Observer::new(&iox, &cell, &nodes, true)?;
+    // Cycle 0 of every node at the next whole second plus one: all start on one grid.
+    let epoch = o
+        .epoch_ns
+        .unwrap_or((rt::now_ns() / 1_000_000_000 + 2) * 1_000_000_000);
+    outln!(
+        out,
+        "tandem up: cell `{}`, {} node(s) on this host: {}{}",
+        cell.name,
+        nodes.len(),
+        nodes
+            .iter()
+            .map(|n| cell.nodes[*n].name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        if removed > 0 {
+            format!("; removed the resources of {removed} crashed process(es)")
+        } else {
+            String::new()
+        }
+    );
+    let launch = Launch {
+        cell_path,
+        cell: &cell,
+        host: &host,
+        epoch,
+        o,
+    };
+    let mut s = Supervisor::new(launch, &nodes, obs);
+    let result = s.supervise(out);
+    s.stop(out);
+    outln!(out, "tandem up: all nodes stopped");
+    result
+}
+
+/// The processes of `up` and what it shows of them.
+struct Supervisor<'a> {
+    launch: Launch<'a>,
+    nodes: &'a [usize],
+    slots: Vec<Slot>,
+    obs: Observer,
+    /// The processes' stderr lines: (name, line).
+    tx: mpsc::Sender<(String, String)>,
+    rx: mpsc::Receiver<(String, String)>,
+    /// The live view's recent messages.
+    messages: VecDeque<String>,
+    last_draw: Instant,
+}
+
+impl<'a> Supervisor<'a> {
+    /// A slot per node of the host, and one for the gateway unless `--no-gateway`.
+    fn new(launch: Launch<'a>, nodes: &'a [usize], obs: Observer) -> Self {
+        let mut slots: Vec<Slot> = nodes
+            .iter()
+            .map(|n| Slot::new(Some(*n), launch.cell.nodes[*n].name.clone()))
+            .collect();
+        if launch.o.gateway {
+            slots.push(Slot::new(None, format!("gateway {}", launch.host)));
+        }
+        let (tx, rx) = mpsc::channel();
+        Self {
+            launch,
+            nodes,
+            slots,
+            obs,
+            tx,
+            rx,
+            messages: VecDeque::new(),
+            last_draw: Instant::now(),
+        }
+    }
+
+    /// Starts, watches and restarts the processes until SIGINT/SIGTERM, until every node
+    /// finished (its script or duration ended; the gateway serves them), or until one refused
+    /// its configuration or could not be started (the error).
+    fn supervise(&mut self, out: &mut impl Write) -> Result<(), CliError> {
+        while !rt::termination_requested() {
+            for i in 0..self.slots.len() {
+                self.tend(i)?;
+            }
+            self.relay(out);
+            self.obs.poll();
+            if self.launch.o.view && self.last_draw.elapsed() > Duration::from_millis(250) {
+                self.last_draw = Instant::now();
+                self.draw(out);
+            }
+            if self
+                .slots
+                .iter()
+                .filter(|s| s.node.is_some())
+                .all(|s| s.finished)
+            {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        Ok(())
+    }
+
+    /// Lists `line` in the live view (a supervision event, already given to `tracing`).
+    fn note(&mut self, line: String) {
+        if self.launch.o.view {
+            self.messages.push_back(line);
+            if self.messages.len() > VIEW_MESSAGES {
+                self.messages.pop_front();
+            }
+        }
+    }
+
+    /// Shows `line` of a process or node: in the live view, else as a line of output.
+    fn say(&mut self, out: &mut impl Write, line: String) {
+        if self.launch.o.view {
+            self.note(line);
+        } else {
+            outln!(out, "{line}");
+        }
+    }
+
+    /// Looks after process `i`: notes how a running one ended, starts one that is due.
+    fn tend(&mut self, i: usize) -> Result<(), CliError> {
+        let span = info_span!("node", node = %self.slots[i].name);
+        let _entered = span.enter();
+        let slot = &mut self.slots[i];
+        if let Some(child) = slot.child.as_mut() {
+            if let Ok(Some(status)) = child.try_wait() {
+                slot.child = None;
+                return self.ended(i, status);
+            }
+        } else if slot.start_at.is_some_and(|at| Instant::now() >= at) {
+            slot.start_at = None;
+            return self.spawn(i);
+        }
+        Ok(())
+    }
+
+    /// Process `i` ended with `status`: finished, refused its configuration (exit code 2: the
+    /// error), or crashed (restarted after its backoff).
+    fn ended(&mut self, i: usize, status: std::process::ExitStatus) -> Result<(), CliError> {
+        let slot = &mut self.slots[i];
+        let name = slot.name.clone();
+        if status.success() {
+            slot.finished = true;
+            let line = format!("[{name}] finished");
+            info!("{line}");
+            self.note(line);
+            return Ok(());
+        }
+        if status.code() == Some(2) {
+            return Err(CliError::Refused { name, status });
+        }
+        if slot.started.elapsed() > MAX_BACKOFF {
+            slot.backoff = FIRST_BACKOFF;
+        }
+        let reason = describe_exit(status);
+        let line = format!(
+            "[{name}] crashed ({reason}); restarting in {:.1} s",
+            slot.backoff.as_secs_f64()
+        );
+        warn!(reason = %reason, restarts = slot.restarts, "{line}");
+        slot.start_at = Some(Instant::now() + slot.backoff);
+        slot.backoff = (slot.backoff * 2).min(MAX_BACKOFF);
+        slot.restarts += 1;
+        self.note(line);
+        Ok(())
+    }
+
+    /// Starts process `i`.
+    fn spawn(&mut self, i: usize) -> Result<(), CliError> {
+        let slot = &self.slots[i];
+        let command = self.launch.command(slot);
+        let program = PathBuf::from(command.get_program());
+        let child =
+            start(command, &slot.name, &self.tx).map_err(|source| CliError::CannotStart {
+                name: slot.name.clone(),
+                program,
+                gateway: slot.node.is_none(),
+                source,
+            })?;
+        let line = format!(
+            "[{}] started, pid {}{}",
+            slot.name,
+            child.id(),
+            if slot.restarts > 0 {
+                format!(" (restart {})", slot.restarts)
+            } else {
+                String::new()
+            }
+        );
+        info!(pid = child.id(), restarts = slot.restarts, "{line}");
+        let slot = &mut self.slots[i];
+        slot.child = Some(child);
+        slot.started = Instant::now();
+        self.note(line);
+        Ok(())
+    }
+
+    /// Shows the processes' stderr lines and the nodes' log lines since the last call.
+    fn relay(&mut self, out: &mut impl Write) {
+        while let Ok((n, line)) = self.rx.try_recv() {
+            self.say(out, format!("[{n}] {line}"));
+        }
+        for (n, e) in self.obs.events() {
+            if e.kind == EVENT_LOG {
+                let line = format!(
+                    "[{}] {}",
+                    self.launch.cell.nodes[n].name,
+                    e.message.as_str()
+                );
+                self.say(out, line);
+            }
+        }
+    }
+
+    /// Draws the live view: the axis table and the recent messages.
+    fn draw(&self, out: &mut impl Write) {
+        out!(
+            out,
+            "\x1b[H\x1b[2J{}",
+            render(self.launch.cell, &self.obs, self.nodes, None)
+        );
+        outln!(out, "\nCtrl-C stops the cell. Recent messages:");
+        for m in &self.messages {
+            outln!(out, "  {m}");
+        }
+        crate::output::flush(out);
+    }
+
+    /// Stops every process: SIGTERM, then SIGKILL for one that does not end within 5 s; then
+    /// prints their last lines.
+    fn stop(&mut self, out: &mut impl Write) {
+        for slot in &self.slots {
+            if let Some(c) = &slot.child {
+                if let Err(e) = rt::send_signal(c.id(), libc::SIGTERM) {
+                    // It ended on its own meanwhile; the wait below collects it.
+                    tracing::debug!(node = %slot.name, error = %e, "SIGTERM");
+                }
+            }
+        }
+        let deadline = Instant::now() + Duration::from_secs(5);
+        for slot in self.slots.iter_mut() {
+            if let Some(c) = slot.child.as_mut() {
+                wait_or_kill(c, deadline, &slot.name);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(50));
+        while let Ok((n, line)) = self.rx.try_recv() {
+            outln!(out, "[{n}] {line}");
+        }
+    }
+}
+
+/// Waits for `c` until `deadline`, then kills it.
+fn wait_or_kill(c: &mut Child, deadline: Instant, name: &str) {
+    loop {
+        match c.try_wait() {
+            Ok(Some(_)) => return,
+            Ok(None) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(10)),
+            _ => {
+                warn!(node = %name, "did not stop within 5 s of SIGTERM: killed");
+                if let Err(e) = c.kill() {
+                    tracing::debug!(node = %name, error = %e, "SIGKILL");
+                }
+                if let Err(e) = c.wait() {
+                    tracing::debug!(node = %name, error = %e, "waiting after SIGKILL");
+                }
+                return;
+            }
+        }
+    }
+}
