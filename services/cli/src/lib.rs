@@ -283,8 +283,8 @@ fn running(name: &str, m: &clap::ArgMatches, out: &mut impl Write) -> Result<(),
                 }
             }
             let line = format!("{target} {instruction} {}", words.join(" "));
-            let parsed =
-                tandem_config::script::split_command(&line).map_err(|m| live::Fail(2, m))?;
+            let parsed = tandem_config::script::split_command(&line)
+                .map_err(|m| live::Fail(2, m.to_string()))?;
             live::cmd(
                 &cell,
                 &target,

@@ -332,7 +332,7 @@ pub fn cmd(
     })?;
     // Check it here first, for an error message without a round trip.
     let entry = tandem_config::script::parse_command(&cell, object, instruction, params)
-        .map_err(|m| Fail(2, m))?;
+        .map_err(|m| Fail(2, m.to_string()))?;
     let object_index = cell.object_names().iter().position(|x| *x == entry.axis);
     let mut text = format!("{object} {instruction}");
     for (k, v) in params {
@@ -866,7 +866,7 @@ pub fn cmd_zenoh(
     })?;
     // Check it here first, for an error message without a round trip.
     tandem_config::script::parse_command(&cell, object, instruction, params)
-        .map_err(|m| Fail(2, m))?;
+        .map_err(|m| Fail(2, m.to_string()))?;
     let mut line = instruction.to_string();
     for (k, v) in params {
         line.push_str(&format!(" --{k} {v}"));

@@ -25,7 +25,7 @@ use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tandem_config::{Cell, Coupling};
+use tandem_config::{Cell, Coupling, Leader};
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
 use tandem_protocol::keys;
@@ -67,9 +67,9 @@ pub struct Counters {
 #[derive(Debug, Default)]
 struct Plan {
     /// Leaders of this host followed on another host: (leader, coupling, node).
-    out: Vec<(usize, Coupling, usize)>,
+    out: Vec<(Leader, Coupling, usize)>,
     /// Leaders of another host followed here: (leader, coupling).
-    inn: Vec<(usize, Coupling)>,
+    inn: Vec<(Leader, Coupling)>,
     /// This host's nodes.
     nodes: Vec<usize>,
     /// Per other host: the smallest delay of a coupling between the two hosts (ns).
@@ -112,7 +112,7 @@ fn plan(cell: &Cell, h: usize) -> Plan {
     for f in &cell.axes {
         let f_host = cell.nodes[f.node].host;
         for (l, c) in f.leaders.iter().flatten() {
-            let c = if *l >= cell.axes.len() {
+            let c = if l.is_encoder() {
                 Coupling::Setpoint
             } else {
                 *c
@@ -124,7 +124,7 @@ fn plan(cell: &Cell, h: usize) -> Plan {
             if l_host == f_host {
                 continue;
             }
-            let d = cell.leading[*l].delay_ns;
+            let d = cell.leading(*l).delay_ns;
             let other = if l_host == h { f_host } else { l_host };
             if l_host == h || f_host == h {
                 let e = p.min_delay.entry(other).or_insert(d);
@@ -280,7 +280,6 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
     }
     rt::no_timer_slack();
     let node = iox(cell, host, "lv-out")?;
-    let names = cell.object_names();
     let mut listeners = Vec::new();
     for n in plan
         .out
@@ -302,7 +301,7 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
         let svc = ipc::leading_values(
             &node,
             &cell.name,
-            names[*l],
+            cell.leader_name(*l),
             actual,
             cell.leading_history(*l),
         )
@@ -312,7 +311,7 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
             .buffer_size(cell.leading_history(*l))
             .create()
             .map_err(|e| format!("subscriber: {e}"))?;
-        let key = keys::leading_value(&cell.name, names[*l], actual);
+        let key = keys::leading_value(&cell.name, cell.leader_name(*l), actual);
         let publisher = session
             .declare_publisher(key.clone())
             .priority(Priority::RealTime)
@@ -348,7 +347,6 @@ fn lv_out(x: &Ctx) -> Result<(), String> {
 fn lv_in(x: &Ctx) -> Result<(), String> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "lv-in")?;
-    let names = cell.object_names();
     // (leader name, actual, leader index, publisher): looked up by &str, no allocation per sample.
     let mut publishers = Vec::new();
     for (l, cp) in &plan.inn {
@@ -356,7 +354,7 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
         let svc = ipc::leading_values(
             &node,
             &cell.name,
-            names[*l],
+            cell.leader_name(*l),
             actual,
             cell.leading_history(*l),
         )
@@ -365,7 +363,7 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
             .publisher_builder()
             .create()
             .map_err(|e| format!("publisher: {e}"))?;
-        publishers.push((names[*l], actual, *l, p));
+        publishers.push((cell.leader_name(*l), actual, *l, p));
     }
     // Every leading value of the cell, so that a malformed one on any lv key is counted.
     let sub = session
@@ -395,7 +393,7 @@ fn lv_in(x: &Ctx) -> Result<(), String> {
             continue;
         };
         match decoded {
-            Ok(s) if s.leader as usize == *l => {
+            Ok(s) if s.leader == cell.leader_id(*l) => {
                 if p.send_copy(s).is_ok() {
                     c.lv_in.fetch_add(1, Ordering::Relaxed);
                 }
