@@ -96,6 +96,24 @@ emergency_deceleration = 2000.0
     }
 
     #[test]
+    fn leaders_are_axes_then_encoders() {
+        let src = format!(
+            "{GOOD}\n[encoders.e]\nnode = \"n\"\nsource = \"profile\"\nprofile = [[0.0, 1.0]]\n"
+        );
+        let c = parse("cell.toml", &src).unwrap();
+        let e = Leader::Encoder(EncoderIndex(0));
+        assert_eq!(c.leader_id(Leader::Axis(AxisIndex(0))), 0);
+        assert_eq!(c.leader_id(e), 1);
+        assert_eq!(c.leader(1), Some(e));
+        assert_eq!(c.leader(2), None);
+        assert_eq!(c.leader_named("e"), Some(e));
+        assert_eq!(c.leader_name(e), "e");
+        assert_eq!(c.leader_node(e), Some(0));
+        assert_eq!(c.coupling(AxisIndex(0), e), Some(Coupling::Setpoint));
+        assert_eq!(c.axes[AxisIndex(0)].name, "x");
+    }
+
+    #[test]
     fn errors_name_file_line_and_key() {
         let bad = GOOD.replace("max_velocity = 100.0", "max_velocity = 0.0");
         let e = parse("cell.toml", &bad).unwrap_err();

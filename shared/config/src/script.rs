@@ -648,4 +648,23 @@ mod tests {
         let e = parse("s.toml", src, &["y"], &[]).unwrap_err();
         assert!(e.problem.to_string().contains("unknown axis `x`"));
     }
+
+    #[test]
+    fn errors_are_typed() {
+        let src = "[sim]\nduration = 1\n[[at]]\nt = 0\naxis = \"x\"\ninstruction = \"MC_Fly\"\n";
+        let e = parse("s.toml", src, &["x"], &[]).unwrap_err();
+        assert_eq!(
+            *e.problem,
+            Problem::Command(CommandError::UnknownInstruction("MC_Fly".into()))
+        );
+        assert_eq!(
+            split_command("x MC_Power --enable"),
+            Err(CommandError::MissingValue("enable".into()))
+        );
+        assert_eq!(split_command("  "), Err(CommandError::Empty));
+        assert_eq!(
+            split_command("x").unwrap_err().to_string(),
+            "`x`: no instruction given"
+        );
+    }
 }
