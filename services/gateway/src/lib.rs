@@ -49,7 +49,7 @@ use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tandem_config::{Cell, Coupling};
+use tandem_config::{Cell, Coupling, Leader};
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
 use tandem_protocol::keys;
@@ -92,9 +92,9 @@ pub struct Counters {
 #[derive(Debug, Default)]
 struct Plan {
     /// Leaders of this host followed on another host: (leader, coupling, node).
-    out: Vec<(usize, Coupling, usize)>,
+    out: Vec<(Leader, Coupling, usize)>,
     /// Leaders of another host followed here: (leader, coupling).
-    inn: Vec<(usize, Coupling)>,
+    inn: Vec<(Leader, Coupling)>,
     /// This host's nodes.
     nodes: Vec<usize>,
     /// Per other host: the smallest delay of a coupling between the two hosts (ns).
@@ -137,7 +137,7 @@ fn plan(cell: &Cell, h: usize) -> Plan {
     for f in &cell.axes {
         let f_host = cell.nodes[f.node].host;
         for (l, c) in f.leaders.iter().flatten() {
-            let c = if *l >= cell.axes.len() {
+            let c = if l.is_encoder() {
                 Coupling::Setpoint
             } else {
                 *c
@@ -149,7 +149,7 @@ fn plan(cell: &Cell, h: usize) -> Plan {
             if l_host == f_host {
                 continue;
             }
-            let d = cell.leading[*l].delay_ns;
+            let d = cell.leading(*l).delay_ns;
             let other = if l_host == h { f_host } else { l_host };
             if l_host == h || f_host == h {
                 let e = p.min_delay.entry(other).or_insert(d);
@@ -353,7 +353,6 @@ fn lv_out(x: &Ctx) -> Result<(), GatewayError> {
     }
     rt::no_timer_slack();
     let node = iox(cell, host, "lv-out")?;
-    let names = cell.object_names();
     let mut listeners = Vec::new();
     for n in plan
         .out
@@ -374,7 +373,7 @@ fn lv_out(x: &Ctx) -> Result<(), GatewayError> {
         let svc = ipc::leading_values(
             &node,
             &cell.name,
-            names[*l],
+            cell.leader_name(*l),
             actual,
             cell.leading_history(*l),
         )?;
@@ -383,7 +382,7 @@ fn lv_out(x: &Ctx) -> Result<(), GatewayError> {
             .buffer_size(cell.leading_history(*l))
             .create()
             .map_err(GatewayError::port("subscriber"))?;
-        let key = keys::leading_value(&cell.name, names[*l], actual);
+        let key = keys::leading_value(&cell.name, cell.leader_name(*l), actual);
         let publisher = session
             .declare_publisher(key.clone())
             .priority(Priority::RealTime)
@@ -420,7 +419,6 @@ fn lv_out(x: &Ctx) -> Result<(), GatewayError> {
 fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "lv-in")?;
-    let names = cell.object_names();
     // (leader name, actual, leader index, publisher): looked up by &str, no allocation per sample.
     let mut publishers = Vec::new();
     for (l, cp) in &plan.inn {
@@ -428,7 +426,7 @@ fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
         let svc = ipc::leading_values(
             &node,
             &cell.name,
-            names[*l],
+            cell.leader_name(*l),
             actual,
             cell.leading_history(*l),
         )?;
@@ -436,7 +434,7 @@ fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
             .publisher_builder()
             .create()
             .map_err(GatewayError::port("publisher"))?;
-        publishers.push((names[*l], actual, *l, p));
+        publishers.push((cell.leader_name(*l), actual, *l, p));
     }
     // Every leading value of the cell, so that a malformed one on any lv key is counted.
     let sub = session
@@ -467,7 +465,7 @@ fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
             continue;
         };
         match decoded {
-            Ok(s) if s.leader as usize == *l => {
+            Ok(s) if s.leader == cell.leader_id(*l) => {
                 if p.send_copy(s).is_ok() {
                     c.lv_in.fetch_add(1, Ordering::Relaxed);
                 }

@@ -20,7 +20,7 @@ use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};
 use std::sync::Arc;
 use std::time::Duration;
 use tandem_config::script::{split_command, ScriptEntry};
-use tandem_config::{Cell, Coupling};
+use tandem_config::{AxisIndex, Cell, Coupling, Leader};
 use tandem_motion::action::Action;
 use tandem_motion::axis::AxisStatus;
 use tandem_protocol::ipc::{self, IpcNode};
@@ -324,13 +324,13 @@ fn cyclic(
     let host = &cell.hosts[me.host];
     let iox = ipc::node(&names::node(&cell.name, &me.name), host).map_err(|e| e.to_string())?;
     let mut exec = Executive::new(cell, Some(n)).map_err(|e| e.to_string())?;
-    let history = |l: usize| cell.leading_history(l);
+    let history = |l: Leader| cell.leading_history(l);
     let names_of = cell.object_names();
     // Leading values this node publishes: the leaders here that followers elsewhere name.
     let mut publish = Vec::new();
     for f in cell.axes.iter().filter(|a| a.node != n) {
         for (l, c) in f.leaders.iter().flatten() {
-            let c = if *l >= cell.axes.len() {
+            let c = if l.is_encoder() {
                 Coupling::Setpoint
             } else {
                 *c
@@ -340,7 +340,7 @@ fn cyclic(
                 let svc = ipc::leading_values(
                     &iox,
                     &cell.name,
-                    names_of[*l],
+                    cell.leader_name(*l),
                     c == Coupling::Actual,
                     history(*l),
                 )
@@ -348,19 +348,19 @@ fn cyclic(
                 let p = svc
                     .publisher_builder()
                     .create()
-                    .map_err(|e| format!("publisher for {}: {e}", names_of[*l]))?;
+                    .map_err(|e| format!("publisher for {}: {e}", cell.leader_name(*l)))?;
                 publish.push((*l, c, p));
             }
         }
     }
     // Leading values of other nodes' leaders that followers here read.
     let mut subscribe = Vec::new();
-    let remote: Vec<(usize, Coupling)> = exec.remote_leaders().collect();
+    let remote: Vec<(Leader, Coupling)> = exec.remote_leaders().collect();
     for (l, c) in remote {
         let svc = ipc::leading_values(
             &iox,
             &cell.name,
-            names_of[l],
+            cell.leader_name(l),
             c == Coupling::Actual,
             history(l),
         )
@@ -369,7 +369,7 @@ fn cyclic(
             .subscriber_builder()
             .buffer_size(history(l))
             .create()
-            .map_err(|e| format!("subscriber for {}: {e}", names_of[l]))?;
+            .map_err(|e| format!("subscriber for {}: {e}", cell.leader_name(l)))?;
         subscribe.push((l, c, s));
     }
     // A gateway waits on this event to forward the leading values at once.
@@ -395,7 +395,7 @@ fn cyclic(
         .max_loaned_samples(4)
         .create()
         .map_err(|e| format!("event publisher: {e}"))?;
-    let io_objects: Vec<(&str, usize)> = cell
+    let io_objects: Vec<(&str, AxisIndex)> = cell
         .output_cams
         .iter()
         .map(|c| (c.name.as_str(), c.axis))
@@ -536,7 +536,7 @@ fn cyclic(
         for ((l, c, p), seq) in publish.iter().zip(seqs.iter_mut()) {
             let s = exec.sample(*l, *c, t, *seq);
             *seq += 1;
-            let _ = p.send_copy(LeadingValueSample::from_sample(*l as u32, &s));
+            let _ = p.send_copy(LeadingValueSample::from_sample(cell.leader_id(*l), &s));
         }
         if let Some(n) = &published {
             let _ = n.notify();
@@ -653,7 +653,7 @@ impl core::fmt::Write for TextWriter<'_> {
 
 /// Whether node `n` hosts the object a script entry addresses.
 fn owns(cell: &Cell, n: usize, target: &str, action: &Action) -> bool {
-    let axis_node = |a: usize| cell.axes.get(a).map(|x| x.node);
+    let axis_node = |a: AxisIndex| cell.axis(a).map(|x| x.node);
     let node = match action {
         Action::InterpolateCam { .. } => return true,
         Action::Command(_) => cell
@@ -709,14 +709,24 @@ fn command_thread(
             while let Ok(Some(active)) = server.receive() {
                 id += 1;
                 let text = active.payload().text.as_str().to_string();
-                let parsed = split_command(&text).and_then(|c| {
-                    let object = match c.object.split_once('/') {
-                        Some((nn, o)) if Some(nn) == Some(node) => o.to_string(),
-                        Some((nn, _)) => return Err(format!("this is node `{node}`, not `{nn}`")),
-                        None => c.object,
-                    };
-                    tandem_config::script::parse_command(cell, &object, &c.instruction, &c.params)
-                });
+                let parsed = split_command(&text)
+                    .map_err(|e| e.to_string())
+                    .and_then(|c| {
+                        let object = match c.object.split_once('/') {
+                            Some((nn, o)) if Some(nn) == Some(node) => o.to_string(),
+                            Some((nn, _)) => {
+                                return Err(format!("this is node `{node}`, not `{nn}`"))
+                            }
+                            None => c.object,
+                        };
+                        tandem_config::script::parse_command(
+                            cell,
+                            &object,
+                            &c.instruction,
+                            &c.params,
+                        )
+                        .map_err(|e| e.to_string())
+                    });
                 let parsed = parsed.and_then(|e| {
                     if n.is_some_and(|n| owns(cell, n, &e.axis, &e.action)) {
                         Ok(e)

@@ -4,6 +4,7 @@
 //! references' input names in snake case (`position`, `velocity`, `abort_acceleration`...).
 //! Defaults are the references' defaults (dynamics -1.0 = the axis defaults).
 
+use core::fmt;
 use tandem_motion::axis::{
     ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
     SyncProfileReference, VelocityDirection,
@@ -262,45 +263,273 @@ pub fn find(name: &str) -> Option<&'static InstructionSpec> {
     INSTRUCTIONS.iter().find(|i| normalize(i.name) == n)
 }
 
+/// The type a parameter must have.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Expected {
+    /// A number.
+    Number,
+    /// `true` or `false`.
+    Bool,
+    /// A whole number.
+    Integer,
+    /// A number or `true`/`false`.
+    NumberOrBool,
+}
+
+impl fmt::Display for Expected {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Expected::Number => "a number",
+            Expected::Bool => "true or false",
+            Expected::Integer => "an integer",
+            Expected::NumberOrBool => "a number or true/false",
+        })
+    }
+}
+
+/// What is wrong with an instruction as written (in a script entry or on a command line).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CommandError {
+    /// No instruction has this name in any spelling.
+    UnknownInstruction(String),
+    /// A parameter the instruction does not have.
+    UnknownParameter {
+        /// The instruction (PLCopen name).
+        instruction: &'static str,
+        /// The parameter given.
+        name: String,
+        /// The instruction's parameters.
+        known: Vec<&'static str>,
+    },
+    /// A required parameter without a value.
+    MissingParameter {
+        /// The instruction.
+        instruction: &'static str,
+        /// The parameter.
+        param: &'static str,
+    },
+    /// A required reference to an object (`master`, `cam`) without a value.
+    MissingReference {
+        /// The instruction.
+        instruction: &'static str,
+        /// The parameter.
+        param: &'static str,
+        /// What it names.
+        what: &'static str,
+    },
+    /// A value of the wrong type.
+    WrongType {
+        /// The instruction, when the message names it.
+        instruction: Option<&'static str>,
+        /// The parameter.
+        param: String,
+        /// The type it must have.
+        expected: Expected,
+    },
+    /// A code outside the values the parameter accepts.
+    BadValue {
+        /// The instruction.
+        instruction: &'static str,
+        /// The parameter.
+        param: &'static str,
+        /// The values it accepts.
+        allowed: &'static str,
+    },
+    /// An instruction the command parser does not build.
+    NoParser(&'static str),
+    /// A name that refers to no object of its kind.
+    UnknownObject {
+        /// The instruction, when the message names it.
+        instruction: Option<&'static str>,
+        /// The kind of object (`axis`, `cam`, `master`, `output cam`...).
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The names the cell has.
+        known: Vec<String>,
+    },
+    /// An axis that names itself as its leader.
+    SelfFollow(String),
+    /// A reference that is not a name.
+    NotAName {
+        /// The parameter.
+        param: &'static str,
+        /// What it must name.
+        what: &'static str,
+    },
+    /// A key every entry needs.
+    MissingKey {
+        /// The key.
+        key: &'static str,
+        /// What it gives, when the message says it.
+        hint: Option<&'static str>,
+    },
+    /// A command-line parameter name that is not a plain name.
+    BadParameterName(String),
+    /// A command-line parameter that is a key of the entry, not of the instruction.
+    ReservedParameter(String),
+    /// A command line that gave no entry.
+    NotUnderstood(String),
+    /// An empty command line.
+    Empty,
+    /// A command line with an object and no instruction.
+    NoInstruction(String),
+    /// A command-line word where `--parameter` was expected.
+    ExpectedParameter(String),
+    /// A command-line parameter without a value.
+    MissingValue(String),
+}
+
+impl fmt::Display for CommandError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CommandError::UnknownInstruction(name) => {
+                let names: Vec<&str> = INSTRUCTIONS.iter().map(|i| i.name).collect();
+                write!(
+                    f,
+                    "unknown instruction `{name}`; known: {}",
+                    names.join(", ")
+                )
+            }
+            CommandError::UnknownParameter {
+                instruction,
+                name,
+                known,
+            } => write!(
+                f,
+                "{instruction}: unknown parameter `{name}`; parameters: {}",
+                known.join(", ")
+            ),
+            CommandError::MissingParameter { instruction, param } => {
+                write!(f, "{instruction}: parameter `{param}` is required")
+            }
+            CommandError::MissingReference {
+                instruction,
+                param,
+                what,
+            } => write!(f, "{instruction}: parameter `{param}` ({what}) is required"),
+            CommandError::WrongType {
+                instruction,
+                param,
+                expected,
+            } => {
+                if let Some(i) = instruction {
+                    write!(f, "{i}: ")?;
+                }
+                write!(f, "`{param}` must be {expected}")
+            }
+            CommandError::BadValue {
+                instruction,
+                param,
+                allowed,
+            } => write!(f, "{instruction}: {param} must be {allowed}"),
+            CommandError::NoParser(i) => write!(f, "instruction `{i}` has no parser"),
+            CommandError::UnknownObject {
+                instruction,
+                what,
+                name,
+                known,
+            } => {
+                if let Some(i) = instruction {
+                    write!(f, "{i}: ")?;
+                }
+                write!(
+                    f,
+                    "unknown {what} `{name}`; the cell has: {}",
+                    known.join(", ")
+                )
+            }
+            CommandError::SelfFollow(axis) => write!(f, "axis `{axis}` cannot follow itself"),
+            CommandError::NotAName { param, what } => write!(f, "`{param}` must be {what}"),
+            CommandError::MissingKey { key, hint } => match hint {
+                Some(h) => write!(f, "`{key}` ({h}) is required"),
+                None => write!(f, "`{key}` is required"),
+            },
+            CommandError::BadParameterName(k) => write!(f, "`--{k}` is not a parameter name"),
+            CommandError::ReservedParameter(k) => {
+                write!(f, "`--{k}` is not a parameter of an instruction")
+            }
+            CommandError::NotUnderstood(i) => write!(f, "`{i}` was not understood"),
+            CommandError::Empty => f.write_str("empty command"),
+            CommandError::NoInstruction(o) => write!(f, "`{o}`: no instruction given"),
+            CommandError::ExpectedParameter(w) => write!(f, "`{w}`: expected `--parameter value`"),
+            CommandError::MissingValue(k) => write!(f, "`--{k}` needs a value"),
+        }
+    }
+}
+
+impl std::error::Error for CommandError {}
+
+/// The parameters given to one instruction, read with its defaults.
 struct Args<'a> {
     spec: &'static InstructionSpec,
     given: &'a [(String, Value)],
 }
 
 impl Args<'_> {
-    fn get(&self, key: &str) -> Result<Value, String> {
+    fn get(&self, key: &'static str) -> Result<Value, CommandError> {
         if let Some((_, v)) = self.given.iter().rev().find(|(k, _)| k == key) {
             return Ok(*v);
         }
         match self.spec.params.iter().find(|(k, _)| *k == key) {
             Some((_, Some(d))) => Ok(*d),
-            _ => Err(format!("{}: parameter `{key}` is required", self.spec.name)),
+            _ => Err(CommandError::MissingParameter {
+                instruction: self.spec.name,
+                param: key,
+            }),
         }
     }
 
-    fn num(&self, key: &str) -> Result<f64, String> {
+    fn wrong(&self, key: &'static str, expected: Expected) -> CommandError {
+        CommandError::WrongType {
+            instruction: Some(self.spec.name),
+            param: key.to_string(),
+            expected,
+        }
+    }
+
+    fn num(&self, key: &'static str) -> Result<f64, CommandError> {
         match self.get(key)? {
             Value::Num(x) => Ok(x),
-            Value::Bool(_) => Err(format!("{}: `{key}` must be a number", self.spec.name)),
+            Value::Bool(_) => Err(self.wrong(key, Expected::Number)),
         }
     }
 
-    fn flag(&self, key: &str) -> Result<bool, String> {
+    fn flag(&self, key: &'static str) -> Result<bool, CommandError> {
         match self.get(key)? {
             Value::Bool(b) => Ok(b),
-            Value::Num(_) => Err(format!("{}: `{key}` must be true or false", self.spec.name)),
+            Value::Num(_) => Err(self.wrong(key, Expected::Bool)),
         }
     }
 
-    fn code(&self, key: &str) -> Result<i32, String> {
+    fn code(&self, key: &'static str) -> Result<i32, CommandError> {
         let x = self.num(key)?;
         if x.fract() != 0.0 || !(-1e6..=1e6).contains(&x) {
-            return Err(format!("{}: `{key}` must be an integer", self.spec.name));
+            return Err(self.wrong(key, Expected::Integer));
         }
         Ok(x as i32)
     }
 
-    fn dynamics_no_velocity(&self) -> Result<Dynamics, String> {
+    /// A code mapped to a value by `table`, or [`CommandError::BadValue`] naming `allowed`.
+    fn choice<T: Copy>(
+        &self,
+        key: &'static str,
+        table: &[(i32, T)],
+        allowed: &'static str,
+    ) -> Result<T, CommandError> {
+        let c = self.code(key)?;
+        table
+            .iter()
+            .find(|(k, _)| *k == c)
+            .map(|(_, v)| *v)
+            .ok_or(CommandError::BadValue {
+                instruction: self.spec.name,
+                param: key,
+                allowed,
+            })
+    }
+
+    fn dynamics_no_velocity(&self) -> Result<Dynamics, CommandError> {
         Ok(Dynamics {
             velocity: -1.0,
             acceleration: self.num("acceleration")?,
@@ -309,7 +538,7 @@ impl Args<'_> {
         })
     }
 
-    fn dynamics(&self, vel_key: &str) -> Result<Dynamics, String> {
+    fn dynamics(&self, vel_key: &'static str) -> Result<Dynamics, CommandError> {
         Ok(Dynamics {
             velocity: self.num(vel_key)?,
             acceleration: self.num("acceleration")?,
@@ -317,135 +546,212 @@ impl Args<'_> {
             jerk: self.num("jerk")?,
         })
     }
+
+    fn sync_direction(&self) -> Result<SyncDirection, CommandError> {
+        self.choice(
+            "sync_direction",
+            &[
+                (1, SyncDirection::Positive),
+                (2, SyncDirection::Negative),
+                (3, SyncDirection::Shortest),
+            ],
+            "1, 2 or 3",
+        )
+    }
+
+    fn ratio(&self) -> Result<(i32, i32), CommandError> {
+        Ok((
+            self.code("ratio_numerator")?,
+            self.code("ratio_denominator")?,
+        ))
+    }
+}
+
+/// The instruction named `instruction`, with every given parameter checked against its list.
+fn spec_of(
+    instruction: &str,
+    params: &[(String, Value)],
+) -> Result<&'static InstructionSpec, CommandError> {
+    let spec =
+        find(instruction).ok_or_else(|| CommandError::UnknownInstruction(instruction.into()))?;
+    if let Some((k, _)) = params
+        .iter()
+        .find(|(k, _)| !spec.params.iter().any(|(p, _)| p == k))
+    {
+        return Err(CommandError::UnknownParameter {
+            instruction: spec.name,
+            name: k.clone(),
+            known: spec.params.iter().map(|(p, _)| *p).collect(),
+        });
+    }
+    Ok(spec)
 }
 
 /// Builds a command. Unknown instructions and parameters, missing required parameters and
 /// values of the wrong type are errors naming what was wrong. `master` is the leader the
 /// instruction names (resolved by the caller), for the instructions that need one.
-pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Result<Command, String> {
-    let master: Option<LeaderId> = refs.master;
-    let spec = find(instruction).ok_or_else(|| {
-        let names: Vec<&str> = INSTRUCTIONS.iter().map(|i| i.name).collect();
-        format!(
-            "unknown instruction `{instruction}`; known: {}",
-            names.join(", ")
-        )
-    })?;
-    for (k, _) in params {
-        if !spec.params.iter().any(|(p, _)| p == k) {
-            let names: Vec<&str> = spec.params.iter().map(|(p, _)| *p).collect();
-            return Err(format!(
-                "{}: unknown parameter `{k}`; parameters: {}",
-                spec.name,
-                names.join(", ")
-            ));
-        }
-    }
+pub fn parse(
+    instruction: &str,
+    params: &[(String, Value)],
+    refs: Refs,
+) -> Result<Command, CommandError> {
+    let spec = spec_of(instruction, params)?;
     let a = Args {
         spec,
         given: params,
     };
+    match sync_command(&a, refs)? {
+        Some(c) => Ok(c),
+        None => single_axis_command(&a),
+    }
+}
+
+/// The synchronous operation instructions (gearing, camming, offset, phasing); `None` for the
+/// others.
+fn sync_command(a: &Args<'_>, refs: Refs) -> Result<Option<Command>, CommandError> {
+    let name = a.spec.name;
     let leader = || {
-        master.ok_or_else(|| {
-            format!(
-                "{}: parameter `master` (the leading axis) is required",
-                spec.name
-            )
+        refs.master.ok_or(CommandError::MissingReference {
+            instruction: name,
+            param: "master",
+            what: "the leading axis",
         })
     };
-    let ratio = |k: &str| -> Result<i32, String> { a.code(k) };
-    let cmd = match spec.name {
-        "MC_GearIn" => Command::GearIn {
-            master: leader()?,
-            ratio_numerator: ratio("ratio_numerator")?,
-            ratio_denominator: ratio("ratio_denominator")?,
-            dynamics: a.dynamics_no_velocity()?,
-        },
-        "MC_GearInPos" => Command::GearInPos {
-            master: leader()?,
-            ratio_numerator: ratio("ratio_numerator")?,
-            ratio_denominator: ratio("ratio_denominator")?,
-            master_sync_position: a.num("master_sync_position")?,
-            slave_sync_position: a.num("slave_sync_position")?,
-            sync_profile_reference: match a.code("sync_profile_reference")? {
-                0 => SyncProfileReference::Dynamics,
-                1 => SyncProfileReference::MasterStartDistance,
-                _ => return Err("MC_GearInPos: sync_profile_reference must be 0 or 1".into()),
-            },
-            master_start_distance: a.num("master_start_distance")?,
-            dynamics: a.dynamics("velocity")?,
-            sync_direction: match a.code("sync_direction")? {
-                1 => SyncDirection::Positive,
-                2 => SyncDirection::Negative,
-                3 => SyncDirection::Shortest,
-                _ => return Err("MC_GearInPos: sync_direction must be 1, 2 or 3".into()),
-            },
-        },
+    Ok(Some(match name {
+        "MC_GearIn" | "MC_GearInVelocity" => {
+            let master = leader()?;
+            let (ratio_numerator, ratio_denominator) = a.ratio()?;
+            let dynamics = a.dynamics_no_velocity()?;
+            if name == "MC_GearIn" {
+                Command::GearIn {
+                    master,
+                    ratio_numerator,
+                    ratio_denominator,
+                    dynamics,
+                }
+            } else {
+                Command::GearInVelocity {
+                    master,
+                    ratio_numerator,
+                    ratio_denominator,
+                    dynamics,
+                }
+            }
+        }
+        "MC_GearInPos" => gear_in_pos(a, leader()?)?,
         "MC_GearOut" => Command::GearOut,
-        "MC_CamIn" => Command::CamIn {
-            master: leader()?,
-            cam: refs
-                .cam
-                .ok_or("MC_CamIn: parameter `cam` (the cam's name) is required")?,
-            master_offset: a.num("master_offset")?,
-            slave_offset: a.num("slave_offset")?,
-            master_scaling: a.num("master_scaling")?,
-            slave_scaling: a.num("slave_scaling")?,
-            master_sync_position: a.num("master_sync_position")?,
-            sync_profile_reference: match a.code("sync_profile_reference")? {
-                0 => SyncProfileReference::Dynamics,
-                1 => SyncProfileReference::MasterStartDistance,
-                2 => SyncProfileReference::Direct,
-                _ => return Err("MC_CamIn: sync_profile_reference must be 0, 1 or 2".into()),
-            },
-            master_start_distance: a.num("master_start_distance")?,
-            dynamics: a.dynamics("velocity")?,
-            application_mode: match a.code("application_mode")? {
-                0 => ApplicationMode::Once,
-                1 => ApplicationMode::Cyclic,
-                2 => ApplicationMode::CyclicAppending,
-                _ => return Err("MC_CamIn: application_mode must be 0, 1 or 2".into()),
-            },
-            sync_direction: match a.code("sync_direction")? {
-                1 => SyncDirection::Positive,
-                2 => SyncDirection::Negative,
-                3 => SyncDirection::Shortest,
-                _ => return Err("MC_CamIn: sync_direction must be 1, 2 or 3".into()),
-            },
-        },
+        "MC_CamIn" => {
+            let master = leader()?;
+            let cam = refs.cam.ok_or(CommandError::MissingReference {
+                instruction: name,
+                param: "cam",
+                what: "the cam's name",
+            })?;
+            cam_in(a, master, cam)?
+        }
         "MC_CamOut" => Command::CamOut,
         "MC_SynchronizedMotionSimulation" => Command::SynchronizedMotionSimulation {
             enable: a.flag("enable")?,
         },
-        "MC_GearInVelocity" => Command::GearInVelocity {
-            master: leader()?,
-            ratio_numerator: ratio("ratio_numerator")?,
-            ratio_denominator: ratio("ratio_denominator")?,
-            dynamics: a.dynamics_no_velocity()?,
-        },
         "MC_OffsetAbsolute" | "MC_OffsetRelative" => Command::Offset {
             offset: a.num("offset")?,
-            absolute: spec.name == "MC_OffsetAbsolute",
+            absolute: name == "MC_OffsetAbsolute",
             dynamics: a.dynamics("velocity")?,
         },
         "MC_PhasingAbsolute" | "MC_PhasingRelative" => Command::Phasing {
             phase_shift: a.num("phase_shift")?,
-            absolute: spec.name == "MC_PhasingAbsolute",
+            absolute: name == "MC_PhasingAbsolute",
             dynamics: a.dynamics("velocity")?,
         },
+        _ => return Ok(None),
+    }))
+}
+
+/// MC_GearInPos with its leader.
+fn gear_in_pos(a: &Args<'_>, master: LeaderId) -> Result<Command, CommandError> {
+    let (ratio_numerator, ratio_denominator) = a.ratio()?;
+    Ok(Command::GearInPos {
+        master,
+        ratio_numerator,
+        ratio_denominator,
+        master_sync_position: a.num("master_sync_position")?,
+        slave_sync_position: a.num("slave_sync_position")?,
+        sync_profile_reference: a.choice(
+            "sync_profile_reference",
+            &[
+                (0, SyncProfileReference::Dynamics),
+                (1, SyncProfileReference::MasterStartDistance),
+            ],
+            "0 or 1",
+        )?,
+        master_start_distance: a.num("master_start_distance")?,
+        dynamics: a.dynamics("velocity")?,
+        sync_direction: a.sync_direction()?,
+    })
+}
+
+/// MC_CamIn with its leader and cam.
+fn cam_in(a: &Args<'_>, master: LeaderId, cam: CamId) -> Result<Command, CommandError> {
+    Ok(Command::CamIn {
+        master,
+        cam,
+        master_offset: a.num("master_offset")?,
+        slave_offset: a.num("slave_offset")?,
+        master_scaling: a.num("master_scaling")?,
+        slave_scaling: a.num("slave_scaling")?,
+        master_sync_position: a.num("master_sync_position")?,
+        sync_profile_reference: a.choice(
+            "sync_profile_reference",
+            &[
+                (0, SyncProfileReference::Dynamics),
+                (1, SyncProfileReference::MasterStartDistance),
+                (2, SyncProfileReference::Direct),
+            ],
+            "0, 1 or 2",
+        )?,
+        master_start_distance: a.num("master_start_distance")?,
+        dynamics: a.dynamics("velocity")?,
+        application_mode: a.choice(
+            "application_mode",
+            &[
+                (0, ApplicationMode::Once),
+                (1, ApplicationMode::Cyclic),
+                (2, ApplicationMode::CyclicAppending),
+            ],
+            "0, 1 or 2",
+        )?,
+        sync_direction: a.sync_direction()?,
+    })
+}
+
+/// The single-axis instructions (power, homing, stop, moves, monitoring).
+fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
+    let name = a.spec.name;
+    let bad = |param: &'static str, allowed: &'static str| CommandError::BadValue {
+        instruction: name,
+        param,
+        allowed,
+    };
+    Ok(match name {
         "MC_Power" => Command::Power {
             enable: a.flag("enable")?,
-            start_mode: match a.code("start_mode")? {
-                0 => StartMode::NonPositionControlled,
-                1 => StartMode::PositionControlled,
-                _ => return Err("MC_Power: start_mode must be 0 or 1".into()),
-            },
-            stop_mode: match a.code("stop_mode")? {
-                0 => StopMode::Emergency,
-                1 => StopMode::Immediate,
-                2 => StopMode::MaxDynamics,
-                _ => return Err("MC_Power: stop_mode must be 0, 1 or 2".into()),
-            },
+            start_mode: a.choice(
+                "start_mode",
+                &[
+                    (0, StartMode::NonPositionControlled),
+                    (1, StartMode::PositionControlled),
+                ],
+                "0 or 1",
+            )?,
+            stop_mode: a.choice(
+                "stop_mode",
+                &[
+                    (0, StopMode::Emergency),
+                    (1, StopMode::Immediate),
+                    (2, StopMode::MaxDynamics),
+                ],
+                "0, 1 or 2",
+            )?,
         },
         "MC_Reset" => Command::Reset {
             restart: a.flag("restart")?,
@@ -453,7 +759,7 @@ pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Resul
         "MC_Home" => {
             let mode = a.code("mode")?;
             Command::Home {
-                mode: u8::try_from(mode).map_err(|_| "MC_Home: mode must be 0..10".to_string())?,
+                mode: u8::try_from(mode).map_err(|_| bad("mode", "0..10"))?,
                 position: a.num("position")?,
             }
         }
@@ -471,7 +777,7 @@ pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Resul
             position: a.num("position")?,
             dynamics: a.dynamics("velocity")?,
             direction: Direction::from_code(a.code("direction")?)
-                .ok_or("MC_MoveAbsolute: direction must be 1, 2 or 3")?,
+                .ok_or(bad("direction", "1, 2 or 3"))?,
         },
         "MC_MoveRelative" => Command::MoveRelative {
             distance: a.num("distance")?,
@@ -480,7 +786,7 @@ pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Resul
         "MC_MoveVelocity" => Command::MoveVelocity {
             dynamics: a.dynamics("velocity")?,
             direction: VelocityDirection::from_code(a.code("direction")?)
-                .ok_or("MC_MoveVelocity: direction must be 0, 1 or 2")?,
+                .ok_or(bad("direction", "0, 1 or 2"))?,
             current: a.flag("current")?,
             position_controlled: a.flag("position_controlled")?,
         },
@@ -509,9 +815,8 @@ pub fn parse(instruction: &str, params: &[(String, Value)], refs: Refs) -> Resul
             acceleration: a.num("acceleration")?,
             position_controlled: a.flag("position_controlled")?,
         },
-        other => return Err(format!("instruction `{other}` has no parser")),
-    };
-    Ok(cmd)
+        other => return Err(CommandError::NoParser(other)),
+    })
 }
 
 #[cfg(test)]
@@ -556,6 +861,7 @@ mod tests {
         );
         assert!(parse("MoveAbsolute", &[], Refs::default())
             .unwrap_err()
+            .to_string()
             .contains("`position` is required"));
         assert!(parse(
             "MoveAbsolute",
@@ -563,15 +869,18 @@ mod tests {
             Refs::default()
         )
         .unwrap_err()
+        .to_string()
         .contains("unknown parameter `postion`"));
         assert!(
             parse("MC_Power", &[p("enable", Value::Num(1.0))], Refs::default())
                 .unwrap_err()
+                .to_string()
                 .contains("true or false")
         );
         assert!(
             parse("MC_Home", &[p("mode", Value::Num(2.5))], Refs::default())
                 .unwrap_err()
+                .to_string()
                 .contains("integer")
         );
     }

@@ -21,8 +21,8 @@
 //! `MC_AbortMeasuringInput`, and `InputEdge` (`rising`): an input edge at the entry's `t`.
 //! Use [`parse_cell`] to address them.
 
-use crate::command::{self, Value};
-use crate::ConfigError;
+use crate::command::{self, CommandError, Expected, Value};
+use crate::{ConfigError, Problem};
 use tandem_motion::action::Action;
 
 /// The names of the cell's output cams, cam tracks and measuring inputs (script targets).
@@ -148,25 +148,30 @@ const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
 ];
 
 /// An entry for an output cam, cam track or measuring input.
-fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action, String> {
+fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action, CommandError> {
     let (name, _, params) = *spec;
     let mut vals: Vec<Value> = params.iter().map(|(_, v)| *v).collect();
+    let wrong = |param: &str, expected| CommandError::WrongType {
+        instruction: None,
+        param: param.into(),
+        expected,
+    };
     for (k, v) in t.iter() {
         if matches!(k, "t" | "axis" | "instruction") {
             continue;
         }
         let Some(i) = params.iter().position(|(p, _)| *p == k) else {
-            let names: Vec<&str> = params.iter().map(|(p, _)| *p).collect();
-            return Err(format!(
-                "{name}: unknown parameter `{k}`; parameters: {}",
-                names.join(", ")
-            ));
+            return Err(CommandError::UnknownParameter {
+                instruction: name,
+                name: k.into(),
+                known: params.iter().map(|(p, _)| *p).collect(),
+            });
         };
         vals[i] = match (params[i].1, v.as_bool(), num(v)) {
             (Value::Bool(_), Some(b), _) => Value::Bool(b),
             (Value::Num(_), _, Some(x)) if x.is_finite() => Value::Num(x),
-            (Value::Bool(_), _, _) => return Err(format!("`{k}` must be true or false")),
-            (Value::Num(_), _, _) => return Err(format!("`{k}` must be a number")),
+            (Value::Bool(_), _, _) => return Err(wrong(k, Expected::Bool)),
+            (Value::Num(_), _, _) => return Err(wrong(k, Expected::Number)),
         };
     }
     let b = |i: usize| matches!(vals.get(i), Some(Value::Bool(true)));
@@ -174,12 +179,12 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
         Some(Value::Num(x)) => *x,
         _ => 0.0,
     };
-    let code = |i: usize| -> Result<i32, String> {
+    let code = |i: usize| -> Result<i32, CommandError> {
         let v = x(i);
         if v.fract() == 0.0 && v.abs() < 1e6 {
             Ok(v as i32)
         } else {
-            Err(format!("`{}` must be an integer", params[i].0))
+            Err(wrong(params[i].0, Expected::Integer))
         }
     };
     Ok(match name {
@@ -206,6 +211,275 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
     })
 }
 
+/// What a script may address: the cell's leaders (axes, then encoders), cams and objects.
+struct Targets<'a> {
+    axes: &'a [&'a str],
+    cams: &'a [&'a str],
+    objects: &'a ObjectNames<'a>,
+}
+
+/// The position of `name` in `list` (a cell's names of one kind), or
+/// [`CommandError::UnknownObject`].
+fn find_in(list: &[&str], what: &'static str, name: &str) -> Result<usize, CommandError> {
+    list.iter()
+        .position(|c| *c == name)
+        .ok_or_else(|| CommandError::UnknownObject {
+            instruction: None,
+            what,
+            name: name.into(),
+            known: list.iter().map(|s| s.to_string()).collect(),
+        })
+}
+
+/// The string at `key`, or [`CommandError::MissingKey`].
+fn required<'t>(
+    t: &'t toml_edit::Table,
+    key: &'static str,
+    hint: Option<&'static str>,
+) -> Result<&'t str, CommandError> {
+    t.get(key)
+        .and_then(|x| x.as_str())
+        .ok_or(CommandError::MissingKey { key, hint })
+}
+
+/// Every key of `t` is one of the entry's keys or of `params`, else
+/// [`CommandError::UnknownParameter`] of `instruction`.
+fn only_params(
+    t: &toml_edit::Table,
+    instruction: &'static str,
+    params: &[&'static str],
+) -> Result<(), CommandError> {
+    match t
+        .iter()
+        .find(|(k, _)| !matches!(*k, "t" | "axis" | "instruction") && !params.contains(k))
+    {
+        Some((k, _)) => Err(CommandError::UnknownParameter {
+            instruction,
+            name: k.into(),
+            known: params.to_vec(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// One `[[at]]` table: when, and what to which object.
+fn entry(
+    t: &toml_edit::Table,
+    targets: &Targets<'_>,
+    line: usize,
+) -> Result<ScriptEntry, CommandError> {
+    let t_ns =
+        t.get("t")
+            .and_then(num)
+            .and_then(seconds_to_ns)
+            .ok_or(CommandError::MissingKey {
+                key: "t",
+                hint: Some("seconds >= 0"),
+            })?;
+    let instr_name = t.get("instruction").and_then(|x| x.as_str()).unwrap_or("");
+    let objects = targets.objects;
+    let object = t.get("axis").and_then(|x| x.as_str()).filter(|a| {
+        objects.output_cams.contains(a)
+            || objects.cam_tracks.contains(a)
+            || objects.measuring_inputs.contains(a)
+    });
+    let normalized = command::normalize(instr_name);
+    let (axis, instruction, action) =
+        if let (Some(target), true) = (object, normalized == command::normalize("MC_Reset")) {
+            (target, "MC_Reset", reset_object(t)?)
+        } else if let Some(spec) = OBJECT_INSTRUCTIONS
+            .iter()
+            .find(|s| command::normalize(s.0) == normalized)
+        {
+            object_instruction(t, spec, objects)?
+        } else if normalized == "interpolatecam" {
+            interpolate_cam(t, targets.cams)?
+        } else {
+            axis_instruction(t, targets)?
+        };
+    Ok(ScriptEntry {
+        t_ns,
+        axis: axis.to_string(),
+        instruction,
+        action,
+        line,
+    })
+}
+
+/// MC_Reset addressed to an output cam, cam track or measuring input.
+fn reset_object(t: &toml_edit::Table) -> Result<Action, CommandError> {
+    let mut restart = false;
+    for (k, v) in t.iter() {
+        match (k, v.as_bool()) {
+            ("t" | "axis" | "instruction", _) => {}
+            ("restart", Some(b)) => restart = b,
+            ("restart", None) => {
+                return Err(CommandError::WrongType {
+                    instruction: None,
+                    param: "restart".into(),
+                    expected: Expected::Bool,
+                })
+            }
+            _ => only_params(t, "MC_Reset", &["restart"])?,
+        }
+    }
+    Ok(Action::ResetObject { restart })
+}
+
+/// An instruction of an output cam, cam track or measuring input: the object, the
+/// instruction and the action.
+fn object_instruction<'t>(
+    t: &'t toml_edit::Table,
+    spec: &ObjectInstruction,
+    objects: &ObjectNames<'_>,
+) -> Result<(&'t str, &'static str, Action), CommandError> {
+    let target = required(t, "axis", Some("the object's name"))?;
+    let (list, what) = match spec.1 {
+        0 => (&objects.output_cams, "output cam"),
+        1 => (&objects.cam_tracks, "cam track"),
+        _ => (&objects.measuring_inputs, "measuring input"),
+    };
+    if !list.contains(&target) {
+        return Err(CommandError::UnknownObject {
+            instruction: Some(spec.0),
+            what,
+            name: target.into(),
+            known: list.iter().map(|s| s.to_string()).collect(),
+        });
+    }
+    Ok((target, spec.0, object_entry(t, spec)?))
+}
+
+/// MC_InterpolateCam of a cam technology object: `axis` names the cam, `from` another cam's
+/// definition.
+fn interpolate_cam<'t>(
+    t: &'t toml_edit::Table,
+    cams: &[&str],
+) -> Result<(&'t str, &'static str, Action), CommandError> {
+    let target = required(t, "axis", Some("the cam's name"))?;
+    let cam = find_in(cams, "cam", target)?;
+    let from = match t.get("from") {
+        None => cam,
+        Some(f) => find_in(
+            cams,
+            "cam",
+            f.as_str().ok_or(CommandError::NotAName {
+                param: "from",
+                what: "a cam name",
+            })?,
+        )?,
+    };
+    only_params(t, "MC_InterpolateCam", &["from"])?;
+    let action = Action::InterpolateCam {
+        cam: cam as u32,
+        from: from as u32,
+    };
+    Ok((target, "MC_InterpolateCam", action))
+}
+
+/// An instruction of an axis or encoder, with its leader and cam resolved by name.
+fn axis_instruction<'t>(
+    t: &'t toml_edit::Table,
+    targets: &Targets<'_>,
+) -> Result<(&'t str, &'static str, Action), CommandError> {
+    let axes = targets.axes;
+    let axis = required(t, "axis", Some("a name"))?;
+    find_in(axes, "axis", axis)?;
+    let instr = required(t, "instruction", None)?;
+    // A leader is named by its name; its id is its index among the axes, then encoders.
+    let master = match t.get("master") {
+        None => None,
+        Some(m) => {
+            let name = m.as_str().ok_or(CommandError::NotAName {
+                param: "master",
+                what: "an axis name",
+            })?;
+            let idx = find_in(axes, "master", name)?;
+            if name == axis {
+                return Err(CommandError::SelfFollow(axis.into()));
+            }
+            Some(idx as u32)
+        }
+    };
+    let cam = match t.get("cam") {
+        None => None,
+        Some(c) => {
+            let name = c.as_str().ok_or(CommandError::NotAName {
+                param: "cam",
+                what: "a cam name",
+            })?;
+            Some(find_in(targets.cams, "cam", name)? as u32)
+        }
+    };
+    let mut params = Vec::new();
+    for (k, v) in t.iter() {
+        if matches!(k, "t" | "axis" | "instruction" | "master" | "cam") {
+            continue;
+        }
+        let value = if let Some(b) = v.as_bool() {
+            Value::Bool(b)
+        } else if let Some(x) = num(v) {
+            Value::Num(x)
+        } else {
+            return Err(CommandError::WrongType {
+                instruction: None,
+                param: k.into(),
+                expected: Expected::NumberOrBool,
+            });
+        };
+        params.push((k.to_string(), value));
+    }
+    let command = command::parse(instr, &params, command::Refs { master, cam })?;
+    let name = command::find(instr).map(|s| s.name).unwrap_or("?");
+    Ok((axis, name, Action::Command(command)))
+}
+
+/// Parses the script's TOML and checks its sections (`[sim]` and `[[at]]` only).
+fn document<'s>(file: &str, src: &'s str) -> Result<toml_edit::ImDocument<&'s str>, ConfigError> {
+    let doc = toml_edit::ImDocument::parse(src).map_err(|x| ConfigError {
+        file: file.into(),
+        line: x.span().map(|s| line_at(src, s.start)),
+        key: String::new(),
+        problem: Box::new(Problem::Syntax(x.message().to_string())),
+    })?;
+    if let Some((k, _)) = doc.iter().find(|(k, _)| *k != "sim" && *k != "at") {
+        return Err(ConfigError {
+            file: file.into(),
+            line: crate::locate(src, &[k]),
+            key: k.into(),
+            problem: Box::new(Problem::Invalid(
+                "unknown section (expected [sim] and [[at]])",
+            )),
+        });
+    }
+    Ok(doc)
+}
+
+/// `[sim] duration`: the virtual time to run (ns).
+fn duration(file: &str, src: &str, doc: &toml_edit::ImDocument<&str>) -> Result<i64, ConfigError> {
+    let e = |line, problem| ConfigError {
+        file: file.into(),
+        line,
+        key: "sim.duration".into(),
+        problem: Box::new(problem),
+    };
+    let duration = doc
+        .get("sim")
+        .and_then(|s| s.get("duration"))
+        .ok_or_else(|| {
+            e(
+                None,
+                Problem::Invalid("is required (virtual seconds to run)"),
+            )
+        })?;
+    num(duration).and_then(seconds_to_ns).ok_or_else(|| {
+        e(
+            crate::locate(src, &["sim", "duration"]),
+            Problem::Invalid("must be a number of seconds >= 0"),
+        )
+    })
+}
+
 fn parse_with(
     file: &str,
     src: &str,
@@ -213,259 +487,34 @@ fn parse_with(
     cams: &[&str],
     objects: &ObjectNames<'_>,
 ) -> Result<Script, ConfigError> {
-    let e = |line: Option<usize>, key: &str, message: String| ConfigError {
-        file: file.into(),
-        line,
-        key: key.into(),
-        message,
+    let doc = document(file, src)?;
+    let duration_ns = duration(file, src, &doc)?;
+    let targets = Targets {
+        axes,
+        cams,
+        objects,
     };
-    let doc = toml_edit::ImDocument::parse(src).map_err(|x| {
-        e(
-            x.span().map(|s| line_at(src, s.start)),
-            "",
-            x.message().to_string(),
-        )
-    })?;
-    for (k, _) in doc.iter() {
-        if k != "sim" && k != "at" {
-            return Err(e(
-                crate::locate(src, &[k]),
-                k,
-                "unknown section (expected [sim] and [[at]])".into(),
-            ));
-        }
-    }
-    let duration = doc
-        .get("sim")
-        .and_then(|s| s.get("duration"))
-        .ok_or_else(|| {
-            e(
-                None,
-                "sim.duration",
-                "is required (virtual seconds to run)".into(),
-            )
-        })?;
-    let duration_ns = num(duration).and_then(seconds_to_ns).ok_or_else(|| {
-        e(
-            crate::locate(src, &["sim", "duration"]),
-            "sim.duration",
-            "must be a number of seconds >= 0".into(),
-        )
-    })?;
     let mut entries = Vec::new();
     // Line numbers by binary search over the newlines (a script may have thousands of entries).
     let newlines: Vec<usize> = src.match_indices('\n').map(|(i, _)| i).collect();
     if let Some(at) = doc.get("at") {
-        let tables = at.as_array_of_tables().ok_or_else(|| {
-            e(
-                crate::locate(src, &["at"]),
-                "at",
-                "must be written as [[at]] tables".into(),
-            )
+        let tables = at.as_array_of_tables().ok_or_else(|| ConfigError {
+            file: file.into(),
+            line: crate::locate(src, &["at"]),
+            key: "at".into(),
+            problem: Box::new(Problem::Invalid("must be written as [[at]] tables")),
         })?;
         for (i, t) in tables.iter().enumerate() {
             let line = t
                 .span()
                 .map(|s| newlines.partition_point(|&i| i < s.start) + 1);
-            let key = format!("at[{i}]");
-            let time = t
-                .get("t")
-                .and_then(num)
-                .and_then(seconds_to_ns)
-                .ok_or_else(|| e(line, &key, "`t` (seconds >= 0) is required".into()))?;
-            let instr_name = t.get("instruction").and_then(|x| x.as_str()).unwrap_or("");
-            let object = t.get("axis").and_then(|x| x.as_str()).filter(|a| {
-                objects.output_cams.contains(a)
-                    || objects.cam_tracks.contains(a)
-                    || objects.measuring_inputs.contains(a)
-            });
-            if let (Some(target), true) = (
-                object,
-                command::normalize(instr_name) == command::normalize("MC_Reset"),
-            ) {
-                // MC_Reset addressed to an output cam, cam track or measuring input.
-                let mut restart = false;
-                for (k, v) in t.iter() {
-                    match (k, v.as_bool()) {
-                        ("t" | "axis" | "instruction", _) => {}
-                        ("restart", Some(b)) => restart = b,
-                        ("restart", None) => {
-                            return Err(e(line, &key, "`restart` must be true or false".into()))
-                        }
-                        _ => {
-                            return Err(e(
-                                line,
-                                &key,
-                                format!("MC_Reset: unknown parameter `{k}`; parameters: restart"),
-                            ))
-                        }
-                    }
-                }
-                entries.push(ScriptEntry {
-                    t_ns: time,
-                    axis: target.to_string(),
-                    instruction: "MC_Reset",
-                    action: Action::ResetObject { restart },
-                    line: line.unwrap_or(0),
-                });
-                continue;
-            }
-            if let Some(spec) = OBJECT_INSTRUCTIONS
-                .iter()
-                .find(|s| command::normalize(s.0) == command::normalize(instr_name))
-            {
-                let target = t.get("axis").and_then(|x| x.as_str()).ok_or_else(|| {
-                    e(line, &key, "`axis` (the object's name) is required".into())
-                })?;
-                let (list, what) = match spec.1 {
-                    0 => (&objects.output_cams, "output cam"),
-                    1 => (&objects.cam_tracks, "cam track"),
-                    _ => (&objects.measuring_inputs, "measuring input"),
-                };
-                if !list.contains(&target) {
-                    return Err(e(
-                        line,
-                        &key,
-                        format!(
-                            "{}: unknown {what} `{target}`; the cell has: {}",
-                            spec.0,
-                            list.join(", ")
-                        ),
-                    ));
-                }
-                let action = object_entry(t, spec).map_err(|m| e(line, &key, m))?;
-                entries.push(ScriptEntry {
-                    t_ns: time,
-                    axis: target.to_string(),
-                    instruction: spec.0,
-                    action,
-                    line: line.unwrap_or(0),
-                });
-                continue;
-            }
-            if command::normalize(instr_name) == "interpolatecam" {
-                // A cam technology object: `axis` names the cam, `from` another cam's definition.
-                let target = t
-                    .get("axis")
-                    .and_then(|x| x.as_str())
-                    .ok_or_else(|| e(line, &key, "`axis` (the cam's name) is required".into()))?;
-                let find = |name: &str| {
-                    cams.iter().position(|c| *c == name).ok_or_else(|| {
-                        e(
-                            line,
-                            &key,
-                            format!("unknown cam `{name}`; the cell has: {}", cams.join(", ")),
-                        )
-                    })
-                };
-                let cam = find(target)?;
-                let from = match t.get("from") {
-                    None => cam,
-                    Some(f) => find(
-                        f.as_str()
-                            .ok_or_else(|| e(line, &key, "`from` must be a cam name".into()))?,
-                    )?,
-                };
-                for (k, _) in t.iter() {
-                    if !matches!(k, "t" | "axis" | "instruction" | "from") {
-                        return Err(e(
-                            line,
-                            &key,
-                            format!("MC_InterpolateCam: unknown parameter `{k}`; parameters: from"),
-                        ));
-                    }
-                }
-                entries.push(ScriptEntry {
-                    t_ns: time,
-                    axis: target.to_string(),
-                    instruction: "MC_InterpolateCam",
-                    action: Action::InterpolateCam {
-                        cam: cam as u32,
-                        from: from as u32,
-                    },
-                    line: line.unwrap_or(0),
-                });
-                continue;
-            }
-            let axis = t
-                .get("axis")
-                .and_then(|x| x.as_str())
-                .ok_or_else(|| e(line, &key, "`axis` (a name) is required".into()))?;
-            if !axes.contains(&axis) {
-                return Err(e(
-                    line,
-                    &key,
-                    format!("unknown axis `{axis}`; the cell has: {}", axes.join(", ")),
-                ));
-            }
-            let instr = t
-                .get("instruction")
-                .and_then(|x| x.as_str())
-                .ok_or_else(|| e(line, &key, "`instruction` is required".into()))?;
-            // A leader is named by its axis name; its id is the axis' index in the cell.
-            let master = match t.get("master") {
-                None => None,
-                Some(m) => {
-                    let name = m
-                        .as_str()
-                        .ok_or_else(|| e(line, &key, "`master` must be an axis name".into()))?;
-                    let idx = axes.iter().position(|a| *a == name).ok_or_else(|| {
-                        e(
-                            line,
-                            &key,
-                            format!("unknown master `{name}`; the cell has: {}", axes.join(", ")),
-                        )
-                    })?;
-                    if name == axis {
-                        return Err(e(line, &key, format!("axis `{axis}` cannot follow itself")));
-                    }
-                    Some(idx as u32)
-                }
-            };
-            let cam = match t.get("cam") {
-                None => None,
-                Some(c) => {
-                    let name = c
-                        .as_str()
-                        .ok_or_else(|| e(line, &key, "`cam` must be a cam name".into()))?;
-                    let idx = cams.iter().position(|c| *c == name).ok_or_else(|| {
-                        e(
-                            line,
-                            &key,
-                            format!("unknown cam `{name}`; the cell has: {}", cams.join(", ")),
-                        )
-                    })?;
-                    Some(idx as u32)
-                }
-            };
-            let mut params = Vec::new();
-            for (k, v) in t.iter() {
-                if matches!(k, "t" | "axis" | "instruction" | "master" | "cam") {
-                    continue;
-                }
-                let value = if let Some(b) = v.as_bool() {
-                    Value::Bool(b)
-                } else if let Some(x) = num(v) {
-                    Value::Num(x)
-                } else {
-                    return Err(e(
-                        line,
-                        &key,
-                        format!("`{k}` must be a number or true/false"),
-                    ));
-                };
-                params.push((k.to_string(), value));
-            }
-            let refs = command::Refs { master, cam };
-            let command = command::parse(instr, &params, refs).map_err(|m| e(line, &key, m))?;
-            let name = command::find(instr).map(|s| s.name).unwrap_or("?");
-            entries.push(ScriptEntry {
-                t_ns: time,
-                axis: axis.to_string(),
-                instruction: name,
-                action: Action::Command(command),
-                line: line.unwrap_or(0),
-            });
+            let entry = entry(t, &targets, line.unwrap_or(0)).map_err(|c| ConfigError {
+                file: file.into(),
+                line,
+                key: format!("at[{i}]"),
+                problem: Box::new(Problem::Command(c)),
+            })?;
+            entries.push(entry);
         }
     }
     entries.sort_by_key(|x| x.t_ns);
@@ -484,7 +533,7 @@ pub fn parse_command(
     object: &str,
     instruction: &str,
     params: &[(String, String)],
-) -> Result<ScriptEntry, String> {
+) -> Result<ScriptEntry, Problem> {
     use std::fmt::Write as _;
     let quote = |s: &str| {
         let mut q = String::from("\"");
@@ -500,14 +549,16 @@ pub fn parse_command(
         q
     };
     let mut src = String::from("[sim]\nduration = 0\n[[at]]\nt = 0\n");
+    // Writing into a String cannot fail.
     let _ = writeln!(src, "axis = {}", quote(object));
+    // Writing into a String cannot fail.
     let _ = writeln!(src, "instruction = {}", quote(instruction));
     for (k, v) in params {
         if k.is_empty() || !k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(format!("`--{k}` is not a parameter name"));
+            return Err(CommandError::BadParameterName(k.clone()).into());
         }
         if matches!(k.as_str(), "t" | "axis" | "instruction") {
-            return Err(format!("`--{k}` is not a parameter of an instruction"));
+            return Err(CommandError::ReservedParameter(k.clone()).into());
         }
         let value = if v == "true" || v == "false" || v.parse::<f64>().is_ok_and(f64::is_finite) {
             v.clone()
@@ -519,14 +570,15 @@ pub fn parse_command(
             };
             quote(name)
         };
+        // Writing into a String cannot fail.
         let _ = writeln!(src, "{k} = {value}");
     }
-    let script = parse_cell("command", &src, cell).map_err(|e| e.message)?;
+    let script = parse_cell("command", &src, cell).map_err(|e| *e.problem)?;
     script
         .entries
         .into_iter()
         .next()
-        .ok_or_else(|| format!("`{instruction}` was not understood"))
+        .ok_or_else(|| CommandError::NotUnderstood(instruction.into()).into())
 }
 
 /// A command line: `<object> <instruction> [--param value | --param=value]...`.
@@ -541,17 +593,17 @@ pub struct CommandLine {
 }
 
 /// Splits a command line into object, instruction and `--param value` pairs.
-pub fn split_command(text: &str) -> Result<CommandLine, String> {
+pub fn split_command(text: &str) -> Result<CommandLine, CommandError> {
     let mut words = text.split_whitespace();
-    let object = words.next().ok_or("empty command")?.to_string();
+    let object = words.next().ok_or(CommandError::Empty)?.to_string();
     let instruction = words
         .next()
-        .ok_or_else(|| format!("`{object}`: no instruction given"))?
+        .ok_or_else(|| CommandError::NoInstruction(object.clone()))?
         .to_string();
     let mut params = Vec::new();
     while let Some(w) = words.next() {
         let Some(key) = w.strip_prefix("--") else {
-            return Err(format!("`{w}`: expected `--parameter value`"));
+            return Err(CommandError::ExpectedParameter(w.into()));
         };
         let (k, v) = match key.split_once('=') {
             Some((k, v)) => (k.to_string(), v.to_string()),
@@ -559,7 +611,7 @@ pub fn split_command(text: &str) -> Result<CommandLine, String> {
                 key.to_string(),
                 words
                     .next()
-                    .ok_or_else(|| format!("`--{key}` needs a value"))?
+                    .ok_or_else(|| CommandError::MissingValue(key.into()))?
                     .to_string(),
             ),
         };
@@ -587,8 +639,32 @@ mod tests {
         let bad = src.replace("distance = 10", "distanc = 10");
         let e = parse("s.toml", &bad, &["x"], &[]).unwrap_err();
         assert_eq!(e.line, Some(4));
-        assert!(e.message.contains("unknown parameter `distanc`"), "{e}");
+        assert!(
+            e.problem
+                .to_string()
+                .contains("unknown parameter `distanc`"),
+            "{e}"
+        );
         let e = parse("s.toml", src, &["y"], &[]).unwrap_err();
-        assert!(e.message.contains("unknown axis `x`"));
+        assert!(e.problem.to_string().contains("unknown axis `x`"));
+    }
+
+    #[test]
+    fn errors_are_typed() {
+        let src = "[sim]\nduration = 1\n[[at]]\nt = 0\naxis = \"x\"\ninstruction = \"MC_Fly\"\n";
+        let e = parse("s.toml", src, &["x"], &[]).unwrap_err();
+        assert_eq!(
+            *e.problem,
+            Problem::Command(CommandError::UnknownInstruction("MC_Fly".into()))
+        );
+        assert_eq!(
+            split_command("x MC_Power --enable"),
+            Err(CommandError::MissingValue("enable".into()))
+        );
+        assert_eq!(split_command("  "), Err(CommandError::Empty));
+        assert_eq!(
+            split_command("x").unwrap_err().to_string(),
+            "`x`: no instruction given"
+        );
     }
 }

@@ -1,61 +1,36 @@
-//! The cyclic executive of one node (design §3), free of IO and clocks: the technology objects a
-//! node hosts, stepped at a time given by the caller. `tandem sim` runs one executive that owns
-//! the whole cell on virtual time; `tandem-node` runs one per process on the real clock and
-//! feeds it the samples of leaders on other nodes.
+//! The cyclic executive of one node, free of IO and clocks: the technology objects a node
+//! hosts, stepped at a time given by the caller, in the node cycle's fixed order
+//! (docs/processes.md, "One cycle of a node"). `tandem sim` runs one executive that owns the whole cell on virtual
+//! time; `tandem-node` runs one per process on the real clock and feeds it the samples of
+//! leaders on other nodes.
 //!
-//! Leading values follow design §4: a follower of a leader with a leading-value delay `D > 0`
-//! evaluates the leader at `t - D` from a buffer of timestamped samples, whether the leader is
-//! stepped by the same executive or another process; a leader with `D = 0` is read directly
-//! (it is stepped first).
+//! Leading values (docs/processes.md, "Leading values"): a follower of a leader with a
+//! leading-value delay `D > 0` evaluates the leader at `t - D` from a buffer of timestamped
+//! samples, whether the leader is stepped by the same executive or another process; a leader
+//! with `D = 0` is read directly (it is stepped first).
 //!
 //! After [`Executive::new`], nothing here allocates: the log lines are formatted into the
 //! caller's writer (a fixed ring in a node).
 
-use crate::objects::{cycle_motion, invalid, CycleMotion, Objects};
-use std::fmt;
+pub use crate::error::ExecError;
+pub use crate::notes::{seconds, Describe, IoNote, JobNote, Secs, NOTES};
+
+use crate::notes::keep;
+use crate::objects::{cycle_motion, CycleMotion, Objects};
 use std::io::{self, Write};
 use std::sync::Arc;
-use tandem_config::{Cell, Coupling, EncoderSource, LEADING_BUFFER};
+use tandem_config::{
+    AxisIndex, Cell, Coupling, EncoderIndex, EncoderSource, Leader, LEADING_BUFFER,
+};
 use tandem_motion::action::Action;
 use tandem_motion::axis::{Axis, AxisStatus, CamId, Command};
 use tandem_motion::cam::{Cam, CamDefinition};
 use tandem_motion::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{Instruction, JobEvent, JobEventKind, JobId};
+use tandem_motion::job::{Instruction, JobEvent, JobId};
 use tandem_motion::leading::{
-    LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
+    LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
-
-/// Formats ns as seconds with 9 decimals, exactly.
-pub fn seconds(t_ns: i64) -> String {
-    Secs(t_ns).to_string()
-}
-
-/// ns shown as seconds with 9 decimals, exactly, without allocating.
-#[derive(Copy, Clone, Debug)]
-pub struct Secs(pub i64);
-
-impl fmt::Display for Secs {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let sign = if self.0 < 0 { "-" } else { "" };
-        let t = self.0.unsigned_abs();
-        write!(f, "{sign}{}.{:09}", t / 1_000_000_000, t % 1_000_000_000)
-    }
-}
-
-/// A job event kind as the log shows it.
-#[derive(Copy, Clone, Debug)]
-pub struct Describe(pub JobEventKind);
-
-impl fmt::Display for Describe {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.0 {
-            JobEventKind::Error(e) => write!(f, "Error {e}"),
-            JobEventKind::Status(on) => write!(f, "Status {}", if on { "TRUE" } else { "FALSE" }),
-            other => write!(f, "{other:?}"),
-        }
-    }
-}
 
 fn gcd(a: i64, b: i64) -> i64 {
     if b == 0 {
@@ -99,23 +74,33 @@ fn interpolate_cam(
 
 /// Whether `follower` appears in the leader chain of `leader` (a recursive coupling). Only the
 /// chain through this executive's axes is seen; a chain through another node is not.
-fn recursive(axes: &[Axis], owned: &[bool], follower: usize, leader: usize) -> bool {
+fn recursive(
+    cell: &Cell,
+    axes: &[Axis],
+    owned: &[bool],
+    follower: AxisIndex,
+    leader: Leader,
+) -> bool {
     let mut stack = vec![leader];
     let mut seen = vec![false; axes.len()];
-    while let Some(i) = stack.pop() {
+    while let Some(l) = stack.pop() {
+        // An external encoder follows nothing.
+        let Some(i) = l.axis() else {
+            continue;
+        };
         if i == follower {
             return true;
         }
-        if i >= axes.len() || !owned[i] {
-            // An external encoder follows nothing; another node's axis is not known here.
+        if i.0 >= axes.len() || !owned[i.0] {
+            // Another node's axis is not known here.
             continue;
         }
-        if std::mem::replace(&mut seen[i], true) {
+        if std::mem::replace(&mut seen[i.0], true) {
             continue;
         }
-        for l in axes[i].leaders().into_iter().flatten() {
-            if let Some(j) = usize::try_from(l).ok().filter(|j| *j < axes.len()) {
-                stack.push(j);
+        for id in axes[i.0].leaders().into_iter().flatten() {
+            if let Some(Leader::Axis(j)) = cell.leader(id) {
+                stack.push(Leader::Axis(j));
             }
         }
     }
@@ -131,17 +116,14 @@ fn job_event(
     object: usize,
     ev: JobEvent,
 ) -> io::Result<()> {
-    if jobs.len() < NOTES {
-        jobs.push(JobNote {
-            t_ns: ev.time_ns,
-            object,
-            job: ev.job,
-            instruction: ev.instruction,
-            kind: ev.kind,
-        });
-    } else {
-        *dropped += 1;
-    }
+    let note = JobNote {
+        t_ns: ev.time_ns,
+        object,
+        job: ev.job,
+        instruction: ev.instruction,
+        kind: ev.kind,
+    };
+    keep(jobs, dropped, note);
     writeln!(
         log,
         "t={} {name} {} job {}: {}",
@@ -155,7 +137,7 @@ fn job_event(
 /// The samples of one leader (in one coupling) that followers read at `t - D`.
 #[derive(Debug)]
 struct LeaderBuffer {
-    leader: usize,
+    leader: Leader,
     coupling: Coupling,
     delay_ns: i64,
     tolerance_ns: i64,
@@ -167,48 +149,184 @@ struct LeaderBuffer {
     logged: bool,
 }
 
-/// A job event of an axis or encoder, for the node to publish.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct JobNote {
-    /// When (ns).
-    pub t_ns: i64,
-    /// The object (index in [`Cell::object_names`]: axes, then encoders).
-    pub object: usize,
-    /// The job.
-    pub job: JobId,
-    /// The instruction.
-    pub instruction: Instruction,
-    /// What happened.
-    pub kind: JobEventKind,
-}
-
-/// What an output cam, cam track or measuring input did, for the node to publish.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct IoNote {
-    /// The object: output cams, then cam tracks, then measuring inputs, in cell order.
-    pub object: usize,
-    /// The exact time (ns).
-    pub t_ns: i64,
-    /// `false`: an output edge (`value` 1 on, 0 off); `true`: a measured value.
-    pub measured: bool,
-    /// The cam number of a cam track's edge (1-based), or the measurement counter.
-    pub counter: u32,
-    /// 1/0, or the measured position.
-    pub value: f64,
-}
-
-/// Notes kept per step for the caller; more are dropped (and counted).
-pub const NOTES: usize = 256;
-
 /// What applying a command did.
 pub type Applied = Result<Option<JobId>, ErrorId>;
+
+/// Which axes and encoders of the cell an executive steps.
+#[derive(Debug)]
+struct Owned {
+    axes: Vec<bool>,
+    encoders: Vec<bool>,
+}
+
+impl Owned {
+    /// The objects of node `node` (all of the cell with `None`).
+    fn of(cell: &Cell, node: Option<usize>) -> Self {
+        Self {
+            axes: cell
+                .axes
+                .iter()
+                .map(|a| node.is_none_or(|n| a.node == n))
+                .collect(),
+            encoders: cell
+                .encoders
+                .iter()
+                .map(|e| node.is_none_or(|n| e.node == n))
+                .collect(),
+        }
+    }
+
+    fn axis(&self, i: AxisIndex) -> bool {
+        self.axes.get(i.0).copied().unwrap_or(false)
+    }
+
+    fn encoder(&self, k: EncoderIndex) -> bool {
+        self.encoders.get(k.0).copied().unwrap_or(false)
+    }
+
+    fn leader(&self, l: Leader) -> bool {
+        match l {
+            Leader::Axis(a) => self.axis(a),
+            Leader::Encoder(e) => self.encoder(e),
+        }
+    }
+}
+
+/// The engine's axes and encoders of the cell (every one is created, the owned ones are
+/// stepped), or the first one it refuses.
+fn engine_objects(cell: &Cell) -> Result<(Vec<Axis>, Vec<ExternalEncoder>), ExecError> {
+    let mut axes = Vec::with_capacity(cell.axes.len());
+    for a in &cell.axes {
+        axes.push(
+            Axis::new(a.config.clone()).map_err(|reason| ExecError::Axis {
+                name: a.name.clone(),
+                reason,
+            })?,
+        );
+    }
+    let mut encoders = Vec::with_capacity(cell.encoders.len());
+    for e in &cell.encoders {
+        encoders.push(
+            ExternalEncoder::new(e.config).map_err(|reason| ExecError::Encoder {
+                name: e.name.clone(),
+                reason,
+            })?,
+        );
+    }
+    // Axes that lead by actual value run the extrapolation of their actual value.
+    for a in &cell.axes {
+        for (l, c) in a.leaders.iter().flatten() {
+            if let (Coupling::Actual, Some(j)) = (*c, l.axis()) {
+                if let Some(leader) = axes.get_mut(j.0) {
+                    leader.set_actual_value_output(true);
+                }
+            }
+        }
+    }
+    Ok((axes, encoders))
+}
+
+/// The period at which an executive of `node` steps: the greatest common divisor of the owned
+/// nodes' cycles (the base tick if that does not divide them).
+fn tick_of(cell: &Cell, node: Option<usize>) -> i64 {
+    let owned_cycles: Vec<i64> = cell
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| node.is_none_or(|n| n == *i))
+        .map(|(_, n)| n.cycle_ns)
+        .collect();
+    let tick = owned_cycles
+        .iter()
+        .copied()
+        .fold(0, gcd)
+        .max(cell.base_tick_ns.max(1));
+    if owned_cycles.iter().all(|c| c % tick == 0) {
+        tick
+    } else {
+        cell.base_tick_ns.max(1)
+    }
+}
+
+/// Per axis: whether it has objects (output cams, cam tracks, measuring inputs) this executive
+/// steps, and whether its cycle motion is needed (those, and axes that carry a sensor).
+fn axes_with_objects(cell: &Cell, owned: &Owned) -> (Vec<bool>, Vec<bool>) {
+    let has_objects: Vec<bool> = cell
+        .axis_indices()
+        .map(|i| {
+            owned.axis(i)
+                && (cell.output_cams.iter().any(|c| c.axis == i)
+                    || cell.cam_tracks.iter().any(|c| c.axis == i)
+                    || cell.measuring_inputs.iter().any(|c| c.axis == i))
+        })
+        .collect();
+    let needs_motion: Vec<bool> = cell
+        .axis_indices()
+        .map(|i| {
+            owned.axis(i)
+                && (has_objects[i.0]
+                    || cell
+                        .measuring_inputs
+                        .iter()
+                        .any(|m| m.sensor.is_some_and(|s| s.axis == i)))
+        })
+        .collect();
+    (has_objects, needs_motion)
+}
+
+/// Buffers: each leader that a follower of this executive may read with a delay, and each
+/// leader on another node that a follower here may follow.
+fn leader_buffers(cell: &Cell, owned: &Owned) -> Vec<LeaderBuffer> {
+    let mut buffers: Vec<LeaderBuffer> = Vec::new();
+    for (f, a) in cell.axis_indices().zip(&cell.axes) {
+        if !owned.axis(f) {
+            continue;
+        }
+        let candidates: Vec<(Leader, Coupling)> = match &a.leaders {
+            Some(list) => list.clone(),
+            None => cell
+                .leaders()
+                .filter(|l| *l != Leader::Axis(f) && cell.coupling(f, *l).is_some())
+                .map(|l| (l, Coupling::Setpoint))
+                .collect(),
+        };
+        for (l, coupling) in candidates {
+            let lv = cell.leading(l);
+            let local = cell.leader_node(l) == Some(a.node);
+            let coupling = if l.is_encoder() {
+                Coupling::Setpoint
+            } else {
+                coupling
+            };
+            if (local && lv.delay_ns == 0)
+                || buffers
+                    .iter()
+                    .any(|b| b.leader == l && b.coupling == coupling)
+            {
+                continue;
+            }
+            let mut samples = Box::new(LeadingValueBuffer::new());
+            samples.set_max_gap(cell.leader_cycle_ns(l) + lv.tolerance_ns);
+            buffers.push(LeaderBuffer {
+                leader: l,
+                coupling,
+                delay_ns: lv.delay_ns,
+                tolerance_ns: lv.tolerance_ns,
+                samples,
+                seq: 0,
+                missing: None,
+                logged: false,
+            });
+        }
+    }
+    buffers
+}
 
 /// The technology objects of one node (or of the whole cell), stepped by the caller.
 #[derive(Debug)]
 pub struct Executive<'c> {
     cell: &'c Cell,
-    owned_axes: Vec<bool>,
-    owned_encoders: Vec<bool>,
+    owned: Owned,
     axes: Vec<Axis>,
     encoders: Vec<ExternalEncoder>,
     /// The cams as the jobs see them: MC_InterpolateCam replaces one (a job keeps its own).
@@ -238,38 +356,11 @@ pub struct Executive<'c> {
 }
 
 impl<'c> Executive<'c> {
-    /// The objects of node `node` (all of the cell with `None`). Fails when an object's
-    /// configuration is refused by the engine.
-    pub fn new(cell: &'c Cell, node: Option<usize>) -> io::Result<Self> {
-        let owned_axes: Vec<bool> = cell
-            .axes
-            .iter()
-            .map(|a| node.is_none_or(|n| a.node == n))
-            .collect();
-        let owned_encoders: Vec<bool> = cell
-            .encoders
-            .iter()
-            .map(|e| node.is_none_or(|n| e.node == n))
-            .collect();
-        let mut axes = Vec::with_capacity(cell.axes.len());
-        for a in &cell.axes {
-            axes.push(Axis::new(a.config.clone()).map_err(|e| invalid("axis", &a.name, e))?);
-        }
-        let mut encoders = Vec::with_capacity(cell.encoders.len());
-        for e in &cell.encoders {
-            encoders
-                .push(ExternalEncoder::new(e.config).map_err(|x| invalid("encoder", &e.name, x))?);
-        }
-        // Axes that lead by actual value run the extrapolation of their actual value.
-        for a in &cell.axes {
-            for (j, c) in a.leaders.iter().flatten() {
-                if *c == Coupling::Actual {
-                    if let Some(leader) = axes.get_mut(*j) {
-                        leader.set_actual_value_output(true);
-                    }
-                }
-            }
-        }
+    /// The objects of node `node` (all of the cell with `None`). Fails when the engine refuses
+    /// an object's configuration.
+    pub fn new(cell: &'c Cell, node: Option<usize>) -> Result<Self, ExecError> {
+        let owned = Owned::of(cell, node);
+        let (axes, encoders) = engine_objects(cell)?;
         let cams = cell
             .cams
             .iter()
@@ -280,95 +371,16 @@ impl<'c> Executive<'c> {
             .iter()
             .map(|a| cell.nodes[a.node].cycle_ns)
             .collect();
-        let owned_cycles: Vec<i64> = cell
-            .nodes
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| node.is_none_or(|n| n == *i))
-            .map(|(_, n)| n.cycle_ns)
-            .collect();
-        let tick = owned_cycles
-            .iter()
-            .copied()
-            .fold(0, gcd)
-            .max(cell.base_tick_ns.max(1));
-        let tick = if owned_cycles.iter().all(|c| c % tick == 0) {
-            tick
-        } else {
-            cell.base_tick_ns.max(1)
-        };
-        let has_objects: Vec<bool> = (0..cell.axes.len())
-            .map(|i| {
-                owned_axes[i]
-                    && (cell.output_cams.iter().any(|c| c.axis == i)
-                        || cell.cam_tracks.iter().any(|c| c.axis == i)
-                        || cell.measuring_inputs.iter().any(|c| c.axis == i))
-            })
-            .collect();
-        // Axes whose cycle motion is needed: those with objects and those that carry a sensor.
-        let needs_motion: Vec<bool> = (0..cell.axes.len())
-            .map(|i| {
-                owned_axes[i]
-                    && (has_objects[i]
-                        || cell
-                            .measuring_inputs
-                            .iter()
-                            .any(|m| m.sensor.is_some_and(|s| s.axis == i)))
-            })
-            .collect();
-        // Buffers: each leader that a follower of this executive may read with a delay, and
-        // each leader on another node that a follower here may follow.
-        let mut buffers: Vec<LeaderBuffer> = Vec::new();
-        for (f, a) in cell.axes.iter().enumerate() {
-            if !owned_axes[f] {
-                continue;
-            }
-            let candidates: Vec<(usize, Coupling)> = match &a.leaders {
-                Some(list) => list.clone(),
-                None => (0..cell.axes.len() + cell.encoders.len())
-                    .filter(|l| *l != f && cell.coupling(f, *l).is_some())
-                    .map(|l| (l, Coupling::Setpoint))
-                    .collect(),
-            };
-            for (l, coupling) in candidates {
-                let lv = cell.leading[l];
-                let local = cell.leader_node(l) == Some(a.node);
-                let coupling = if l >= cell.axes.len() {
-                    Coupling::Setpoint
-                } else {
-                    coupling
-                };
-                if (local && lv.delay_ns == 0)
-                    || buffers
-                        .iter()
-                        .any(|b| b.leader == l && b.coupling == coupling)
-                {
-                    continue;
-                }
-                let mut samples = Box::new(LeadingValueBuffer::new());
-                let leader_cycle = cell.leader_node(l).map_or(0, |n| cell.nodes[n].cycle_ns);
-                samples.set_max_gap(leader_cycle + lv.tolerance_ns);
-                buffers.push(LeaderBuffer {
-                    leader: l,
-                    coupling,
-                    delay_ns: lv.delay_ns,
-                    tolerance_ns: lv.tolerance_ns,
-                    samples,
-                    seq: 0,
-                    missing: None,
-                    logged: false,
-                });
-            }
-        }
+        let (has_objects, needs_motion) = axes_with_objects(cell, &owned);
+        let buffers = leader_buffers(cell, &owned);
         let status: Vec<AxisStatus> = axes.iter().map(|a| *a.status()).collect();
         let encoder_status = encoders.iter().map(|e| *e.status()).collect();
         Ok(Self {
             cell,
             objects: Objects::new(cell)?,
-            owned_axes,
-            owned_encoders,
+            owned,
             cams,
-            tick,
+            tick: tick_of(cell, node),
             has_objects,
             needs_motion,
             motions: (0..cell.axes.len()).map(|_| None).collect(),
@@ -396,8 +408,8 @@ impl<'c> Executive<'c> {
     }
 
     /// Whether this executive steps axis `i`.
-    pub fn owns_axis(&self, i: usize) -> bool {
-        self.owned_axes.get(i).copied().unwrap_or(false)
+    pub fn owns_axis(&self, i: AxisIndex) -> bool {
+        self.owned.axis(i)
     }
 
     /// The status of every axis of the cell (meaningful for the owned ones).
@@ -411,8 +423,8 @@ impl<'c> Executive<'c> {
     }
 
     /// The axis `i` (for its alarms and details).
-    pub fn axis(&self, i: usize) -> Option<&Axis> {
-        self.axes.get(i)
+    pub fn axis(&self, i: AxisIndex) -> Option<&Axis> {
+        self.axes.get(i.0)
     }
 
     /// The objects' columns of a trace row (output cams, cam tracks, measuring inputs).
@@ -430,15 +442,15 @@ impl<'c> Executive<'c> {
         self.axes
             .iter()
             .enumerate()
-            .filter(|(i, a)| self.owned_axes[*i] && a.alarms().next().is_some())
+            .filter(|(i, a)| self.owned.axes[*i] && a.alarms().next().is_some())
             .count()
     }
 
-    /// Hands the executive a sample of leader `leader` published by another node (in the
-    /// leader's `coupling`). A sample of a leader nobody here follows is ignored.
+    /// Hands the executive a sample of `leader` published by another node (in the leader's
+    /// `coupling`). A sample of a leader nobody here follows is ignored.
     pub fn feed(
         &mut self,
-        leader: usize,
+        leader: Leader,
         coupling: Coupling,
         sample: LeadingSample,
     ) -> Result<(), Rejected> {
@@ -453,27 +465,16 @@ impl<'c> Executive<'c> {
     }
 
     /// The leaders (and couplings) this executive reads from other nodes.
-    pub fn remote_leaders(&self) -> impl Iterator<Item = (usize, Coupling)> + '_ {
+    pub fn remote_leaders(&self) -> impl Iterator<Item = (Leader, Coupling)> + '_ {
         self.buffers
             .iter()
-            .filter(|b| !self.owns_leader(b.leader))
+            .filter(|b| !self.owned.leader(b.leader))
             .map(|b| (b.leader, b.coupling))
     }
 
-    fn owns_leader(&self, l: usize) -> bool {
-        match self.owned_axes.get(l) {
-            Some(o) => *o,
-            None => self
-                .owned_encoders
-                .get(l - self.axes.len())
-                .copied()
-                .unwrap_or(false),
-        }
-    }
-
-    /// The current leading value of leader `leader` as this executive computed it in its last
-    /// step, timestamped `t_ns` (for publishing to other nodes).
-    pub fn sample(&self, leader: usize, coupling: Coupling, t_ns: i64, seq: u64) -> LeadingSample {
+    /// The current leading value of `leader` as this executive computed it in its last step,
+    /// timestamped `t_ns` (for publishing to other nodes).
+    pub fn sample(&self, leader: Leader, coupling: Coupling, t_ns: i64, seq: u64) -> LeadingSample {
         let lv = self.direct(leader, coupling);
         LeadingSample {
             t_ns,
@@ -487,16 +488,16 @@ impl<'c> Executive<'c> {
     }
 
     /// The value of an owned leader as stepped this cycle.
-    fn direct(&self, j: usize, coupling: Coupling) -> Option<LeadingValue> {
-        if j >= self.axes.len() {
-            self.encoders
-                .get(j - self.axes.len())
-                .and_then(|e| e.leading_value())
-        } else {
-            Some(match coupling {
-                Coupling::Actual => self.axes[j].actual_leading_value(),
-                Coupling::Setpoint => self.axes[j].setpoint_leading_value(),
-            })
+    fn direct(&self, leader: Leader, coupling: Coupling) -> Option<LeadingValue> {
+        match leader {
+            Leader::Encoder(k) => self.encoders.get(k.0).and_then(|e| e.leading_value()),
+            Leader::Axis(j) => {
+                let axis = self.axes.get(j.0)?;
+                Some(match coupling {
+                    Coupling::Actual => axis.actual_leading_value(),
+                    Coupling::Setpoint => axis.setpoint_leading_value(),
+                })
+            }
         }
     }
 
@@ -558,15 +559,7 @@ impl<'c> Executive<'c> {
             | Action::AbortMeasuringInput
             | Action::ResetObject { .. }
             | Action::InputEdge { .. } => {
-                let axis = cell
-                    .output_cam(target)
-                    .map(|i| cell.output_cams[i].axis)
-                    .or_else(|| cell.cam_track(target).map(|i| cell.cam_tracks[i].axis))
-                    .or_else(|| {
-                        cell.measuring_input(target)
-                            .map(|i| cell.measuring_inputs[i].axis)
-                    });
-                if !axis.is_some_and(|a| self.owned_axes[a]) {
+                if !cell.object_axis(target).is_some_and(|a| self.owned.axis(a)) {
                     return Err(ErrorId::IllegalObject);
                 }
                 return self.objects.apply(cell, target, t, action).map(|()| None);
@@ -576,7 +569,7 @@ impl<'c> Executive<'c> {
             }
         };
         if let Some(k) = cell.encoders.iter().position(|x| x.name == target) {
-            if !self.owned_encoders[k] {
+            if !self.owned.encoders[k] {
                 return Err(ErrorId::IllegalObject);
             }
             return self.encoders[k].command(&command).map(Some);
@@ -585,10 +578,18 @@ impl<'c> Executive<'c> {
             .axes
             .iter()
             .position(|a| a.name == target)
-            .filter(|i| self.owned_axes[*i])
+            .map(AxisIndex)
+            .filter(|i| self.owned.axis(*i))
         else {
             return Err(ErrorId::IllegalObject);
         };
+        self.axis_command(i, command)
+    }
+
+    /// A command to owned axis `i`: synchronous operation only with a configured leader
+    /// that does not follow `i`; MC_CamIn takes its own reference to the cam.
+    fn axis_command(&mut self, i: AxisIndex, command: Command) -> Applied {
+        let cell = self.cell;
         let master = match command {
             Command::GearIn { master, .. }
             | Command::GearInPos { master, .. }
@@ -599,16 +600,18 @@ impl<'c> Executive<'c> {
         if let Command::CamIn { cam, .. } = command {
             // The job takes its own reference to the interpolated cam.
             if let Some((c, _)) = usize::try_from(cam).ok().and_then(|c| self.cams.get(c)) {
-                self.axes[i].provide_cam(cam, Arc::clone(c));
+                self.axes[i.0].provide_cam(cam, Arc::clone(c));
             }
         }
-        let result = match master.and_then(|m| usize::try_from(m).ok()) {
-            Some(m) if recursive(&self.axes, &self.owned_axes, i, m) => {
+        let result = match master.map(|m| cell.leader(m)) {
+            // A leader id the cell does not have.
+            Some(None) => Err(ErrorId::IllegalObject),
+            Some(Some(m)) if recursive(cell, &self.axes, &self.owned.axes, i, m) => {
                 Err(ErrorId::RecursiveSyncChain)
             }
             // The leader must be one of the follower's configured leaders.
-            Some(m) if cell.coupling(i, m).is_none() => Err(ErrorId::IllegalObject),
-            _ => self.axes[i].command(&command).map(Some),
+            Some(Some(m)) if cell.coupling(i, m).is_none() => Err(ErrorId::IllegalObject),
+            _ => self.axes[i.0].command(&command).map(Some),
         };
         if let (Ok(_), Command::Home { mode, .. }) = (&result, command) {
             self.objects.homing_started(cell, i, mode);
@@ -617,13 +620,13 @@ impl<'c> Executive<'c> {
     }
 
     /// The value follower `i` reads of leader `l` at time `t`.
-    fn leading_value(&mut self, i: usize, l: usize, t: i64) -> Option<LeadingValue> {
-        let coupling = if l >= self.axes.len() {
+    fn leading_value(&mut self, i: AxisIndex, l: Leader, t: i64) -> Option<LeadingValue> {
+        let coupling = if l.is_encoder() {
             Coupling::Setpoint
         } else {
             self.cell.coupling(i, l).unwrap_or(Coupling::Setpoint)
         };
-        let owned = self.owns_leader(l);
+        let owned = self.owned.leader(l);
         match self
             .buffers
             .iter_mut()
@@ -654,24 +657,17 @@ impl<'c> Executive<'c> {
     /// Logs each leader whose value went missing this step, once per outage: which leader,
     /// why, and the newest sample's time.
     fn log_missing(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
-        let names = &self.cell.axes;
+        let cell = self.cell;
         for b in self.buffers.iter_mut().filter(|b| !b.logged) {
             let Some(m) = b.missing else {
                 continue;
             };
             b.logged = true;
-            let leader = match names.get(b.leader) {
-                Some(a) => a.name.as_str(),
-                None => self
-                    .cell
-                    .encoders
-                    .get(b.leader - names.len())
-                    .map_or("?", |e| e.name.as_str()),
-            };
             write!(
                 log,
-                "t={} leading value of {leader} missing at t - D = {}: ",
+                "t={} leading value of {} missing at t - D = {}: ",
                 Secs(t),
+                cell.leader_name(b.leader),
                 Secs(t - b.delay_ns)
             )?;
             match m {
@@ -698,17 +694,29 @@ impl<'c> Executive<'c> {
     /// cycle, then register corrections. Job events, alarms, output edges and measured values
     /// are written to `log`.
     pub fn step(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        self.step_encoders(t, log)?;
+        self.record_samples(t, true);
+        self.step_axes(t);
+        self.record_samples(t, false);
+        self.log_missing(t, log)?;
+        self.axis_events(t, log)?;
+        self.step_objects(t, log)?;
+        self.register_corrections(t, log)
+    }
+
+    /// External encoders first: they lead and follow nothing. An encoder on an axis reads that
+    /// axis' actual position of the previous cycle (one cycle of acquisition delay).
+    fn step_encoders(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
         let n_axes = self.axes.len();
-        // External encoders first: they lead and follow nothing. An encoder on an axis reads
-        // that axis' actual position of the previous cycle (one cycle of acquisition delay).
         for (k, enc) in self.encoders.iter_mut().enumerate() {
-            if !self.owned_encoders[k] || t % cell.nodes[cell.encoders[k].node].cycle_ns != 0 {
+            let entry = &cell.encoders[k];
+            if !self.owned.encoders[k] || t % cell.nodes[entry.node].cycle_ns != 0 {
                 continue;
             }
-            let (p, v) = match &cell.encoders[k].source {
+            let (p, v) = match &entry.source {
                 EncoderSource::Axis { axis, scale } => {
-                    let s = self.axes[*axis].status();
+                    let s = self.axes[axis.0].status();
                     (
                         s.actual_position_unwrapped * scale,
                         s.actual_velocity * scale,
@@ -720,47 +728,42 @@ impl<'c> Executive<'c> {
             };
             enc.step(t, p, v);
             while let Some(ev) = enc.pop_event() {
-                let name = &cell.encoders[k].name;
-                job_event(
-                    &mut self.jobs,
-                    &mut self.notes_dropped,
-                    log,
-                    name,
-                    n_axes + k,
-                    ev,
-                )?;
+                let (jobs, dropped) = (&mut self.jobs, &mut self.notes_dropped);
+                job_event(jobs, dropped, log, &entry.name, n_axes + k, ev)?;
             }
             self.encoder_status[k] = *enc.status();
         }
-        self.record_samples(t, true);
-        // Leaders before their followers: an axis steps once every leader it needs has.
+        Ok(())
+    }
+
+    /// The owned axes, leaders before their followers: an axis steps once every leader it
+    /// needs has, with the leading values of this step.
+    fn step_axes(&mut self, t: i64) {
+        let cell = self.cell;
+        let n_axes = self.axes.len();
         self.stepped.fill(false);
         for _pass in 0..=n_axes {
             let mut progress = false;
-            for i in 0..n_axes {
-                if self.stepped[i] || !self.owned_axes[i] {
+            for i in cell.axis_indices() {
+                if self.stepped[i.0] || !self.owned.axes[i.0] {
                     continue;
                 }
-                let needs: [Option<LeaderId>; 2] = self.axes[i].leaders();
-                let ready = needs.iter().flatten().all(|l| {
-                    usize::try_from(*l)
-                        .ok()
-                        .map(|j| j >= n_axes || !self.owned_axes[j] || self.stepped[j])
-                        .unwrap_or(true)
+                let needs = self.axes[i.0].leaders();
+                let ready = needs.iter().flatten().all(|l| match cell.leader(*l) {
+                    Some(Leader::Axis(j)) => !self.owned.axes[j.0] || self.stepped[j.0],
+                    _ => true,
                 });
                 if !ready {
                     continue;
                 }
                 for l in needs.into_iter().flatten() {
-                    let lv = usize::try_from(l)
-                        .ok()
-                        .and_then(|j| self.leading_value(i, j, t));
-                    self.axes[i].set_leading_value(l, lv);
+                    let lv = cell.leader(l).and_then(|j| self.leading_value(i, j, t));
+                    self.axes[i.0].set_leading_value(l, lv);
                 }
-                if t % self.cycles[i] == 0 {
-                    self.axes[i].step(t);
+                if t % self.cycles[i.0] == 0 {
+                    self.axes[i.0].step(t);
                 }
-                self.stepped[i] = true;
+                self.stepped[i.0] = true;
                 progress = true;
             }
             if !progress {
@@ -770,14 +773,17 @@ impl<'c> Executive<'c> {
         // Not reached only with a coupling loop, which commands cannot create (16#8019): the
         // axis then runs without its leading value and raises "leader missing".
         for (i, axis) in self.axes.iter_mut().enumerate() {
-            if self.owned_axes[i] && !self.stepped[i] && t % self.cycles[i] == 0 {
+            if self.owned.axes[i] && !self.stepped[i] && t % self.cycles[i] == 0 {
                 axis.step(t);
             }
         }
-        self.record_samples(t, false);
-        self.log_missing(t, log)?;
+    }
+
+    /// The job events and new alarms of the owned axes, and their status.
+    fn axis_events(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        let cell = self.cell;
         for (i, axis) in self.axes.iter_mut().enumerate() {
-            if !self.owned_axes[i] {
+            if !self.owned.axes[i] {
                 continue;
             }
             while let Some(ev) = axis.pop_event() {
@@ -803,8 +809,13 @@ impl<'c> Executive<'c> {
             self.alarms_seen[i] = now;
             self.status[i] = *axis.status();
         }
-        // Output cams, cam tracks and measuring inputs: after their axis, every cycle of its
-        // node, with the motion of that cycle.
+        Ok(())
+    }
+
+    /// Output cams, cam tracks and measuring inputs: after their axis, every cycle of its
+    /// node, with the motion of that cycle.
+    fn step_objects(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        let cell = self.cell;
         for (i, m) in self.motions.iter_mut().enumerate() {
             *m = (t % self.cycles[i] == 0 && self.needs_motion[i]).then(|| {
                 cycle_motion(
@@ -817,23 +828,28 @@ impl<'c> Executive<'c> {
                 )
             });
         }
-        for i in 0..n_axes {
-            if !self.owned_axes[i] || t % self.cycles[i] != 0 {
+        for i in cell.axis_indices() {
+            if !self.owned.axes[i.0] || t % self.cycles[i.0] != 0 {
                 continue;
             }
-            if self.has_objects[i] {
+            if self.has_objects[i.0] {
                 self.objects.step(cell, i, &self.motions, log)?;
-                if self.objects.homing[i]
-                    && !matches!(self.status[i].motion_job, Some((_, Instruction::Home)))
+                if self.objects.homing[i.0]
+                    && !matches!(self.status[i.0].motion_job, Some((_, Instruction::Home)))
                 {
-                    self.objects.homing[i] = false;
+                    self.objects.homing[i.0] = false;
                 }
             }
-            self.last_cycle[i] = self.status[i];
+            self.last_cycle[i.0] = self.status[i.0];
         }
-        // Register corrections: MC_MoveSuperimposed, effective from the next cycle.
-        for k in 0..self.objects.corrections.len() {
-            let (a, distance, input) = self.objects.corrections[k];
+        Ok(())
+    }
+
+    /// Register corrections: MC_MoveSuperimposed, effective from the next cycle.
+    fn register_corrections(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        let cell = self.cell;
+        for k in 0..self.objects.out.corrections.len() {
+            let (a, distance, input) = self.objects.out.corrections[k];
             let command = Command::MoveSuperimposed {
                 distance,
                 dynamics: tandem_motion::dynamics::Dynamics::DEFAULT,
@@ -847,7 +863,7 @@ impl<'c> Executive<'c> {
                 cell.axes[a].name,
                 distance
             )?;
-            if let Err(id) = self.axes[a].command(&command) {
+            if let Err(id) = self.axes[a.0].command(&command) {
                 self.rejected += 1;
                 writeln!(
                     log,
@@ -858,7 +874,7 @@ impl<'c> Executive<'c> {
                 )?;
             }
         }
-        self.objects.corrections.clear();
+        self.objects.out.corrections.clear();
         Ok(())
     }
 
@@ -870,23 +886,21 @@ impl<'c> Executive<'c> {
 
     /// Hands each output edge and measured value of the last step to `f`, then forgets them.
     pub fn drain_io_notes(&mut self, mut f: impl FnMut(&IoNote)) {
-        self.objects.notes.iter().for_each(&mut f);
-        self.objects.notes.clear();
+        self.objects.out.notes.iter().for_each(&mut f);
+        self.objects.out.notes.clear();
     }
 
     /// Records the samples of owned leaders that were stepped at `t` into their buffers
     /// (encoders before the axes step, axes after).
     fn record_samples(&mut self, t: i64, encoders: bool) {
-        let n_axes = self.axes.len();
         for k in 0..self.buffers.len() {
             let l = self.buffers[k].leader;
-            if (l >= n_axes) != encoders || !self.owns_leader(l) {
+            if l.is_encoder() != encoders || !self.owned.leader(l) {
                 continue;
             }
-            let cycle = if l < n_axes {
-                self.cycles[l]
-            } else {
-                self.cell.nodes[self.cell.encoders[l - n_axes].node].cycle_ns
+            let cycle = match l {
+                Leader::Axis(a) => self.cycles[a.0],
+                Leader::Encoder(_) => self.cell.leader_cycle_ns(l),
             };
             if t % cycle != 0 {
                 continue;

@@ -1,9 +1,10 @@
 //! Output cams, cam tracks and measuring inputs of an executive: stepped after their axis with
 //! the motion of its last cycle.
 
-use crate::exec::{Describe, IoNote, Secs, NOTES};
+use crate::error::ExecError;
+use crate::notes::{keep, seconds, Describe, IoNote, Secs, NOTES};
 use std::io::{self, Write};
-use tandem_config::Cell;
+use tandem_config::{AxisIndex, CamTrackEntry, Cell, MeasuringInputEntry, OutputCamEntry};
 use tandem_motion::action::Action;
 use tandem_motion::alarm::AlarmInstance;
 use tandem_motion::axis::AxisStatus;
@@ -48,6 +49,16 @@ const INSTANCE: u32 = 1;
 pub(crate) struct CycleMotion {
     pub(crate) setpoint: AxisMotion,
     pub(crate) actual: AxisMotion,
+}
+
+impl CycleMotion {
+    /// The setpoint or actual motion, as an object's position type says.
+    fn of(&self, p: PositionType) -> &AxisMotion {
+        match p {
+            PositionType::Setpoint => &self.setpoint,
+            PositionType::Actual => &self.actual,
+        }
+    }
 }
 
 /// The motion from `prev` to `now` (continuous positions). A homing jump is detected only
@@ -120,7 +131,21 @@ pub(crate) fn cycle_motion(
     CycleMotion { setpoint, actual }
 }
 
-/// A measuring input of the simulator: the engine object, its sensor, the scripted edges and
+/// An output cam of the executive and the time of its last edge.
+#[derive(Debug)]
+pub(crate) struct SimCam {
+    cam: OutputCam,
+    last_edge: Option<i64>,
+}
+
+/// A cam track of the executive and the time of its last edge.
+#[derive(Debug)]
+pub(crate) struct SimTrack {
+    track: CamTrack,
+    last_edge: Option<i64>,
+}
+
+/// A measuring input of the executive: the engine object, its sensor, the scripted edges and
 /// what was last logged.
 #[derive(Debug)]
 pub(crate) struct SimInput {
@@ -131,35 +156,32 @@ pub(crate) struct SimInput {
     logged: (u32, i64, u32, i64, bool),
 }
 
-/// The output cams, cam tracks and measuring inputs of a run.
+/// What the objects' steps produce besides the log, shared by all objects of a step.
 #[derive(Debug)]
-pub(crate) struct Objects {
-    pub(crate) cams: Vec<OutputCam>,
-    pub(crate) cam_last_edge: Vec<Option<i64>>,
-    pub(crate) tracks: Vec<CamTrack>,
-    pub(crate) track_last_edge: Vec<Option<i64>>,
-    pub(crate) inputs: Vec<SimInput>,
-    /// Per axis: an MC_Home job was started and has not ended.
-    pub(crate) homing: Vec<bool>,
-    pub(crate) edges: CamEdges,
-    pub(crate) row: String,
+pub(crate) struct StepOutput {
+    /// The edges of the output cam or cam track being stepped.
+    edges: CamEdges,
     /// Output edges and measured values of the current step.
     pub(crate) notes: Vec<IoNote>,
     /// Notes dropped (more than [`NOTES`] in one step).
     pub(crate) notes_dropped: u64,
     /// Register corrections due: (axis, distance, measuring input).
-    pub(crate) corrections: Vec<(usize, f64, usize)>,
+    pub(crate) corrections: Vec<(AxisIndex, f64, usize)>,
     /// The alarm last logged per object: output cams, then cam tracks, then measuring inputs.
-    pub(crate) alarms: Vec<Option<AlarmInstance>>,
+    alarms: Vec<Option<AlarmInstance>>,
 }
 
-/// Keeps `n` unless the step already has [`NOTES`] notes.
-fn note(notes: &mut Vec<IoNote>, dropped: &mut u64, n: IoNote) {
-    if notes.len() < NOTES {
-        notes.push(n);
-    } else {
-        *dropped += 1;
-    }
+/// The output cams, cam tracks and measuring inputs of an executive.
+#[derive(Debug)]
+pub(crate) struct Objects {
+    cams: Vec<SimCam>,
+    tracks: Vec<SimTrack>,
+    inputs: Vec<SimInput>,
+    /// Per axis: an MC_Home job was started and has not ended.
+    pub(crate) homing: Vec<bool>,
+    row: String,
+    /// Notes, corrections and alarms of the current step.
+    pub(crate) out: StepOutput,
 }
 
 /// Logs `now` if it is a new alarm of `name` (and remembers it).
@@ -184,21 +206,349 @@ fn log_alarm(
     Ok(())
 }
 
-pub(crate) fn invalid(what: &str, name: &str, e: impl std::fmt::Display) -> io::Error {
-    io::Error::new(io::ErrorKind::InvalidInput, format!("{what} {name}: {e}"))
+/// What an object's report works with: the cell, which object, the motion of the cycle and
+/// where its notes and corrections go.
+struct Report<'a> {
+    cell: &'a Cell,
+    /// The object's id in [`IoNote::object`].
+    object: usize,
+    /// Its index among the objects of its kind.
+    index: usize,
+    motion: &'a CycleMotion,
+    edges: &'a CamEdges,
+    notes: &'a mut Vec<IoNote>,
+    notes_dropped: &'a mut u64,
+    corrections: &'a mut Vec<(AxisIndex, f64, usize)>,
+}
+
+impl Report<'_> {
+    /// Keeps an I/O note of this object.
+    fn note(&mut self, t_ns: i64, measured: bool, counter: u32, value: f64) {
+        let object = self.object;
+        keep(
+            self.notes,
+            self.notes_dropped,
+            IoNote {
+                object,
+                t_ns,
+                measured,
+                counter,
+                value,
+            },
+        );
+    }
+}
+
+/// One kind of object stepped after its axis with the motion of the axis' cycle: step it, log
+/// a new alarm, then report what it did.
+trait CycleObject {
+    /// Its entry in the cell.
+    type Entry;
+    /// The axis whose motion it follows.
+    fn axis(e: &Self::Entry) -> AxisIndex;
+    /// Its name.
+    fn name(e: &Self::Entry) -> &str;
+    /// Steps it with `motion` (`motions`: every axis' motion of this step; a cam's edges go to
+    /// `edges`). Returns the time its alarm is logged at.
+    fn step(
+        &mut self,
+        e: &Self::Entry,
+        motion: &CycleMotion,
+        motions: &[Option<CycleMotion>],
+        edges: &mut CamEdges,
+    ) -> i64;
+    /// Its pending alarm.
+    fn alarm(&self) -> Option<AlarmInstance>;
+    /// Reports the step: notes, log lines, register corrections.
+    fn report(
+        &mut self,
+        e: &Self::Entry,
+        r: &mut Report<'_>,
+        log: &mut impl Write,
+    ) -> io::Result<()>;
+}
+
+/// The log's word for an output state.
+fn on_off(on: bool) -> &'static str {
+    if on {
+        "ON"
+    } else {
+        "OFF"
+    }
+}
+
+impl CycleObject for SimCam {
+    type Entry = OutputCamEntry;
+    fn axis(e: &OutputCamEntry) -> AxisIndex {
+        e.axis
+    }
+    fn name(e: &OutputCamEntry) -> &str {
+        &e.name
+    }
+    fn step(
+        &mut self,
+        e: &OutputCamEntry,
+        motion: &CycleMotion,
+        _: &[Option<CycleMotion>],
+        edges: &mut CamEdges,
+    ) -> i64 {
+        edges.clear();
+        self.cam.step(motion.of(e.config.position_type), edges);
+        motion.setpoint.t1_ns
+    }
+    fn alarm(&self) -> Option<AlarmInstance> {
+        self.cam.status().alarm
+    }
+    fn report(
+        &mut self,
+        e: &OutputCamEntry,
+        r: &mut Report<'_>,
+        log: &mut impl Write,
+    ) -> io::Result<()> {
+        for edge in r.edges.as_slice() {
+            self.last_edge = Some(edge.time_ns);
+            r.note(edge.time_ns, false, 0, f64::from(u8::from(edge.on)));
+            writeln!(
+                log,
+                "t={} {} output {}",
+                Secs(edge.time_ns),
+                e.name,
+                on_off(edge.on)
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl CycleObject for SimTrack {
+    type Entry = CamTrackEntry;
+    fn axis(e: &CamTrackEntry) -> AxisIndex {
+        e.axis
+    }
+    fn name(e: &CamTrackEntry) -> &str {
+        &e.name
+    }
+    fn step(
+        &mut self,
+        e: &CamTrackEntry,
+        motion: &CycleMotion,
+        _: &[Option<CycleMotion>],
+        edges: &mut CamEdges,
+    ) -> i64 {
+        edges.clear();
+        self.track.step(motion.of(e.config.position_type), edges);
+        motion.setpoint.t1_ns
+    }
+    fn alarm(&self) -> Option<AlarmInstance> {
+        self.track.status().alarm
+    }
+    fn report(
+        &mut self,
+        e: &CamTrackEntry,
+        r: &mut Report<'_>,
+        log: &mut impl Write,
+    ) -> io::Result<()> {
+        for edge in r.edges.as_slice() {
+            self.last_edge = Some(edge.time_ns);
+            r.note(
+                edge.time_ns,
+                false,
+                edge.cam as u32 + 1,
+                f64::from(u8::from(edge.on)),
+            );
+            writeln!(
+                log,
+                "t={} {} output {} (cam {})",
+                Secs(edge.time_ns),
+                e.name,
+                on_off(edge.on),
+                edge.cam + 1
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl CycleObject for SimInput {
+    type Entry = MeasuringInputEntry;
+    fn axis(e: &MeasuringInputEntry) -> AxisIndex {
+        e.axis
+    }
+    fn name(e: &MeasuringInputEntry) -> &str {
+        &e.name
+    }
+    fn step(
+        &mut self,
+        e: &MeasuringInputEntry,
+        motion: &CycleMotion,
+        motions: &[Option<CycleMotion>],
+        _: &mut CamEdges,
+    ) -> i64 {
+        // A measuring input measures the actual value; its sensor sees the actual value of
+        // the axis that carries the mark.
+        if let (Some(s), Some(src)) = (
+            self.sensor.as_mut(),
+            e.sensor
+                .and_then(|x| motions.get(x.axis.0))
+                .and_then(Option::as_ref),
+        ) {
+            s.step(&src.actual, &mut self.edges);
+        }
+        self.input.step(&motion.actual, self.edges.as_slice());
+        self.edges.clear();
+        motion.actual.t1_ns
+    }
+    fn alarm(&self) -> Option<AlarmInstance> {
+        self.input.status().alarm
+    }
+    fn report(
+        &mut self,
+        e: &MeasuringInputEntry,
+        r: &mut Report<'_>,
+        log: &mut impl Write,
+    ) -> io::Result<()> {
+        let Some(job) = self.job else {
+            return Ok(());
+        };
+        let Some(js) = self.input.job_status(job).copied() else {
+            return Ok(());
+        };
+        let (c1, t1, c2, t2, ended) = self.logged;
+        let one_time = matches!(js.kind, MeasuringJobKind::OneTime(_));
+        // A one-time job counts no captures: a new edge time is a new value.
+        if (js.counter1 != c1 || (one_time && js.edge_time1_ns != t1)) && js.edge_time1_ns != 0 {
+            r.note(js.edge_time1_ns, true, js.counter1, js.measured_value1);
+            writeln!(
+                log,
+                "t={} {} MeasuredValue1 = {} (counter {})",
+                Secs(js.edge_time1_ns),
+                e.name,
+                js.measured_value1,
+                js.counter1
+            )?;
+            if let (Some(reg), false) = (e.registration, one_time) {
+                let mut error = reg.target - js.measured_value1;
+                if let Some(md) = r.cell.axes[e.axis].config.modulo {
+                    error -= md.length * (error / md.length).round();
+                }
+                r.corrections.push((reg.axis, reg.gain * error, r.index));
+            }
+        }
+        if (js.counter2 != c2 || (one_time && js.edge_time2_ns != t2)) && js.edge_time2_ns != 0 {
+            writeln!(
+                log,
+                "t={} {} MeasuredValue2 = {} (counter {})",
+                Secs(js.edge_time2_ns),
+                e.name,
+                js.measured_value2,
+                js.counter2
+            )?;
+        }
+        let end = js.done || js.error || js.command_aborted;
+        if end && !ended {
+            let kind = if js.done {
+                JobEventKind::Done
+            } else if js.error {
+                JobEventKind::Error(js.error_id)
+            } else {
+                JobEventKind::CommandAborted
+            };
+            writeln!(
+                log,
+                "t={} {} {} job {job}: {}",
+                Secs(r.motion.actual.t1_ns),
+                e.name,
+                if one_time {
+                    "MC_MeasuringInput"
+                } else {
+                    "MC_MeasuringInputCyclic"
+                },
+                Describe(kind)
+            )?;
+        }
+        self.logged = (
+            js.counter1,
+            js.edge_time1_ns,
+            js.counter2,
+            js.edge_time2_ns,
+            end,
+        );
+        Ok(())
+    }
+}
+
+/// The step of the objects of one axis: the cell, the axis and every axis' motion of its
+/// last cycle.
+struct AxisCycle<'a> {
+    cell: &'a Cell,
+    axis: AxisIndex,
+    motions: &'a [Option<CycleMotion>],
+}
+
+/// The objects of one kind on the axis, in cell order: each is stepped with the axis' motion,
+/// logs a new alarm (slot `first + k`) and reports. `first` is the kind's first object id.
+fn step_kind<T: CycleObject>(
+    c: &AxisCycle<'_>,
+    objects: &mut [T],
+    entries: &[T::Entry],
+    first: usize,
+    out: &mut StepOutput,
+    log: &mut impl Write,
+) -> io::Result<()> {
+    let Some(motion) = c.motions.get(c.axis.0).and_then(Option::as_ref) else {
+        return Ok(());
+    };
+    for (k, (o, e)) in objects.iter_mut().zip(entries).enumerate() {
+        if T::axis(e) != c.axis {
+            continue;
+        }
+        let t_alarm = o.step(e, motion, c.motions, &mut out.edges);
+        if let Some(last) = out.alarms.get_mut(first + k) {
+            log_alarm(log, t_alarm, T::name(e), last, o.alarm())?;
+        }
+        let mut r = Report {
+            cell: c.cell,
+            object: first + k,
+            index: k,
+            motion,
+            edges: &out.edges,
+            notes: &mut out.notes,
+            notes_dropped: &mut out.notes_dropped,
+            corrections: &mut out.corrections,
+        };
+        o.report(e, &mut r, log)?;
+    }
+    Ok(())
+}
+
+/// The error of an object of kind `kind` named `name` that the engine refuses.
+fn refused<'n>(
+    kind: &'static str,
+    name: &'n str,
+) -> impl FnOnce(tandem_motion::measuring::ConfigError) -> ExecError + 'n {
+    move |reason| ExecError::Object {
+        kind,
+        name: name.to_string(),
+        reason,
+    }
 }
 
 impl Objects {
-    pub(crate) fn new(cell: &Cell) -> io::Result<Self> {
+    /// The objects of `cell`, or the first one the engine refuses.
+    pub(crate) fn new(cell: &Cell) -> Result<Self, ExecError> {
         let mut cams = Vec::new();
         for c in &cell.output_cams {
-            cams.push(OutputCam::new(c.config).map_err(|e| invalid("output cam", &c.name, e))?);
+            cams.push(SimCam {
+                cam: OutputCam::new(c.config).map_err(refused("output cam", &c.name))?,
+                last_edge: None,
+            });
         }
         let mut tracks = Vec::new();
         for c in &cell.cam_tracks {
-            tracks.push(
-                CamTrack::new(c.config, c.data).map_err(|e| invalid("cam track", &c.name, e))?,
-            );
+            tracks.push(SimTrack {
+                track: CamTrack::new(c.config, c.data).map_err(refused("cam track", &c.name))?,
+                last_edge: None,
+            });
         }
         let n_objects =
             cell.output_cams.len() + cell.cam_tracks.len() + cell.measuring_inputs.len();
@@ -206,7 +556,7 @@ impl Objects {
         for m in &cell.measuring_inputs {
             inputs.push(SimInput {
                 input: MeasuringInput::new(m.config)
-                    .map_err(|e| invalid("measuring input", &m.name, e))?,
+                    .map_err(refused("measuring input", &m.name))?,
                 sensor: m.sensor.map(|s| s.sensor()),
                 edges: InputEdges::default(),
                 job: None,
@@ -214,18 +564,18 @@ impl Objects {
             });
         }
         Ok(Self {
-            cam_last_edge: vec![None; cams.len()],
             cams,
-            track_last_edge: vec![None; tracks.len()],
             tracks,
             inputs,
             homing: vec![false; cell.axes.len()],
-            edges: CamEdges::default(),
             row: String::new(),
-            corrections: Vec::with_capacity(cell.measuring_inputs.len()),
-            notes: Vec::with_capacity(NOTES),
-            notes_dropped: 0,
-            alarms: vec![None; n_objects],
+            out: StepOutput {
+                edges: CamEdges::default(),
+                corrections: Vec::with_capacity(cell.measuring_inputs.len()),
+                notes: Vec::with_capacity(NOTES),
+                notes_dropped: 0,
+                alarms: vec![None; n_objects],
+            },
         })
     }
 
@@ -257,7 +607,6 @@ impl Objects {
         t_ns: i64,
         action: Action,
     ) -> Result<(), ErrorId> {
-        use tandem_motion::measuring::{CyclicMode, MeasuringContext, OneTimeMode};
         match action {
             Action::OutputCam {
                 enable,
@@ -276,7 +625,7 @@ impl Objects {
                     mode: OutputCamMode::from_code(mode)?,
                     direction: CamDirection::from_code(direction)?,
                 };
-                let fb = self.cams[i].call(INSTANCE, &input);
+                let fb = self.cams[i].cam.call(INSTANCE, &input);
                 if fb.error && fb.error_id != ErrorId::None {
                     return Err(fb.error_id);
                 }
@@ -293,7 +642,7 @@ impl Objects {
                     mode: CamTrackMode::from_code(mode)?,
                     invert_output,
                 };
-                let fb = self.tracks[i].call(INSTANCE, &input);
+                let fb = self.tracks[i].track.call(INSTANCE, &input);
                 if fb.error && fb.error_id != ErrorId::None {
                     return Err(fb.error_id);
                 }
@@ -303,25 +652,7 @@ impl Objects {
                 cyclic,
                 mode,
                 window,
-            } => {
-                let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
-                let window = window.map(|(start, end)| MeasuringWindow { start, end });
-                let ctx = MeasuringContext {
-                    encoder_valid: true,
-                    homing_active: self.homing[cell.measuring_inputs[i].axis],
-                };
-                let m = &mut self.inputs[i];
-                let job = if cyclic {
-                    m.input
-                        .measuring_input_cyclic(CyclicMode::from_code(mode)?, window, ctx)?
-                } else {
-                    m.input
-                        .measuring_input(OneTimeMode::from_code(mode)?, window, ctx)?
-                };
-                m.job = Some(job);
-                m.logged = (0, 0, 0, 0, false);
-                Ok(())
-            }
+            } => self.measuring_input(cell, target, cyclic, mode, window),
             Action::AbortMeasuringInput => {
                 let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
                 self.inputs[i].input.abort_measuring_input()?;
@@ -337,9 +668,9 @@ impl Objects {
             }
             Action::ResetObject { restart } => {
                 if let Some(i) = cell.output_cam(target) {
-                    self.cams[i].reset();
+                    self.cams[i].cam.reset();
                 } else if let Some(i) = cell.cam_track(target) {
-                    self.tracks[i].reset();
+                    self.tracks[i].track.reset();
                 } else if let Some(i) = cell.measuring_input(target) {
                     self.inputs[i].input.reset(restart);
                 } else {
@@ -351,9 +682,38 @@ impl Objects {
         }
     }
 
+    /// MC_MeasuringInput or MC_MeasuringInputCyclic on the measuring input `target`.
+    fn measuring_input(
+        &mut self,
+        cell: &Cell,
+        target: &str,
+        cyclic: bool,
+        mode: i32,
+        window: Option<(f64, f64)>,
+    ) -> Result<(), ErrorId> {
+        use tandem_motion::measuring::{CyclicMode, MeasuringContext, OneTimeMode};
+        let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
+        let window = window.map(|(start, end)| MeasuringWindow { start, end });
+        let ctx = MeasuringContext {
+            encoder_valid: true,
+            homing_active: self.homing[cell.measuring_inputs[i].axis.0],
+        };
+        let m = &mut self.inputs[i];
+        let job = if cyclic {
+            m.input
+                .measuring_input_cyclic(CyclicMode::from_code(mode)?, window, ctx)?
+        } else {
+            m.input
+                .measuring_input(OneTimeMode::from_code(mode)?, window, ctx)?
+        };
+        m.job = Some(job);
+        m.logged = (0, 0, 0, 0, false);
+        Ok(())
+    }
+
     /// MC_Home started on axis `axis` with `mode`.
-    pub(crate) fn homing_started(&mut self, cell: &Cell, axis: usize, mode: u8) {
-        if let Some(h) = self.homing.get_mut(axis) {
+    pub(crate) fn homing_started(&mut self, cell: &Cell, axis: AxisIndex, mode: u8) {
+        if let Some(h) = self.homing.get_mut(axis.0) {
             *h = true;
         }
         for (m, e) in self.inputs.iter_mut().zip(&cell.measuring_inputs) {
@@ -364,207 +724,32 @@ impl Objects {
     }
 
     /// Steps the objects of axis `axis` with the motion of its last cycle, logging edges and
-    /// measured values.
+    /// measured values: its output cams, then its cam tracks, then its measuring inputs.
     pub(crate) fn step(
         &mut self,
         cell: &Cell,
-        axis: usize,
+        axis: AxisIndex,
         motions: &[Option<CycleMotion>],
         log: &mut impl Write,
     ) -> io::Result<()> {
-        let Some(motion) = motions.get(axis).and_then(Option::as_ref) else {
-            return Ok(());
+        let c = AxisCycle {
+            cell,
+            axis,
+            motions,
         };
-        let pick = |p: PositionType| match p {
-            PositionType::Setpoint => &motion.setpoint,
-            PositionType::Actual => &motion.actual,
-        };
-        for (i, c) in cell.output_cams.iter().enumerate() {
-            if c.axis != axis {
-                continue;
-            }
-            self.edges.clear();
-            self.cams[i].step(pick(c.config.position_type), &mut self.edges);
-            if let Some(last) = self.alarms.get_mut(i) {
-                log_alarm(
-                    log,
-                    motion.setpoint.t1_ns,
-                    &c.name,
-                    last,
-                    self.cams[i].status().alarm,
-                )?;
-            }
-            for e in self.edges.as_slice() {
-                self.cam_last_edge[i] = Some(e.time_ns);
-                note(
-                    &mut self.notes,
-                    &mut self.notes_dropped,
-                    IoNote {
-                        object: i,
-                        t_ns: e.time_ns,
-                        measured: false,
-                        counter: 0,
-                        value: f64::from(u8::from(e.on)),
-                    },
-                );
-                writeln!(
-                    log,
-                    "t={} {} output {}",
-                    Secs(e.time_ns),
-                    c.name,
-                    if e.on { "ON" } else { "OFF" }
-                )?;
-            }
-        }
-        for (i, c) in cell.cam_tracks.iter().enumerate() {
-            if c.axis != axis {
-                continue;
-            }
-            self.edges.clear();
-            self.tracks[i].step(pick(c.config.position_type), &mut self.edges);
-            if let Some(last) = self.alarms.get_mut(cell.output_cams.len() + i) {
-                log_alarm(
-                    log,
-                    motion.setpoint.t1_ns,
-                    &c.name,
-                    last,
-                    self.tracks[i].status().alarm,
-                )?;
-            }
-            for e in self.edges.as_slice() {
-                self.track_last_edge[i] = Some(e.time_ns);
-                note(
-                    &mut self.notes,
-                    &mut self.notes_dropped,
-                    IoNote {
-                        object: cell.output_cams.len() + i,
-                        t_ns: e.time_ns,
-                        measured: false,
-                        counter: e.cam as u32 + 1,
-                        value: f64::from(u8::from(e.on)),
-                    },
-                );
-                writeln!(
-                    log,
-                    "t={} {} output {} (cam {})",
-                    Secs(e.time_ns),
-                    c.name,
-                    if e.on { "ON" } else { "OFF" },
-                    e.cam + 1
-                )?;
-            }
-        }
-        for (k, (m, e)) in self
-            .inputs
-            .iter_mut()
-            .zip(&cell.measuring_inputs)
-            .enumerate()
-        {
-            if e.axis != axis {
-                continue;
-            }
-            // A measuring input measures the actual value; its sensor sees the actual value of
-            // the axis that carries the mark.
-            if let (Some(s), Some(src)) = (
-                m.sensor.as_mut(),
-                e.sensor
-                    .and_then(|x| motions.get(x.axis))
-                    .and_then(Option::as_ref),
-            ) {
-                s.step(&src.actual, &mut m.edges);
-            }
-            m.input.step(&motion.actual, m.edges.as_slice());
-            m.edges.clear();
-            let slot = cell.output_cams.len() + cell.cam_tracks.len() + k;
-            if let Some(last) = self.alarms.get_mut(slot) {
-                log_alarm(
-                    log,
-                    motion.actual.t1_ns,
-                    &e.name,
-                    last,
-                    m.input.status().alarm,
-                )?;
-            }
-            let Some(job) = m.job else {
-                continue;
-            };
-            let Some(js) = m.input.job_status(job).copied() else {
-                continue;
-            };
-            let (c1, t1, c2, t2, ended) = m.logged;
-            let one_time = matches!(js.kind, MeasuringJobKind::OneTime(_));
-            // A one-time job counts no captures: a new edge time is a new value.
-            if (js.counter1 != c1 || (one_time && js.edge_time1_ns != t1)) && js.edge_time1_ns != 0
-            {
-                note(
-                    &mut self.notes,
-                    &mut self.notes_dropped,
-                    IoNote {
-                        object: cell.output_cams.len() + cell.cam_tracks.len() + k,
-                        t_ns: js.edge_time1_ns,
-                        measured: true,
-                        counter: js.counter1,
-                        value: js.measured_value1,
-                    },
-                );
-                writeln!(
-                    log,
-                    "t={} {} MeasuredValue1 = {} (counter {})",
-                    Secs(js.edge_time1_ns),
-                    e.name,
-                    js.measured_value1,
-                    js.counter1
-                )?;
-                if let (Some(r), false) = (e.registration, one_time) {
-                    let mut error = r.target - js.measured_value1;
-                    if let Some(md) = cell.axes[e.axis].config.modulo {
-                        error -= md.length * (error / md.length).round();
-                    }
-                    self.corrections.push((r.axis, r.gain * error, k));
-                }
-            }
-            if (js.counter2 != c2 || (one_time && js.edge_time2_ns != t2)) && js.edge_time2_ns != 0
-            {
-                writeln!(
-                    log,
-                    "t={} {} MeasuredValue2 = {} (counter {})",
-                    Secs(js.edge_time2_ns),
-                    e.name,
-                    js.measured_value2,
-                    js.counter2
-                )?;
-            }
-            let end = js.done || js.error || js.command_aborted;
-            if end && !ended {
-                let kind = if js.done {
-                    JobEventKind::Done
-                } else if js.error {
-                    JobEventKind::Error(js.error_id)
-                } else {
-                    JobEventKind::CommandAborted
-                };
-                writeln!(
-                    log,
-                    "t={} {} {} job {job}: {}",
-                    Secs(motion.actual.t1_ns),
-                    e.name,
-                    if one_time {
-                        "MC_MeasuringInput"
-                    } else {
-                        "MC_MeasuringInputCyclic"
-                    },
-                    Describe(kind)
-                )?;
-            }
-            m.logged = (
-                js.counter1,
-                js.edge_time1_ns,
-                js.counter2,
-                js.edge_time2_ns,
-                end,
-            );
-        }
-        Ok(())
+        let out = &mut self.out;
+        let n_cams = cell.output_cams.len();
+        let first = n_cams + cell.cam_tracks.len();
+        step_kind(&c, &mut self.cams, &cell.output_cams, 0, out, log)?;
+        step_kind(&c, &mut self.tracks, &cell.cam_tracks, n_cams, out, log)?;
+        step_kind(
+            &c,
+            &mut self.inputs,
+            &cell.measuring_inputs,
+            first,
+            out,
+            log,
+        )
     }
 
     /// The objects' part of a trace row.
@@ -572,17 +757,24 @@ impl Objects {
         use std::fmt::Write as _;
         let r = &mut self.row;
         r.clear();
-        let last = |x: Option<i64>| x.map(crate::exec::seconds).unwrap_or_default();
-        for (c, e) in self.cams.iter().zip(&self.cam_last_edge) {
-            let _ = write!(r, ",{},{}", u8::from(c.status().cam_output), last(*e));
+        let last = |x: Option<i64>| x.map(seconds).unwrap_or_default();
+        for c in &self.cams {
+            // Writing into a String cannot fail.
+            let _ = write!(
+                r,
+                ",{},{}",
+                u8::from(c.cam.status().cam_output),
+                last(c.last_edge)
+            );
         }
-        for (c, e) in self.tracks.iter().zip(&self.track_last_edge) {
-            let s = c.status();
+        for c in &self.tracks {
+            let s = c.track.status();
+            // Writing into a String cannot fail.
             let _ = write!(
                 r,
                 ",{},{},{},{}",
                 u8::from(s.track_output),
-                last(*e),
+                last(c.last_edge),
                 s.single_cam_state,
                 s.track_position
             );
@@ -595,6 +787,7 @@ impl Objects {
                 MeasuringState::TriggerOccurred => "TRIGGER_OCCURRED",
                 MeasuringState::MeasuringError => "MEASURING_ERROR",
             };
+            // Writing into a String cannot fail.
             let _ = write!(
                 r,
                 ",{},{},{},{},{},{}",

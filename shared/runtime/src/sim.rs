@@ -5,8 +5,9 @@
 //! It runs one [`Executive`] that owns the whole cell, the same code a node runs for its part
 //! of the cell, so leading-value delays act as they do between processes.
 
+pub use crate::error::SimError;
 use crate::exec::Executive;
-pub use crate::exec::{seconds, Secs};
+pub use crate::notes::{seconds, Secs};
 use std::io::{self, Write};
 use tandem_config::script::Script;
 use tandem_config::Cell;
@@ -107,13 +108,13 @@ pub fn write_row(
 }
 
 /// Runs `script` on `cell`, writing the CSV trace to `trace` and a log of job events,
-/// rejections and alarms to `log`.
+/// rejections and alarms to `log`. Fails when the engine refuses the cell or a write fails.
 pub fn run(
     cell: &Cell,
     script: &Script,
     trace: &mut impl Write,
     log: &mut impl Write,
-) -> io::Result<Summary> {
+) -> Result<Summary, SimError> {
     let mut exec = Executive::new(cell, None)?;
     let tick = exec.tick_ns();
     write!(trace, "time_s")?;
@@ -139,7 +140,7 @@ pub fn run(
         }
         while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
             next += 1;
-            // A rejection is in the log and the summary.
+            // A rejection is in the log and the summary; a failed write of it is an error.
             let _ = exec.apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, log)?;
         }
         exec.step(t, log)?;

@@ -21,7 +21,7 @@ fn three_executives_step_without_allocating() {
         .iter()
         .map(|n| Executive::new(&cell, Some(node(n))).unwrap())
         .collect();
-    let line = cell.axes.iter().position(|a| a.name == "line").unwrap();
+    let line = cell.leader_named("line").unwrap();
     let mut log = std::io::sink();
     let mut next = 0;
     let mut allocations = 0;

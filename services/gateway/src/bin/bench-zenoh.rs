@@ -223,11 +223,8 @@ impl TandemEnd {
         } else {
             ("pong", "ping", "nb")
         };
-        let objects = cell.object_names();
         let index = |name: &str| {
-            objects
-                .iter()
-                .position(|o| *o == name)
+            cell.leader_named(name)
                 .ok_or_else(|| format!("the cell has no leader `{name}`"))
         };
         let (l_mine, l_theirs) = (index(mine)?, index(theirs)?);
@@ -266,7 +263,7 @@ impl TandemEnd {
             subscriber,
             notifier,
             _node: node,
-            leader: u32::try_from(l_mine).unwrap_or(u32::MAX),
+            leader: cell.leader_id(l_mine),
         })
     }
 }

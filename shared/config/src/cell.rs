@@ -1,0 +1,513 @@
+//! The validated cell: nodes, axes, external encoders, cams, output cams, cam tracks and
+//! measuring inputs, referred to by typed indices.
+
+use core::ops::Index;
+use tandem_motion::axis::AxisConfig;
+use tandem_motion::leading::LeaderId;
+
+/// Samples a leader's buffer holds at each follower: the delay plus the tolerance, in leader
+/// cycles, must fit with a margin of four samples.
+pub const LEADING_BUFFER: usize = 256;
+
+/// An axis of the cell: its index in [`Cell::axes`] (name order).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct AxisIndex(pub usize);
+
+/// An external encoder of the cell: its index in [`Cell::encoders`] (name order).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct EncoderIndex(pub usize);
+
+/// An object that can lead: an axis or an external encoder. Ordered axes first, then
+/// encoders, as the leader ids of commands count them ([`Cell::leader_id`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Leader {
+    /// An axis.
+    Axis(AxisIndex),
+    /// An external encoder.
+    Encoder(EncoderIndex),
+}
+
+impl Leader {
+    /// The axis, if the leader is one.
+    pub fn axis(self) -> Option<AxisIndex> {
+        match self {
+            Leader::Axis(a) => Some(a),
+            Leader::Encoder(_) => None,
+        }
+    }
+
+    /// The encoder, if the leader is one.
+    pub fn encoder(self) -> Option<EncoderIndex> {
+        match self {
+            Leader::Axis(_) => None,
+            Leader::Encoder(e) => Some(e),
+        }
+    }
+
+    /// Whether the leader is an external encoder (which leads by its value only, never by
+    /// setpoint or actual value).
+    pub fn is_encoder(self) -> bool {
+        matches!(self, Leader::Encoder(_))
+    }
+}
+
+impl Index<AxisIndex> for Vec<AxisEntry> {
+    type Output = AxisEntry;
+    fn index(&self, i: AxisIndex) -> &AxisEntry {
+        &self[i.0]
+    }
+}
+
+impl Index<AxisIndex> for [AxisEntry] {
+    type Output = AxisEntry;
+    fn index(&self, i: AxisIndex) -> &AxisEntry {
+        &self[i.0]
+    }
+}
+
+impl Index<EncoderIndex> for Vec<EncoderEntry> {
+    type Output = EncoderEntry;
+    fn index(&self, i: EncoderIndex) -> &EncoderEntry {
+        &self[i.0]
+    }
+}
+
+impl Index<EncoderIndex> for [EncoderEntry] {
+    type Output = EncoderEntry;
+    fn index(&self, i: EncoderIndex) -> &EncoderEntry {
+        &self[i.0]
+    }
+}
+
+/// A node of the cell: one process with one servo cycle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    /// Name.
+    pub name: String,
+    /// Servo cycle (ns).
+    pub cycle_ns: i64,
+    /// Index into [`Cell::hosts`].
+    pub host: usize,
+    /// Scheduling of the cyclic thread.
+    pub realtime: Realtime,
+}
+
+/// Scheduling of a node's cyclic thread (`[nodes.realtime]`).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct Realtime {
+    /// SCHED_FIFO priority 1..=99; `None`: normal scheduling.
+    pub priority: Option<u8>,
+    /// CPU the cyclic thread is pinned to.
+    pub cpu: Option<usize>,
+    /// Lock the process' memory.
+    pub lock_memory: bool,
+}
+
+/// How followers receive a leader's values (`[axes.<name>.leading_value]`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct LeadingValueConfig {
+    /// Leading-value delay D (ns): every follower evaluates the leader at `t - D`.
+    pub delay_ns: i64,
+    /// How long a late sample is bridged by extrapolation (ns).
+    pub tolerance_ns: i64,
+}
+
+/// How a follower reads a leader.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Coupling {
+    /// The leader's setpoint.
+    Setpoint,
+    /// The leader's actual value, filtered and extrapolated.
+    Actual,
+}
+
+/// An axis of the cell, with the node that hosts it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisEntry {
+    /// Name (unique in the cell).
+    pub name: String,
+    /// Index into [`Cell::nodes`].
+    pub node: usize,
+    /// Engine configuration.
+    pub config: AxisConfig,
+    /// The leaders it may follow and how; `None`: any of its node, by setpoint.
+    pub leaders: Option<Vec<(Leader, Coupling)>>,
+    /// Its leading-value delay and tolerance, as a leader.
+    pub leading: LeadingValueConfig,
+}
+
+impl AxisEntry {
+    /// How this axis reads leader `leader`, or `None` if it may not follow it.
+    pub fn coupling(&self, leader: Leader) -> Option<Coupling> {
+        match &self.leaders {
+            None => Some(Coupling::Setpoint),
+            Some(list) => list.iter().find(|(i, _)| *i == leader).map(|(_, c)| *c),
+        }
+    }
+}
+
+/// Where a simulated external encoder gets its position from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EncoderSource {
+    /// The actual position of an axis times `scale`.
+    Axis {
+        /// The measured axis.
+        axis: AxisIndex,
+        /// Encoder units per axis unit.
+        scale: f64,
+    },
+    /// A velocity profile: `(t s, v)` points, linear in between, constant after the last.
+    Profile(Vec<(f64, f64)>),
+}
+
+impl EncoderSource {
+    /// Position and velocity of a profile source at `t` (s), from 0 at t = 0.
+    pub fn profile_at(points: &[(f64, f64)], t: f64) -> (f64, f64) {
+        let mut p = 0.0;
+        let mut prev = (0.0, points.first().map(|x| x.1).unwrap_or(0.0));
+        for &(ti, vi) in points {
+            if t <= ti {
+                let span = ti - prev.0;
+                let f = if span > 0.0 { (t - prev.0) / span } else { 1.0 };
+                let v = prev.1 + (vi - prev.1) * f;
+                return (p + 0.5 * (prev.1 + v) * (t - prev.0), v);
+            }
+            p += 0.5 * (prev.1 + vi) * (ti - prev.0);
+            prev = (ti, vi);
+        }
+        (p + prev.1 * (t - prev.0), prev.1)
+    }
+}
+
+/// An external encoder of the cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EncoderEntry {
+    /// Name (unique among axes and encoders).
+    pub name: String,
+    /// Index into [`Cell::nodes`].
+    pub node: usize,
+    /// Engine configuration.
+    pub config: tandem_motion::encoder::EncoderConfig,
+    /// Simulated source.
+    pub source: EncoderSource,
+    /// Its leading-value delay and tolerance, as a leader.
+    pub leading: LeadingValueConfig,
+}
+
+/// A cam of the cell, interpolated.
+#[derive(Clone, Debug)]
+pub struct CamEntry {
+    /// Name.
+    pub name: String,
+    /// The interpolated cam, shared by every job that uses it.
+    pub cam: std::sync::Arc<tandem_motion::cam::Cam>,
+    /// Its definition (for MC_InterpolateCam at run time).
+    pub definition: tandem_motion::cam::CamDefinition,
+}
+
+impl PartialEq for CamEntry {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && std::sync::Arc::ptr_eq(&self.cam, &other.cam)
+    }
+}
+
+/// An output cam of the cell (`[[output_cams]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputCamEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose motion it follows.
+    pub axis: AxisIndex,
+    /// Engine configuration.
+    pub config: tandem_motion::output_cam::OutputCamConfig,
+}
+
+/// A cam track of the cell (`[[cam_tracks]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CamTrackEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose motion it follows.
+    pub axis: AxisIndex,
+    /// Engine configuration.
+    pub config: tandem_motion::cam_track::CamTrackConfig,
+    /// Track data (reference, length, cams).
+    pub data: tandem_motion::cam_track::CamTrackData,
+}
+
+/// A simulated mark sensor on a measuring input.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SensorEntry {
+    /// The axis that carries the mark.
+    pub axis: AxisIndex,
+    /// Mark start.
+    pub position: f64,
+    /// Mark width.
+    pub width: f64,
+    /// Dead time (s).
+    pub dead_time: f64,
+    /// Jitter (ns, uniform in ±).
+    pub jitter_ns: i64,
+    /// Seed of the jitter.
+    pub seed: u64,
+    /// Direction that produces edges.
+    pub direction: tandem_motion::measuring::SensorDirection,
+}
+
+impl SensorEntry {
+    /// The engine's simulated sensor.
+    pub fn sensor(&self) -> tandem_motion::measuring::SimulatedSensor {
+        tandem_motion::measuring::SimulatedSensor::new(
+            self.position,
+            self.width,
+            self.dead_time,
+            self.jitter_ns,
+            self.seed,
+            self.direction,
+        )
+    }
+}
+
+/// A measuring input of the cell (`[[measuring_inputs]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeasuringInputEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose motion it follows.
+    pub axis: AxisIndex,
+    /// Engine configuration.
+    pub config: tandem_motion::measuring::MeasuringInputConfig,
+    /// Optional simulated sensor producing the input's edges.
+    pub sensor: Option<SensorEntry>,
+    /// Optional register correction.
+    pub registration: Option<Registration>,
+}
+
+/// Register correction of a measuring input: each new `MeasuredValue1` of a cyclic job moves
+/// `axis` by `gain * (target - measured)`, reduced to ±half the measured axis' modulo length,
+/// with `MC_MoveSuperimposed`.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Registration {
+    /// The corrected axis.
+    pub axis: AxisIndex,
+    /// The register target.
+    pub target: f64,
+    /// Share of the error corrected per mark.
+    pub gain: f64,
+}
+
+/// A validated cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cell {
+    /// Cell name.
+    pub name: String,
+    /// Base tick (ns).
+    pub base_tick_ns: i64,
+    /// Time budget of a leading value between two nodes of one host (ns).
+    pub ipc_budget_ns: i64,
+    /// Time budget of a leading value between nodes of different hosts (ns).
+    pub network_budget_ns: i64,
+    /// Host names (`local` when the file has no `[[hosts]]`).
+    pub hosts: Vec<String>,
+    /// Per host: the Zenoh endpoints its gateway listens on.
+    pub host_listen: Vec<Vec<String>>,
+    /// Telemetry rate of the gateways (Hz).
+    pub telemetry_hz: f64,
+    /// Clock-offset warning threshold, as a share of the smallest cross-host delay.
+    pub clock_warning_fraction: f64,
+    /// Nodes.
+    pub nodes: Vec<Node>,
+    /// Axes, in name order.
+    pub axes: Vec<AxisEntry>,
+    /// External encoders, in name order.
+    pub encoders: Vec<EncoderEntry>,
+    /// Cams, in name order (a cam's id is its index here).
+    pub cams: Vec<CamEntry>,
+    /// Output cams, in file order.
+    pub output_cams: Vec<OutputCamEntry>,
+    /// Cam tracks, in file order.
+    pub cam_tracks: Vec<CamTrackEntry>,
+    /// Measuring inputs, in file order.
+    pub measuring_inputs: Vec<MeasuringInputEntry>,
+}
+
+impl Cell {
+    /// The axis `i`, if the cell has it.
+    pub fn axis(&self, i: AxisIndex) -> Option<&AxisEntry> {
+        self.axes.get(i.0)
+    }
+
+    /// The encoder `k`, if the cell has it.
+    pub fn encoder(&self, k: EncoderIndex) -> Option<&EncoderEntry> {
+        self.encoders.get(k.0)
+    }
+
+    /// Every axis of the cell, in order.
+    pub fn axis_indices(&self) -> impl Iterator<Item = AxisIndex> {
+        (0..self.axes.len()).map(AxisIndex)
+    }
+
+    /// Every leader of the cell: the axes, then the encoders.
+    pub fn leaders(&self) -> impl Iterator<Item = Leader> {
+        (0..self.axes.len())
+            .map(|i| Leader::Axis(AxisIndex(i)))
+            .chain((0..self.encoders.len()).map(|k| Leader::Encoder(EncoderIndex(k))))
+    }
+
+    /// The id of `leader` in commands and on the wire: axes count first, then encoders (its
+    /// index in [`Cell::object_names`]).
+    pub fn leader_id(&self, leader: Leader) -> LeaderId {
+        let flat = match leader {
+            Leader::Axis(a) => a.0,
+            Leader::Encoder(e) => self.axes.len() + e.0,
+        };
+        LeaderId::try_from(flat).unwrap_or(LeaderId::MAX)
+    }
+
+    /// The leader with id `id` (see [`Cell::leader_id`]), if the cell has it.
+    pub fn leader(&self, id: LeaderId) -> Option<Leader> {
+        let i = usize::try_from(id).ok()?;
+        if i < self.axes.len() {
+            Some(Leader::Axis(AxisIndex(i)))
+        } else {
+            let k = i - self.axes.len();
+            (k < self.encoders.len()).then_some(Leader::Encoder(EncoderIndex(k)))
+        }
+    }
+
+    /// The leader named `name` (an axis or an encoder).
+    pub fn leader_named(&self, name: &str) -> Option<Leader> {
+        match self.axes.iter().position(|a| a.name == name) {
+            Some(i) => Some(Leader::Axis(AxisIndex(i))),
+            None => self
+                .encoders
+                .iter()
+                .position(|e| e.name == name)
+                .map(|k| Leader::Encoder(EncoderIndex(k))),
+        }
+    }
+
+    /// The name of `leader` (`?` if the cell does not have it).
+    pub fn leader_name(&self, leader: Leader) -> &str {
+        match leader {
+            Leader::Axis(a) => self.axis(a).map(|x| x.name.as_str()),
+            Leader::Encoder(e) => self.encoder(e).map(|x| x.name.as_str()),
+        }
+        .unwrap_or("?")
+    }
+
+    /// The leading-value delay and tolerance of `leader` (none if the cell does not have it).
+    pub fn leading(&self, leader: Leader) -> LeadingValueConfig {
+        match leader {
+            Leader::Axis(a) => self.axis(a).map(|x| x.leading),
+            Leader::Encoder(e) => self.encoder(e).map(|x| x.leading),
+        }
+        .unwrap_or(LeadingValueConfig {
+            delay_ns: 0,
+            tolerance_ns: 0,
+        })
+    }
+
+    /// How axis `follower` reads `leader`, or `None` if it may not follow it. Without a
+    /// `leaders` table an axis may follow any leader of its own node, by setpoint.
+    pub fn coupling(&self, follower: AxisIndex, leader: Leader) -> Option<Coupling> {
+        let f = self.axis(follower)?;
+        match &f.leaders {
+            Some(_) => f.coupling(leader),
+            None => (self.leader_node(leader)? == f.node).then_some(Coupling::Setpoint),
+        }
+    }
+
+    /// The node that hosts `leader`.
+    pub fn leader_node(&self, leader: Leader) -> Option<usize> {
+        match leader {
+            Leader::Axis(a) => self.axis(a).map(|x| x.node),
+            Leader::Encoder(e) => self.encoder(e).map(|x| x.node),
+        }
+    }
+
+    /// The leaders of other nodes that followers on `node` may follow (sorted, unique).
+    pub fn remote_leaders(&self, node: usize) -> Vec<Leader> {
+        let mut out: Vec<Leader> = self
+            .axes
+            .iter()
+            .filter(|a| a.node == node)
+            .flat_map(|a| a.leaders.iter().flatten().map(|(l, _)| *l))
+            .filter(|l| self.leader_node(*l) != Some(node))
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The leaders on `node` that followers on other nodes may follow (sorted, unique).
+    pub fn published_leaders(&self, node: usize) -> Vec<Leader> {
+        let mut out: Vec<Leader> = (0..self.nodes.len())
+            .filter(|n| *n != node)
+            .flat_map(|n| self.remote_leaders(n))
+            .filter(|l| self.leader_node(*l) == Some(node))
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The samples of `leader` its iceoryx2 service keeps for late joiners and each
+    /// subscriber buffers: the delay plus the tolerance in leader cycles, plus four.
+    pub fn leading_history(&self, leader: Leader) -> usize {
+        let Some(node) = self.leader_node(leader) else {
+            return 4;
+        };
+        let lv = self.leading(leader);
+        let cycle = self.nodes.get(node).map_or(1_000_000, |n| n.cycle_ns);
+        (((lv.delay_ns + lv.tolerance_ns) / cycle.max(1)) as usize + 4).min(LEADING_BUFFER)
+    }
+
+    /// The cycle (ns) of the node that hosts `leader` (0 if the cell does not have it).
+    pub fn leader_cycle_ns(&self, leader: Leader) -> i64 {
+        self.leader_node(leader)
+            .and_then(|n| self.nodes.get(n))
+            .map_or(0, |n| n.cycle_ns)
+    }
+
+    /// The index of the node named `name`.
+    pub fn node(&self, name: &str) -> Option<usize> {
+        self.nodes.iter().position(|n| n.name == name)
+    }
+
+    /// The names of all technology objects that can be addressed or lead: axes, then encoders
+    /// (a leader's id is its index here, see [`Cell::leader_id`]).
+    pub fn object_names(&self) -> Vec<&str> {
+        self.axes
+            .iter()
+            .map(|a| a.name.as_str())
+            .chain(self.encoders.iter().map(|e| e.name.as_str()))
+            .collect()
+    }
+
+    /// The index of the output cam named `name`.
+    pub fn output_cam(&self, name: &str) -> Option<usize> {
+        self.output_cams.iter().position(|c| c.name == name)
+    }
+
+    /// The index of the cam track named `name`.
+    pub fn cam_track(&self, name: &str) -> Option<usize> {
+        self.cam_tracks.iter().position(|c| c.name == name)
+    }
+
+    /// The index of the measuring input named `name`.
+    pub fn measuring_input(&self, name: &str) -> Option<usize> {
+        self.measuring_inputs.iter().position(|c| c.name == name)
+    }
+
+    /// The axis of the output cam, cam track or measuring input named `name`.
+    pub fn object_axis(&self, name: &str) -> Option<AxisIndex> {
+        self.output_cam(name)
+            .map(|i| self.output_cams[i].axis)
+            .or_else(|| self.cam_track(name).map(|i| self.cam_tracks[i].axis))
+            .or_else(|| {
+                self.measuring_input(name)
+                    .map(|i| self.measuring_inputs[i].axis)
+            })
+    }
+}

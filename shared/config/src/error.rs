@@ -1,0 +1,315 @@
+//! The one error type of the configuration: [`ConfigError`] says where (file, line, key) and
+//! [`Problem`] what is wrong, with the data of each kind of problem.
+
+use crate::command::CommandError;
+use core::fmt;
+use tandem_motion::cam::{CamError, CamParseError};
+
+/// A problem in a configuration file (a cell file or a script), located.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ConfigError {
+    /// File (as given).
+    pub file: String,
+    /// 1-based line, when known.
+    pub line: Option<usize>,
+    /// Dotted key path, when known.
+    pub key: String,
+    /// What is wrong.
+    pub problem: Box<Problem>,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: ", self.file, l)?,
+            None => write!(f, "{}: ", self.file)?,
+        }
+        if self.key.is_empty() {
+            write!(f, "{}", self.problem)
+        } else {
+            write!(f, "{}: {}", self.key, self.problem)
+        }
+    }
+}
+
+impl std::error::Error for ConfigError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &*self.problem {
+            Problem::Command(c) => Some(c),
+            _ => None,
+        }
+    }
+}
+
+/// What is wrong in a configuration file: one variant per kind of problem, with its data.
+/// `Display` gives the message the tools print after the file, line and key.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Problem {
+    /// The file cannot be read (the operating system's reason).
+    Unreadable(String),
+    /// TOML syntax or schema (an unknown field, a wrong type), as the TOML parser says it.
+    Syntax(String),
+    /// A value outside what the key accepts; the text says what it must be.
+    Invalid(&'static str),
+    /// A name that must be one of a fixed list.
+    NotOneOf {
+        /// The value given.
+        value: String,
+        /// The accepted names.
+        options: Vec<&'static str>,
+    },
+    /// A name that refers to no object of its kind.
+    Unknown {
+        /// The kind of object (`host`, `axis`, `leader`).
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The names the cell has, when the message lists them.
+        known: Option<Vec<String>>,
+    },
+    /// A node that names no node of `[[nodes]]`.
+    UnknownNode(String),
+    /// A host name defined twice, empty or not plain.
+    BadHostName(String),
+    /// A node name that is not a plain name.
+    BadNodeName(String),
+    /// A node without `host` in a cell of several hosts.
+    HostRequired(String),
+    /// A SCHED_FIFO priority outside 1..=99.
+    Priority(u8),
+    /// A node cycle that is not a positive multiple of the base tick.
+    Cycle {
+        /// The node.
+        node: String,
+        /// Its cycle (µs).
+        cycle_us: u64,
+        /// The base tick (µs).
+        base_us: u64,
+    },
+    /// A node defined twice.
+    DuplicateNode(String),
+    /// An encoder with the name of an axis.
+    AlsoAnAxis(String),
+    /// An object name that is empty or already used.
+    NameTaken(String),
+    /// An axis that names itself as its leader.
+    SelfLeader,
+    /// A leader named `node/leader` that is hosted by another node.
+    LeaderNode {
+        /// The leader.
+        leader: String,
+        /// The node that hosts it.
+        hosted: String,
+        /// The node the key names.
+        named: String,
+    },
+    /// A leading-value delay plus tolerance that does not fit the leader's buffer.
+    LeadingBuffer {
+        /// The cycles they span.
+        cycles: i64,
+        /// The leader's node.
+        node: String,
+        /// The most cycles that fit.
+        max: usize,
+    },
+    /// A leading-value delay shorter than the link to a follower needs.
+    DelayTooShort(DelayShortfall),
+    /// A cam points file that cannot be read.
+    CamFile {
+        /// The path as resolved.
+        path: String,
+        /// The operating system's reason.
+        error: String,
+    },
+    /// A cam points file with a bad line.
+    CamCsv {
+        /// The path as resolved.
+        path: String,
+        /// The bad line.
+        error: CamParseError,
+    },
+    /// A cam segment that is not well defined.
+    Segment {
+        /// The segment (0-based, as in the file).
+        index: usize,
+        /// What is wrong with it.
+        problem: SegmentProblem,
+    },
+    /// A cam that cannot be interpolated.
+    Interpolation(CamError),
+    /// A cam track with more cams than it holds.
+    TooManyCams(usize),
+    /// A cam of a cam track that is not well defined.
+    TrackCam {
+        /// The cam (1-based).
+        cam: usize,
+        /// What is wrong.
+        problem: &'static str,
+    },
+    /// A sensor on an axis of another node than its measuring input's.
+    SensorNode {
+        /// The sensor's axis.
+        sensor_axis: String,
+        /// The measuring input's axis.
+        axis: String,
+    },
+    /// An object refused by the engine.
+    Rejected {
+        /// The kind of object (`cam track`, `measuring input`).
+        object: &'static str,
+        /// The engine's reason.
+        reason: tandem_motion::measuring::ConfigError,
+    },
+    /// A script instruction or its parameters.
+    Command(CommandError),
+}
+
+/// A leading-value delay shorter than the link from a leader to a follower on another node
+/// needs: the leader's cycle, the link budget and the follower's cycle.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DelayShortfall {
+    /// The configured delay (µs).
+    pub delay_us: i64,
+    /// The follower.
+    pub follower: String,
+    /// The follower's node.
+    pub node: String,
+    /// The delay needed (µs).
+    pub need_us: i64,
+    /// The leader's cycle (µs).
+    pub leader_cycle_us: i64,
+    /// The budget key of the link (`ipc_budget_us` or `network_budget_us`).
+    pub budget: &'static str,
+    /// The link budget (µs).
+    pub link_us: i64,
+    /// The follower's cycle (µs).
+    pub follower_cycle_us: i64,
+}
+
+/// What is wrong with a cam segment.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SegmentProblem {
+    /// A `law` segment without `law`.
+    LawRequired,
+    /// A law name or parameter the engine does not know.
+    UnknownLaw(String),
+    /// A `law` segment without `y`.
+    YRequired,
+    /// A `polynomial` segment without 1 to 8 coefficients.
+    CoeffsRequired,
+    /// An `s7_polynomial` segment with more than 7 coefficients.
+    TooManyCoefficients,
+    /// A segment type that does not exist.
+    UnknownType(String),
+}
+
+impl From<CommandError> for Problem {
+    fn from(c: CommandError) -> Self {
+        Problem::Command(c)
+    }
+}
+
+impl fmt::Display for SegmentProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SegmentProblem::LawRequired => f.write_str("`law` is required"),
+            SegmentProblem::UnknownLaw(n) => write!(f, "unknown law `{n}` or bad parameter"),
+            SegmentProblem::YRequired => f.write_str("`y = [y0, y1]` is required"),
+            SegmentProblem::CoeffsRequired => f.write_str("`coeffs` (1 to 8 numbers) is required"),
+            SegmentProblem::TooManyCoefficients => f.write_str("`a` has at most 7 coefficients"),
+            SegmentProblem::UnknownType(t) => {
+                write!(f, "type `{t}` is not one of law, polynomial, s7_polynomial")
+            }
+        }
+    }
+}
+
+impl fmt::Display for DelayShortfall {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "leading-value delay {} µs is shorter than the link to follower `{}` on node `{}` needs: {} µs (leader cycle {} + {} {} + follower cycle {})",
+            self.delay_us,
+            self.follower,
+            self.node,
+            self.need_us,
+            self.leader_cycle_us,
+            self.budget,
+            self.link_us,
+            self.follower_cycle_us,
+        )
+    }
+}
+
+impl std::error::Error for Problem {}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Problem::Unreadable(e) => write!(f, "cannot read: {e}"),
+            Problem::Syntax(m) => f.write_str(m),
+            Problem::Invalid(m) => f.write_str(m),
+            Problem::NotOneOf { value, options } => {
+                write!(f, "`{value}` is not one of {}", options.join(", "))
+            }
+            Problem::Unknown { what, name, known } => {
+                write!(f, "unknown {what} `{name}`")?;
+                match known {
+                    Some(k) => write!(f, "; the cell has: {}", k.join(", ")),
+                    None => Ok(()),
+                }
+            }
+            Problem::UnknownNode(n) => write!(f, "unknown node `{n}` (define it in [[nodes]])"),
+            Problem::BadHostName(h) => {
+                write!(f, "host `{h}` is defined twice, empty or contains `/`")
+            }
+            Problem::BadNodeName(n) => write!(
+                f,
+                "`{n}`: a node name is a plain name (letters, digits, `_`, `-`; it names services and keys)"
+            ),
+            Problem::HostRequired(n) => write!(
+                f,
+                "node `{n}` needs `host = ...`: the cell has several hosts"
+            ),
+            Problem::Priority(p) => write!(f, "priority = {p}: SCHED_FIFO priorities are 1 to 99"),
+            Problem::Cycle {
+                node,
+                cycle_us,
+                base_us,
+            } => write!(
+                f,
+                "node `{node}`: cycle_us = {cycle_us} is not a positive multiple of the base tick ({base_us} µs)"
+            ),
+            Problem::DuplicateNode(n) => write!(f, "node `{n}` is defined twice"),
+            Problem::AlsoAnAxis(n) => write!(f, "`{n}` is also an axis: names must be unique"),
+            Problem::NameTaken(n) => write!(
+                f,
+                "`{n}` is empty or already used: names must be unique"
+            ),
+            Problem::SelfLeader => f.write_str("an axis cannot lead itself"),
+            Problem::LeaderNode {
+                leader,
+                hosted,
+                named,
+            } => write!(f, "`{leader}` is on node `{hosted}`, not `{named}`"),
+            Problem::LeadingBuffer { cycles, node, max } => write!(
+                f,
+                "delay plus tolerance span {cycles} cycles of node `{node}`; at most {max} fit the buffer"
+            ),
+            Problem::DelayTooShort(d) => fmt::Display::fmt(d, f),
+            Problem::CamFile { path, error } => write!(f, "cannot read {path}: {error}"),
+            Problem::CamCsv { path, error } => write!(f, "{path}: {error}"),
+            Problem::Segment { index, problem } => write!(f, "segment {index}: {problem}"),
+            Problem::Interpolation(e) => {
+                write!(f, "cannot interpolate: {e:?} ({})", e.error_id())
+            }
+            Problem::TooManyCams(n) => write!(f, "at most {n} cams"),
+            Problem::TrackCam { cam, problem } => write!(f, "cam {cam}: {problem}"),
+            Problem::SensorNode { sensor_axis, axis } => {
+                write!(f, "`{sensor_axis}` must be on the node of `{axis}`")
+            }
+            Problem::Rejected { object, reason } => write!(f, "rejected by the {object}: {reason}"),
+            Problem::Command(c) => fmt::Display::fmt(c, f),
+        }
+    }
+}

@@ -1,0 +1,86 @@
+//! The runtime's errors: a configuration the engine refuses ([`ExecError`]) and a failed
+//! simulation ([`SimError`]).
+
+use std::fmt;
+use std::io;
+use tandem_motion::error_id::ErrorId;
+
+/// A technology object whose configuration the engine refuses, when an
+/// [`Executive`](crate::exec::Executive) is created: which object, and the engine's reason.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExecError {
+    /// An axis.
+    Axis {
+        /// Its name.
+        name: String,
+        /// The engine's reason.
+        reason: tandem_motion::axis::ConfigError,
+    },
+    /// An external encoder.
+    Encoder {
+        /// Its name.
+        name: String,
+        /// The ErrorID that refused it.
+        reason: ErrorId,
+    },
+    /// An output cam, cam track or measuring input.
+    Object {
+        /// The kind of object (`output cam`, `cam track`, `measuring input`).
+        kind: &'static str,
+        /// Its name.
+        name: String,
+        /// The engine's reason.
+        reason: tandem_motion::measuring::ConfigError,
+    },
+}
+
+impl fmt::Display for ExecError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ExecError::Axis { name, reason } => write!(f, "axis {name}: {reason}"),
+            ExecError::Encoder { name, reason } => write!(f, "encoder {name}: {reason}"),
+            ExecError::Object { kind, name, reason } => write!(f, "{kind} {name}: {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for ExecError {}
+
+/// Why a simulation stopped: the cell was refused, or the trace or log could not be written.
+#[derive(Debug)]
+pub enum SimError {
+    /// The engine refused the cell's configuration.
+    Exec(ExecError),
+    /// Writing the trace or the log failed.
+    Io(io::Error),
+}
+
+impl fmt::Display for SimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SimError::Exec(e) => fmt::Display::fmt(e, f),
+            SimError::Io(e) => fmt::Display::fmt(e, f),
+        }
+    }
+}
+
+impl std::error::Error for SimError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            SimError::Exec(e) => Some(e),
+            SimError::Io(e) => Some(e),
+        }
+    }
+}
+
+impl From<io::Error> for SimError {
+    fn from(e: io::Error) -> Self {
+        SimError::Io(e)
+    }
+}
+
+impl From<ExecError> for SimError {
+    fn from(e: ExecError) -> Self {
+        SimError::Exec(e)
+    }
+}
