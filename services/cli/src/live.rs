@@ -8,7 +8,7 @@ use std::process::{Child, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use tandem_config::Cell;
-use tandem_motion::error_id::ErrorId;
+use tandem_motion::catalog::error_id::ErrorId;
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::wire::{
     AxisTelemetry, CommandRequest, Event, NodeHealth, Text, EVENT_JOB, EVENT_LOG, JOB_ABORTED,

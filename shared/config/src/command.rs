@@ -4,12 +4,12 @@
 //! references' input names in snake case (`position`, `velocity`, `abort_acceleration`...).
 //! Defaults are the references' defaults (dynamics -1.0 = the axis defaults).
 
-use tandem_motion::axis::{
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::axis::{
     ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
     SyncProfileReference, VelocityDirection,
 };
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::leading::LeaderId;
+use tandem_motion::objects::leading::LeaderId;
 
 /// A parameter value.
 #[derive(Copy, Clone, Debug, PartialEq)]

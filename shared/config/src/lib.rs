@@ -9,15 +9,15 @@ pub mod script;
 
 use schema::{AxisSection, CellFile};
 use std::path::Path;
-use tandem_motion::alarm::Reaction;
-use tandem_motion::axis::{
+use tandem_motion::catalog::alarm::Reaction;
+use tandem_motion::kinematics::dynamics::{DynamicDefaults, DynamicLimits};
+use tandem_motion::kinematics::extrapolation::{ExtrapolationConfig, VelocityMode};
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{
     AxisConfig, AxisKind, EncoderType, FollowingErrorMonitoring, HomingConfig, HomingMark,
     MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
 };
-use tandem_motion::drive::{DriveModel, Plant, ZeroMark};
-use tandem_motion::dynamics::{DynamicDefaults, DynamicLimits};
-use tandem_motion::extrapolation::{ExtrapolationConfig, VelocityMode};
-use tandem_motion::modulo::Modulo;
+use tandem_motion::plant::drive::{DriveModel, Plant, ZeroMark};
 
 /// A problem in a configuration file, located.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -154,7 +154,7 @@ pub struct EncoderEntry {
     /// Index into [`Cell::nodes`].
     pub node: usize,
     /// Engine configuration.
-    pub config: tandem_motion::encoder::EncoderConfig,
+    pub config: tandem_motion::objects::encoder::EncoderConfig,
     /// Simulated source.
     pub source: EncoderSource,
 }
@@ -184,7 +184,7 @@ pub struct OutputCamEntry {
     /// Index into [`Cell::axes`].
     pub axis: usize,
     /// Engine configuration.
-    pub config: tandem_motion::output_cam::OutputCamConfig,
+    pub config: tandem_motion::objects::output_cam::OutputCamConfig,
 }
 
 /// A cam track of the cell (`[[cam_tracks]]`).
@@ -195,9 +195,9 @@ pub struct CamTrackEntry {
     /// Index into [`Cell::axes`].
     pub axis: usize,
     /// Engine configuration.
-    pub config: tandem_motion::cam_track::CamTrackConfig,
+    pub config: tandem_motion::objects::cam_track::CamTrackConfig,
     /// Track data (reference, length, cams).
-    pub data: tandem_motion::cam_track::CamTrackData,
+    pub data: tandem_motion::objects::cam_track::CamTrackData,
 }
 
 /// A simulated mark sensor on a measuring input.
@@ -216,13 +216,13 @@ pub struct SensorEntry {
     /// Seed of the jitter.
     pub seed: u64,
     /// Direction that produces edges.
-    pub direction: tandem_motion::measuring::SensorDirection,
+    pub direction: tandem_motion::plant::sensor::SensorDirection,
 }
 
 impl SensorEntry {
     /// The engine's simulated sensor.
-    pub fn sensor(&self) -> tandem_motion::measuring::SimulatedSensor {
-        tandem_motion::measuring::SimulatedSensor::new(
+    pub fn sensor(&self) -> tandem_motion::plant::sensor::SimulatedSensor {
+        tandem_motion::plant::sensor::SimulatedSensor::new(
             self.position,
             self.width,
             self.dead_time,
@@ -241,7 +241,7 @@ pub struct MeasuringInputEntry {
     /// Index into [`Cell::axes`].
     pub axis: usize,
     /// Engine configuration.
-    pub config: tandem_motion::measuring::MeasuringInputConfig,
+    pub config: tandem_motion::objects::measuring::MeasuringInputConfig,
     /// Optional simulated sensor producing the input's edges.
     pub sensor: Option<SensorEntry>,
     /// Optional register correction.
@@ -735,7 +735,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
             }
         };
         let x = &e.extrapolation;
-        let config = tandem_motion::encoder::EncoderConfig {
+        let config = tandem_motion::objects::encoder::EncoderConfig {
             cycle: nodes[node].cycle_ns as f64 * 1e-9,
             modulo: e.modulo.as_ref().map(|m| Modulo {
                 start: m.start,
@@ -936,8 +936,8 @@ type Objects = (
     Vec<MeasuringInputEntry>,
 );
 
-fn position_type(v: &str) -> Result<tandem_motion::output_cam::PositionType, FieldError> {
-    use tandem_motion::output_cam::PositionType;
+fn position_type(v: &str) -> Result<tandem_motion::objects::output_cam::PositionType, FieldError> {
+    use tandem_motion::objects::output_cam::PositionType;
     pick(
         "position",
         v,
@@ -963,7 +963,7 @@ fn parameters(
     on: f64,
     off: f64,
     h: f64,
-) -> Result<tandem_motion::output_cam::OutputCamParameters, FieldError> {
+) -> Result<tandem_motion::objects::output_cam::OutputCamParameters, FieldError> {
     if !(0.0..=1e9).contains(&on) {
         return Err(("on_compensation", "must be 0..1e9 seconds".into()));
     }
@@ -973,7 +973,7 @@ fn parameters(
     if !(0.0..=1e12).contains(&h) {
         return Err(("hysteresis", "must be 0..1e12".into()));
     }
-    Ok(tandem_motion::output_cam::OutputCamParameters {
+    Ok(tandem_motion::objects::output_cam::OutputCamParameters {
         on_compensation: on,
         off_compensation: off,
         hysteresis: h,
@@ -988,11 +988,12 @@ fn objects(
     axes: &[AxisEntry],
     nodes: &[Node],
 ) -> Result<Objects, ConfigError> {
-    use tandem_motion::cam_track::{
+    use tandem_motion::objects::cam_track::{
         CamTrackConfig, CamTrackData, CamTrackType, TrackCam, TrackOutputInterface, MAX_CAMS,
     };
-    use tandem_motion::measuring::{MeasuringInputConfig, MeasuringRoute, SensorDirection};
-    use tandem_motion::output_cam::{OutputCamConfig, OutputCamType};
+    use tandem_motion::objects::measuring::{MeasuringInputConfig, MeasuringRoute};
+    use tandem_motion::objects::output_cam::{OutputCamConfig, OutputCamType};
+    use tandem_motion::plant::sensor::SensorDirection;
     let err = |array: &str, i: usize, key: &str, message: String| ConfigError {
         file: file.into(),
         line: locate_in_array(src, array, i, key),
@@ -1133,7 +1134,7 @@ fn objects(
             };
             data = data.with_cam(j, tc);
         }
-        if let Err(e) = tandem_motion::cam_track::CamTrack::new(config, data) {
+        if let Err(e) = tandem_motion::objects::cam_track::CamTrack::new(config, data) {
             return Err(err(a, i, "", format!("rejected by the cam track: {e}")));
         }
         cam_tracks.push(CamTrackEntry {
@@ -1257,7 +1258,7 @@ fn objects(
                 })
             }
         };
-        if let Err(e) = tandem_motion::measuring::MeasuringInput::new(config) {
+        if let Err(e) = tandem_motion::objects::measuring::MeasuringInput::new(config) {
             return Err(err(
                 a,
                 i,
@@ -1642,7 +1643,7 @@ emergency_deceleration = 2000.0
         assert_eq!(c.output_cams.len(), 1);
         assert_eq!(
             c.output_cams[0].config.cam_type,
-            tandem_motion::output_cam::OutputCamType::Time
+            tandem_motion::objects::output_cam::OutputCamType::Time
         );
         assert_eq!(c.cam_tracks[0].data.cams[0].off_position, 20.0);
         assert!(!c.cam_tracks[0].data.cams[1].existent);
