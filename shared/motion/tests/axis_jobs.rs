@@ -406,8 +406,8 @@ fn jog_runs_while_held_and_both_inputs_are_an_error() {
 
 #[test]
 fn superimposed_adds_to_a_positioning_move() {
-    // S7-1500T Motion Control V4.0 function manual, chapter 10 'Instructions': MoveRelative 50 plus
-    // superimposed 50 gives 100 in total.
+    // S7-1500T Motion Control V4.0 function manual, 10.9.1 'MC_MoveSuperimposed: Position axes
+    // overlapping V4': MoveRelative 50 plus superimposed 50 gives 100 in total.
     let mut r = Rig::enabled(AxisConfig::example(0.001));
     let m = r
         .cmd(Command::MoveRelative {

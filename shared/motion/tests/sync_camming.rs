@@ -1,7 +1,7 @@
 //! Camming: MC_CamIn with offsets, scalings, application modes, the three synchronization
 //! references, MC_CamOut and the change to a pending cam at the end of a cycle (S7-1500T Motion
-//! Control V4.0 function manual, 3.5 'Synchronous axis technology object', chapter 10
-//! 'Instructions'). Exact synchronism: once InSync the follower equals the cam function of the
+//! Control V4.0 function manual, 3.5.7 'Camming' and 10.12.5
+//! 'MC_CamIn V4'). Exact synchronism: once InSync the follower equals the cam function of the
 //! leading value in every cycle.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 

@@ -1,6 +1,7 @@
 //! Synchronous operation: MC_GearIn, MC_GearInPos, MC_GearOut, phasing (S7-1500T Motion Control
-//! V4.0 function manual, 3.5 'Synchronous axis technology object', chapter 10 'Instructions', table
-//! 2). A leader and a follower in one process, the leader stepped first (D = 0).
+//! V4.0 function manual, 3.5 'Synchronous axis technology object', 10.12 'Synchronous motion',
+//! 10.16.2 'Override response V4: Synchronous operation jobs'). A leader and a follower in one
+//! process, the leader stepped first (D = 0).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use proptest::prelude::*;
@@ -563,8 +564,8 @@ fn velocity_gearing_ignores_a_leader_position_jump_and_offsets_shift_the_followe
 
 #[test]
 fn superimposed_on_the_leader_moves_its_followers_and_exceedances_are_flagged() {
-    // S7-1500T Motion Control V4.0 function manual, chapter 10 'Instructions' MC_MoveSuperimposed:
-    // on a leader it moves leader and followers.
+    // S7-1500T Motion Control V4.0 function manual, 10.9.1 'MC_MoveSuperimposed: Position axes
+    // overlapping V4': on a leader it moves leader and followers.
     let mut fc = AxisConfig::example(0.001);
     fc.following_error.enable = false;
     let mut p = Pair::new(AxisConfig::example(0.001), fc);

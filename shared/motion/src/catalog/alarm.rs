@@ -3,8 +3,8 @@
 //! Data from the S7-1500T Motion Control V4.0 function manual:
 //! - 9.3 'Technology alarms': alarm classes and reactions;
 //! - A.8.1 'List of the technology alarms': the overview table and the alarm detail pages;
-//! - A.2 'Tags of the positioning axis/synchronous axis technology object': StatusWord, ErrorWord
-//!   and WarningWord of positioning/synchronous axes.
+//! - A.2.35 'StatusWord tag', A.2.36 'ErrorWord tag' and A.2.38 'WarningWord tag' (positioning
+//!   axis/synchronous axis).
 //!
 //! The table is static data: [`ALARMS`] holds one [`AlarmSpec`] per [`AlarmId`] with its reaction,
 //! ErrorWord/WarningWord bit, restart flag and text. [`AlarmId::spec`] is a `match`, so it is
@@ -369,8 +369,8 @@ alarms! {
             "Numerical value range of the position exceeded.",
         },
         /// Raised by an absolute positioning job on an axis that is not homed (S7-1500T Motion
-        /// Control V4.0 function manual, chapter 10 'Instructions' MC_MoveAbsolute). See also
-        /// [`crate::catalog::error_id::ErrorId::NotHomed`].
+        /// Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4').
+        /// See also [`crate::catalog::error_id::ErrorId::NotHomed`].
         AxisNotHomed = 321 => {
             EmergencyStop, error: Some(3), warning: None, restart: false,
             "Axis not homed.",
@@ -703,8 +703,8 @@ where
     best
 }
 
-/// `<TO>.ErrorDetail` (S7-1500T Motion Control V4.0 function manual, A.2 'Tags of the positioning
-/// axis/synchronous axis technology object'): number and reaction of the highest-priority pending
+/// `<TO>.ErrorDetail` (S7-1500T Motion Control V4.0 function manual, A.2.37 'ErrorDetail tags
+/// (positioning axis/synchronous axis)'): number and reaction of the highest-priority pending
 /// alarm.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct ErrorDetail {
@@ -743,7 +743,7 @@ impl Default for ErrorDetail {
 }
 
 /// Bit masks of `<TO>.StatusWord` of positioning and synchronous axes (S7-1500T Motion Control V4.0
-/// function manual, A.2 'Tags of the positioning axis/synchronous axis technology object').
+/// function manual, A.2.35 'StatusWord tag (positioning axis/synchronous axis)').
 pub mod status_bit {
     /// 0 "Enable": the TO is enabled.
     pub const ENABLE: u32 = 1 << 0;
@@ -814,7 +814,7 @@ pub mod status_bit {
     pub const SYNCHRONOUS_AXIS_ONLY: u32 = SYNCHRONIZING | SYNCHRONOUS | PHASING_COMMAND;
 
     /// Bits a **speed axis** uses: 0–4, 6, 9, 10, 12–14, 25–27 (S7-1500T Motion Control V4.0
-    /// function manual, A.1 'Tags of the speed axis technology object').
+    /// function manual, A.1.15 'StatusWord tag (speed axis)').
     pub const SPEED_AXIS_MASK: u32 = ENABLE
         | ERROR
         | RESTART_ACTIVE
@@ -832,7 +832,7 @@ pub mod status_bit {
 }
 
 /// Bit masks of `<TO>.ErrorWord` of positioning and synchronous axes (S7-1500T Motion Control V4.0
-/// function manual, A.2 'Tags of the positioning axis/synchronous axis technology object'). Bits
+/// function manual, A.2.36 'ErrorWord tag (positioning axis/synchronous axis)'). Bits
 /// 16–31 are reserved. [`AlarmSpec::error_bit`] holds the bit *index*.
 pub mod error_bit {
     /// 0 "SystemFault": system-internal error.
@@ -870,7 +870,7 @@ pub mod error_bit {
 }
 
 /// Bit masks of `<TO>.WarningWord` of positioning and synchronous axes (S7-1500T Motion Control
-/// V4.0 function manual, A.2 'Tags of the positioning axis/synchronous axis technology object').
+/// V4.0 function manual, A.2.38 'WarningWord tag (positioning axis/synchronous axis)').
 /// Same layout as [`error_bit`] with "…Warning" names, except that bits 8 and 9 are split into SW
 /// limit min / max. Bits 16–31 are reserved.
 pub mod warning_bit {

@@ -18,8 +18,8 @@
 //! | Code | Variant | Why |
 //! |---|---|---|
 //! | `16#80F0` | [`ErrorId::AxisLocked`] | S7-Technology MC_Stop locks the axis and rejects motion jobs with `8045` (S7-Technology V4.1 function manual, 6.2.3 'FB404 MC_Stop - Stopping an axis and preventing new motion commands'); in S7-1500 `16#8045` already means "fixed-stop travel active", so tandem uses a free code. |
-//! | `16#80F1` | [`ErrorId::IllegalOverride`] | S7-1500 clamps `Override.Velocity` (a DIR tag, S7-1500T Motion Control V4.0 function manual, A.2 'Tags of the positioning axis/synchronous axis technology object'); tandem's job interface can also reject an override outside 0..200 %. |
-//! | `16#80F2` | [`ErrorId::NotHomed`] | S7-1500 reacts to MC_MoveAbsolute on an axis that is not homed with technology alarm 321 (E-stop, ErrorID `16#8001`, S7-1500T Motion Control V4.0 function manual, chapter 10 'Instructions'); the reference has no plain ErrorID for it. This code is for a rejection without an alarm. |
+//! | `16#80F1` | [`ErrorId::IllegalOverride`] | S7-1500 clamps `Override.Velocity` (a DIR tag, S7-1500T Motion Control V4.0 function manual, A.2.20 'Override tags (positioning axis/synchronous axis)'); tandem's job interface can also reject an override outside 0..200 %. |
+//! | `16#80F2` | [`ErrorId::NotHomed`] | S7-1500 reacts to MC_MoveAbsolute on an axis that is not homed with technology alarm 321 (E-stop, ErrorID `16#8001`, S7-1500T Motion Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4'); the reference has no plain ErrorID for it. This code is for a rejection without an alarm. |
 //! | `16#80F3` | [`ErrorId::JobRejectedInErrorStop`] | PLCopen ErrorStop: a motion job while a stopping technology alarm is pending and not acknowledged. S7-1500 has no own code for it; its manual only tells the user to check `ErrorDetail` before starting a job (S7-1500T Motion Control V4.0 function manual, 6.3 'Motion Control instructions'). |
 //!
 //! Whether the axis reports a missing homing as alarm 321 (S7-compatible) or as
@@ -170,13 +170,13 @@ error_ids! {
         /// TRUE), every new motion job is rejected, even across disable/re-enable.
         AxisLocked = 0x80F0 => "Tandem extension: job rejected, the axis is locked by an active MC_Stop.",
         /// **Tandem extension.** Velocity override outside 0.0..=200.0 % (S7-1500T Motion Control
-        /// V4.0 function manual, A.2 'Tags of the positioning axis/synchronous axis technology
-        /// object' range of `Override.Velocity`) or not finite.
+        /// V4.0 function manual, A.2.20 'Override tags (positioning axis/synchronous
+        /// axis)', range of `Override.Velocity`) or not finite.
         IllegalOverride = 0x80F1 => "Tandem extension: override outside 0..200 %.",
         /// **Tandem extension.** Absolute positioning requested on an axis that is not homed.
         /// S7-1500 raises technology alarm 321 instead (E-stop reaction, job ErrorID `16#8001`,
-        /// S7-1500T Motion Control V4.0 function manual, chapter 10 'Instructions'
-        /// MC_MoveAbsolute).
+        /// S7-1500T Motion Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis
+        /// absolutely V4').
         NotHomed = 0x80F2 => "Tandem extension: absolute move rejected, the axis is not homed (S7-1500: alarm 321).",
         /// **Tandem extension.** PLCopen ErrorStop: a technology alarm with a stopping reaction
         /// (1..=5) is pending and not yet acknowledged with MC_Reset.

@@ -1,5 +1,5 @@
 //! Jobs: identifiers, the instructions they run, and the events they report (S7-1500T Motion
-//! Control V4.0 function manual, 6.3 'Motion Control instructions').
+//! Control V4.0 function manual, 6.5 'Tracking active jobs').
 //!
 //! An Execute-type instruction starts a job and is answered at once with a [`JobId`] or a
 //! rejection ([`crate::catalog::error_id::ErrorId`]); the job then reports its progress as

@@ -1,7 +1,7 @@
 //! Simulated drive and plant, so that actual values and the following error are real.
 //!
 //! Two models, both from the references (S7-1500T Motion Control V4.0 function manual, 3.2.11
-//! 'Closed-loop control', 3.2.5.7 'Axis in simulation'):
+//! 'Closed-loop control' and 3.2.5.3 'Actual values'):
 //! - [`DriveModel::Delay`]: the S7 simulation model of a simulated or virtual axis, where the
 //!   actual value is the setpoint delayed by `T_t` (interpolated between cycle samples).
 //! - [`DriveModel::PositionLoop`]: a position controller (gain `Kv`, velocity precontrol `Kpc`)

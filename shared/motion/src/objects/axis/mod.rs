@@ -687,7 +687,7 @@ impl Axis {
 
     fn abort_all(&mut self, how: JobEventKind) {
         // A simulated synchronous operation survives disables and alarms (S7-1500T Motion Control
-        // V4.0 function manual, 3.5 'Synchronous axis technology object').
+        // V4.0 function manual, 3.5.10 'Simulate synchronous operation').
         if self.sync_sim.is_none() {
             self.abort_sync(how);
             self.abort_pending(how);
@@ -1088,7 +1088,7 @@ impl Axis {
     }
 
     /// Continuous target of MoveAbsolute: modulo reduction and Direction (S7-1500T Motion Control
-    /// V4.0 function manual, chapter 10 'Instructions').
+    /// V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4').
     fn absolute_target(&self, position: f64, direction: Direction, lim: &Limits) -> f64 {
         let Some(m) = self.cfg.modulo else {
             return position;

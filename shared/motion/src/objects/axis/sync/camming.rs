@@ -1,5 +1,5 @@
-//! Camming of a synchronous axis (S7-1500T Motion Control V4.0 function manual, 3.5 'Synchronous
-//! axis technology object', "Camming, MC_CamIn", and chapter 10 'Instructions'): the cam mapping
+//! Camming of a synchronous axis (S7-1500T Motion Control V4.0 function manual, 3.5.7 'Camming' and
+//! 10.12.5 'MC_CamIn V4'): the cam mapping
 //! with offsets, scalings and application modes, the synchronization (shared with MC_GearInPos,
 //! whose law it uses until the sync point), MC_CamOut, and the seamless change to a pending cam at
 //! the end of a cam cycle.

@@ -1,9 +1,9 @@
 //! Synchronous operation of a synchronous axis (S7-1500T Motion Control V4.0 function manual,
-//! 3.5 'Synchronous axis technology object', chapter 10 'Instructions'): one synchronous operation
-//! with two laws, gearing (MC_GearIn, MC_GearInVelocity, MC_GearInPos, MC_GearOut) and camming
-//! (MC_CamIn, MC_CamOut), plus phasing and offsets. The leading value is an input of each cycle
-//! ([`Axis::set_leading_value`]); once synchronous, the follower setpoint is the coupling function
-//! of the leading value, exactly.
+//! 3.5 'Synchronous axis technology object' and 10.12 'Synchronous motion'): one synchronous
+//! operation with two laws, gearing (MC_GearIn, MC_GearInVelocity, MC_GearInPos, MC_GearOut) and
+//! camming (MC_CamIn, MC_CamOut), plus phasing and offsets. The leading value is an input of each
+//! cycle ([`Axis::set_leading_value`]); once synchronous, the follower setpoint is the coupling
+//! function of the leading value, exactly.
 //!
 //! The parts, each depending only on the ones before it:
 //! - [`law`]: the coupling laws as data and the math of the synchronization;
@@ -62,7 +62,7 @@ impl Axis {
     }
 
     /// `MC_SynchronizedMotionSimulation` (S7-1500T Motion Control V4.0 function manual,
-    /// 3.5 'Synchronous axis technology object'): enable while synchronous; the coupling goes on
+    /// 3.5.10 'Simulate synchronous operation'): enable while synchronous; the coupling goes on
     /// logically while the follower's own setpoint stands (velocity 0) and survives a disable; at
     /// the end the coupling is output again, without a new synchronization.
     pub(in crate::objects::axis) fn cmd_sync_simulation(
