@@ -216,13 +216,80 @@ pub struct AxisConfig {
     pub leader_missing_reaction: Option<crate::catalog::alarm::Reaction>,
 }
 
+/// What is wrong with a value of an [`AxisConfig`] (see [`AxisConfigError`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AxisConfigProblem {
+    /// Not a positive number.
+    NotPositive,
+    /// Negative or not a number.
+    Negative,
+    /// Not a finite number.
+    NotFinite,
+    /// A reaction that does not stop the follower when its leading value is missing.
+    LeaderMissingMustStop,
+    /// The default exceeds `max_velocity`.
+    ExceedsMaxVelocity,
+    /// The default exceeds `max_acceleration`.
+    ExceedsMaxAcceleration,
+    /// The default exceeds `max_deceleration`.
+    ExceedsMaxDeceleration,
+    /// The default exceeds `max_jerk`.
+    ExceedsMaxJerk,
+    /// A modulo setting on a speed axis.
+    SpeedAxisModulo,
+    /// The upper software limit is not above the lower one (alarm 104).
+    SoftwareLimitsReversed,
+    /// Software limit switches on a modulo axis (not supported yet).
+    SoftwareLimitsOnModulo,
+    /// The maximum following error is below the minimum.
+    FollowingErrorMaxBelowMin,
+    /// A warning level outside 0..=100 %.
+    WarningLevelOutOfRange,
+    /// A velocity precontrol outside 0..=150 %.
+    KpcOutOfRange,
+    /// A reference cam whose high end is not above its low end.
+    ReferenceCamReversed,
+    /// The upper hardware limit switch is not above the lower one.
+    HardwareLimitsReversed,
+}
+
+impl AxisConfigProblem {
+    /// The problem in words, as the configuration's error messages show it.
+    pub const fn text(self) -> &'static str {
+        match self {
+            Self::NotPositive => "must be a positive number",
+            Self::Negative => "must be zero or a positive number",
+            Self::NotFinite => "must be a finite number",
+            Self::LeaderMissingMustStop => "a follower without its leading value must stop: stop_current_dynamics, stop_max_dynamics, emergency_stop or remove_enable",
+            Self::ExceedsMaxVelocity => "exceeds max_velocity",
+            Self::ExceedsMaxAcceleration => "exceeds max_acceleration",
+            Self::ExceedsMaxDeceleration => "exceeds max_deceleration",
+            Self::ExceedsMaxJerk => "exceeds max_jerk",
+            Self::SpeedAxisModulo => "a speed axis has no modulo",
+            Self::SoftwareLimitsReversed => "must be greater than sw_limits.min (alarm 104)",
+            Self::SoftwareLimitsOnModulo => "software limit switches on a modulo axis are not supported yet",
+            Self::FollowingErrorMaxBelowMin => "must not be less than following_error.min_value",
+            Self::WarningLevelOutOfRange => "must be between 0 and 100 (%)",
+            Self::KpcOutOfRange => "must be between 0 and 150 %",
+            Self::ReferenceCamReversed => "must be [low, high] with high > low",
+            Self::HardwareLimitsReversed => "must be greater than plant.hw_limit_min",
+        }
+    }
+}
+
+impl core::fmt::Display for AxisConfigProblem {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.text())
+    }
+}
+
 /// A configuration value that is not acceptable: which field, and why.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct AxisConfigError {
     /// The key, as in the cell file (e.g. `dynamics.max_velocity`).
     pub field: &'static str,
     /// What is wrong with it.
-    pub problem: &'static str,
+    pub problem: AxisConfigProblem,
 }
 
 impl core::fmt::Display for AxisConfigError {
@@ -239,7 +306,7 @@ fn positive(field: &'static str, x: f64) -> Result<(), AxisConfigError> {
     } else {
         Err(AxisConfigError {
             field,
-            problem: "must be a positive number",
+            problem: AxisConfigProblem::NotPositive,
         })
     }
 }
@@ -250,7 +317,7 @@ fn non_negative(field: &'static str, x: f64) -> Result<(), AxisConfigError> {
     } else {
         Err(AxisConfigError {
             field,
-            problem: "must be zero or a positive number",
+            problem: AxisConfigProblem::Negative,
         })
     }
 }
@@ -261,7 +328,7 @@ fn finite(field: &'static str, x: f64) -> Result<(), AxisConfigError> {
     } else {
         Err(AxisConfigError {
             field,
-            problem: "must be a finite number",
+            problem: AxisConfigProblem::NotFinite,
         })
     }
 }
@@ -332,7 +399,7 @@ impl AxisConfig {
         ) {
             return Err(AxisConfigError {
                 field: "leader_missing_reaction",
-                problem: "a follower without its leading value must stop: stop_current_dynamics, stop_max_dynamics, emergency_stop or remove_enable",
+                problem: AxisConfigProblem::LeaderMissingMustStop,
             });
         }
         self.validate_dynamics()?;
@@ -361,25 +428,25 @@ impl AxisConfig {
         if self.defaults.velocity > self.limits.max_velocity {
             return Err(AxisConfigError {
                 field: "dynamics.velocity",
-                problem: "exceeds max_velocity",
+                problem: AxisConfigProblem::ExceedsMaxVelocity,
             });
         }
         if self.defaults.acceleration > self.limits.max_acceleration {
             return Err(AxisConfigError {
                 field: "dynamics.acceleration",
-                problem: "exceeds max_acceleration",
+                problem: AxisConfigProblem::ExceedsMaxAcceleration,
             });
         }
         if self.defaults.deceleration > self.limits.max_deceleration {
             return Err(AxisConfigError {
                 field: "dynamics.deceleration",
-                problem: "exceeds max_deceleration",
+                problem: AxisConfigProblem::ExceedsMaxDeceleration,
             });
         }
         if self.defaults.jerk > self.limits.max_jerk {
             return Err(AxisConfigError {
                 field: "dynamics.jerk",
-                problem: "exceeds max_jerk",
+                problem: AxisConfigProblem::ExceedsMaxJerk,
             });
         }
         Ok(())
@@ -393,7 +460,7 @@ impl AxisConfig {
             if self.kind == AxisKind::Speed {
                 return Err(AxisConfigError {
                     field: "modulo",
-                    problem: "a speed axis has no modulo",
+                    problem: AxisConfigProblem::SpeedAxisModulo,
                 });
             }
         }
@@ -403,13 +470,13 @@ impl AxisConfig {
             if sw.max <= sw.min {
                 return Err(AxisConfigError {
                     field: "sw_limits.max",
-                    problem: "must be greater than sw_limits.min (alarm 104)",
+                    problem: AxisConfigProblem::SoftwareLimitsReversed,
                 });
             }
             if self.modulo.is_some() {
                 return Err(AxisConfigError {
                     field: "sw_limits",
-                    problem: "software limit switches on a modulo axis are not supported yet",
+                    problem: AxisConfigProblem::SoftwareLimitsOnModulo,
                 });
             }
         }
@@ -435,13 +502,13 @@ impl AxisConfig {
             if fe.max_value < fe.min_value {
                 return Err(AxisConfigError {
                     field: "following_error.max_value",
-                    problem: "must not be less than following_error.min_value",
+                    problem: AxisConfigProblem::FollowingErrorMaxBelowMin,
                 });
             }
             if !(0.0..=100.0).contains(&fe.warning_level) {
                 return Err(AxisConfigError {
                     field: "following_error.warning_level",
-                    problem: "must be between 0 and 100 (%)",
+                    problem: AxisConfigProblem::WarningLevelOutOfRange,
                 });
             }
         }
@@ -472,7 +539,7 @@ impl AxisConfig {
                 if !(0.0..=1.5).contains(&kpc) {
                     return Err(AxisConfigError {
                         field: "drive.kpc",
-                        problem: "must be between 0 and 150 %",
+                        problem: AxisConfigProblem::KpcOutOfRange,
                     });
                 }
                 non_negative("drive.t_vtc", t_vtc)?;
@@ -487,7 +554,7 @@ impl AxisConfig {
             if !(lo.is_finite() && hi.is_finite() && hi > lo) {
                 return Err(AxisConfigError {
                     field: "plant.reference_cam",
-                    problem: "must be [low, high] with high > low",
+                    problem: AxisConfigProblem::ReferenceCamReversed,
                 });
             }
         }
@@ -499,7 +566,7 @@ impl AxisConfig {
             if hi <= lo {
                 return Err(AxisConfigError {
                     field: "plant.hw_limit_max",
-                    problem: "must be greater than plant.hw_limit_min",
+                    problem: AxisConfigProblem::HardwareLimitsReversed,
                 });
             }
         }

@@ -16,9 +16,9 @@ pub use command::{
     SyncProfileReference, VelocityDirection,
 };
 pub use config::{
-    AxisConfig, AxisConfigError, AxisKind, EncoderType, FollowingErrorMonitoring, HomingConfig,
-    HomingMark, MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits,
-    StandstillSignal,
+    AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
+    FollowingErrorMonitoring, HomingConfig, HomingMark, MotionType, PassiveDirection,
+    PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
 };
 
 use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
