@@ -4,7 +4,7 @@ use std::fmt;
 use std::path::PathBuf;
 use std::time::Duration;
 use tandem_config::ConfigError;
-use tandem_motion::error_id::ErrorId;
+use tandem_motion::catalog::error_id::ErrorId;
 use tandem_protocol::ipc::IpcError;
 
 /// A boxed error from another crate, kept as the source.

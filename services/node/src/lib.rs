@@ -21,8 +21,8 @@ use std::sync::Arc;
 use std::time::Duration;
 use tandem_config::script::{split_command, ScriptEntry};
 use tandem_config::{AxisIndex, Cell, Coupling, Leader};
-use tandem_motion::action::Action;
-use tandem_motion::axis::AxisStatus;
+use tandem_motion::objects::action::Action;
+use tandem_motion::objects::axis::AxisStatus;
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::names;
 use tandem_protocol::wire::{
@@ -506,7 +506,9 @@ fn cyclic(
             let e = &q.entry;
             let applied = exec
                 .apply(t, &e.axis, e.instruction, e.action, &mut log)
-                .unwrap_or(Err(tandem_motion::error_id::ErrorId::IllegalObject));
+                .unwrap_or(Err(
+                    tandem_motion::catalog::error_id::ErrorId::IllegalObject,
+                ));
             let mut reply = CommandReply {
                 outcome: OUTCOME_ACCEPTED,
                 job: 0,

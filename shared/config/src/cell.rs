@@ -2,8 +2,8 @@
 //! measuring inputs, referred to by typed indices.
 
 use core::ops::Index;
-use tandem_motion::axis::AxisConfig;
-use tandem_motion::leading::LeaderId;
+use tandem_motion::objects::axis::AxisConfig;
+use tandem_motion::objects::leading::LeaderId;
 
 /// Samples a leader's buffer holds at each follower: the delay plus the tolerance, in leader
 /// cycles, must fit with a margin of four samples.
@@ -187,7 +187,7 @@ pub struct EncoderEntry {
     /// Index into [`Cell::nodes`].
     pub node: usize,
     /// Engine configuration.
-    pub config: tandem_motion::encoder::EncoderConfig,
+    pub config: tandem_motion::objects::encoder::EncoderConfig,
     /// Simulated source.
     pub source: EncoderSource,
     /// Its leading-value delay and tolerance, as a leader.
@@ -219,7 +219,7 @@ pub struct OutputCamEntry {
     /// The axis whose motion it follows.
     pub axis: AxisIndex,
     /// Engine configuration.
-    pub config: tandem_motion::output_cam::OutputCamConfig,
+    pub config: tandem_motion::objects::output_cam::OutputCamConfig,
 }
 
 /// A cam track of the cell (`[[cam_tracks]]`).
@@ -230,9 +230,9 @@ pub struct CamTrackEntry {
     /// The axis whose motion it follows.
     pub axis: AxisIndex,
     /// Engine configuration.
-    pub config: tandem_motion::cam_track::CamTrackConfig,
+    pub config: tandem_motion::objects::cam_track::CamTrackConfig,
     /// Track data (reference, length, cams).
-    pub data: tandem_motion::cam_track::CamTrackData,
+    pub data: tandem_motion::objects::cam_track::CamTrackData,
 }
 
 /// A simulated mark sensor on a measuring input.
@@ -251,13 +251,13 @@ pub struct SensorEntry {
     /// Seed of the jitter.
     pub seed: u64,
     /// Direction that produces edges.
-    pub direction: tandem_motion::measuring::SensorDirection,
+    pub direction: tandem_motion::plant::sensor::SensorDirection,
 }
 
 impl SensorEntry {
     /// The engine's simulated sensor.
-    pub fn sensor(&self) -> tandem_motion::measuring::SimulatedSensor {
-        tandem_motion::measuring::SimulatedSensor::new(
+    pub fn sensor(&self) -> tandem_motion::plant::sensor::SimulatedSensor {
+        tandem_motion::plant::sensor::SimulatedSensor::new(
             self.position,
             self.width,
             self.dead_time,
@@ -276,7 +276,7 @@ pub struct MeasuringInputEntry {
     /// The axis whose motion it follows.
     pub axis: AxisIndex,
     /// Engine configuration.
-    pub config: tandem_motion::measuring::MeasuringInputConfig,
+    pub config: tandem_motion::objects::measuring::MeasuringInputConfig,
     /// Optional simulated sensor producing the input's edges.
     pub sensor: Option<SensorEntry>,
     /// Optional register correction.

@@ -5,12 +5,12 @@
 //! Defaults are the references' defaults (dynamics -1.0 = the axis defaults).
 
 use core::fmt;
-use tandem_motion::axis::{
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::axis::{
     ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
     SyncProfileReference, VelocityDirection,
 };
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::leading::LeaderId;
+use tandem_motion::objects::leading::LeaderId;
 
 /// A parameter value.
 #[derive(Copy, Clone, Debug, PartialEq)]

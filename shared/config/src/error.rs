@@ -4,6 +4,7 @@
 use crate::command::CommandError;
 use core::fmt;
 use tandem_motion::cam::{CamError, CamParseError};
+use tandem_motion::objects::axis::AxisConfigProblem;
 
 /// A problem in a configuration file (a cell file or a script), located.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -51,6 +52,8 @@ pub enum Problem {
     Syntax(String),
     /// A value outside what the key accepts; the text says what it must be.
     Invalid(&'static str),
+    /// A value of an axis the engine refuses (`[axes.<name>]`, validated by the axis).
+    Axis(AxisConfigProblem),
     /// A name that must be one of a fixed list.
     NotOneOf {
         /// The value given.
@@ -158,7 +161,7 @@ pub enum Problem {
         /// The kind of object (`cam track`, `measuring input`).
         object: &'static str,
         /// The engine's reason.
-        reason: tandem_motion::measuring::ConfigError,
+        reason: tandem_motion::objects::measuring::MeasuringConfigError,
     },
     /// A script instruction or its parameters.
     Command(CommandError),
@@ -249,6 +252,7 @@ impl fmt::Display for Problem {
             Problem::Unreadable(e) => write!(f, "cannot read: {e}"),
             Problem::Syntax(m) => f.write_str(m),
             Problem::Invalid(m) => f.write_str(m),
+            Problem::Axis(p) => f.write_str(p.text()),
             Problem::NotOneOf { value, options } => {
                 write!(f, "`{value}` is not one of {}", options.join(", "))
             }

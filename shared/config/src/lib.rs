@@ -159,7 +159,7 @@ emergency_deceleration = 2000.0
         assert_eq!(c.output_cams.len(), 1);
         assert_eq!(
             c.output_cams[0].config.cam_type,
-            tandem_motion::output_cam::OutputCamType::Time
+            tandem_motion::objects::output_cam::OutputCamType::Time
         );
         assert_eq!(c.cam_tracks[0].data.cams[0].off_position, 20.0);
         assert!(!c.cam_tracks[0].data.cams[1].existent);

@@ -23,7 +23,7 @@
 
 use crate::command::{self, CommandError, Expected, Value};
 use crate::{ConfigError, Problem};
-use tandem_motion::action::Action;
+use tandem_motion::objects::action::Action;
 
 /// The names of the cell's output cams, cam tracks and measuring inputs (script targets).
 #[derive(Clone, Debug, Default)]

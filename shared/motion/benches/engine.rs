@@ -14,7 +14,7 @@ use std::sync::OnceLock;
 
 use divan::black_box;
 use rsruckig::prelude::*;
-use tandem_motion::profile::{plan_position, plan_velocity, Limits, Profile, State};
+use tandem_motion::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, State};
 
 fn main() {
     divan::main();
@@ -206,9 +206,11 @@ impl Cycle {
 #[divan::bench_group(sample_count = 3000, sample_size = 1000)]
 mod axis_step_in_motion {
     use super::*;
-    use tandem_motion::axis::{Axis, AxisConfig, Command, StartMode, StopMode, VelocityDirection};
-    use tandem_motion::drive::DriveModel;
-    use tandem_motion::dynamics::Dynamics;
+    use tandem_motion::kinematics::dynamics::Dynamics;
+    use tandem_motion::objects::axis::{
+        Axis, AxisConfig, Command, StartMode, StopMode, VelocityDirection,
+    };
+    use tandem_motion::plant::drive::DriveModel;
 
     const MS: i64 = 1_000_000;
 
@@ -486,10 +488,10 @@ mod profile_at {
 #[divan::bench_group(sample_count = 3000, sample_size = 1000)]
 mod follower_step {
     use super::*;
-    use tandem_motion::axis::{Axis, AxisConfig, AxisKind, Command, StartMode, StopMode};
-    use tandem_motion::dynamics::Dynamics;
-    use tandem_motion::job::JobEventKind;
-    use tandem_motion::leading::LeadingValue;
+    use tandem_motion::kinematics::dynamics::Dynamics;
+    use tandem_motion::objects::axis::{Axis, AxisConfig, AxisKind, Command, StartMode, StopMode};
+    use tandem_motion::objects::job::JobEventKind;
+    use tandem_motion::objects::leading::LeadingValue;
 
     const MS: i64 = 1_000_000;
 
@@ -551,9 +553,11 @@ mod follower_step {
     }
 
     use std::sync::Arc;
-    use tandem_motion::alarm::status_bit;
-    use tandem_motion::axis::{ApplicationMode, AxisState, SyncDirection, SyncProfileReference};
     use tandem_motion::cam::Cam;
+    use tandem_motion::catalog::alarm::status_bit;
+    use tandem_motion::objects::axis::{
+        ApplicationMode, AxisState, SyncDirection, SyncProfileReference,
+    };
 
     /// A follower in MC_CamIn (cyclic, direct: synchronous at once) on `cam`, its leader at
     /// constant velocity `v` from 0; returns the follower, the next cycle and the follower
@@ -800,14 +804,16 @@ mod cam_following_value {
 #[divan::bench_group(sample_count = 3000, sample_size = 1000)]
 mod cams_and_measuring {
     use super::*;
-    use tandem_motion::cam_track::{
+    use tandem_motion::kinematics::cycle_motion::AxisMotion;
+    use tandem_motion::kinematics::modulo::Modulo;
+    use tandem_motion::objects::cam_track::{
         CamTrack, CamTrackConfig, CamTrackData, CamTrackMode, CamTrackType, McCamTrack, TrackCam,
     };
-    use tandem_motion::measuring::{
-        AxisMotion, CyclicMode, InputEdge, MeasuringContext, MeasuringInput, MeasuringInputConfig,
+    use tandem_motion::objects::measuring::{
+        CyclicMode, MeasuringContext, MeasuringInput, MeasuringInputConfig,
     };
-    use tandem_motion::modulo::Modulo;
-    use tandem_motion::output_cam::CamEdges;
+    use tandem_motion::objects::output_cam::CamEdges;
+    use tandem_motion::plant::sensor::InputEdge;
 
     const MS: i64 = 1_000_000;
     const MODULO: Option<Modulo> = Some(Modulo {
@@ -931,15 +937,15 @@ mod cams_and_measuring {
     }
 }
 
-/// The leading-value buffer (design §4) of a leader sampled every 1 ms, 256 samples buffered:
-/// a follower's lookup inside the last two sample intervals (the common case: delay of one or
-/// two cycles), a lookup deep in the buffer (binary search), and one cycle of the runtime (push
-/// the new sample, then look the leader up at a delay of 1.5 ms). The lookup times are a corpus
-/// of random offsets.
+/// The leading-value buffer (see the leading values between nodes, docs/processes.md 'Leading
+/// values') of a leader sampled every 1 ms, 256 samples buffered: a follower's lookup inside the
+/// last two sample intervals (the common case: delay of one or two cycles), a lookup deep in the
+/// buffer (binary search), and one cycle of the runtime (push the new sample, then look the leader
+/// up at a delay of 1.5 ms). The lookup times are a corpus of random offsets.
 #[divan::bench_group(sample_count = 3000, sample_size = 1000)]
 mod leading_value_buffer {
     use super::*;
-    use tandem_motion::leading::{LeadingSample, LeadingValueBuffer, Lookup};
+    use tandem_motion::objects::leading::{LeadingSample, LeadingValueBuffer, Lookup};
 
     const MS: i64 = 1_000_000;
     const N: usize = 256;

@@ -1,17 +1,19 @@
-//! Known-answer tests of the axis jobs against the references (seed 001 §3, §4, §6; seed 000 on
-//! MC_Stop). One cycle = 1 ms unless said otherwise.
+//! Known-answer tests of the axis jobs against the references (S7-1500T Motion Control V4.0
+//! function manual, 6.3 'Motion Control instructions', 3.2.10 'Position monitoring functions',
+//! 3.2.9 'Homing'; S7-Technology V4.1 function manual on MC_Stop). One cycle = 1 ms unless said
+//! otherwise.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use tandem_motion::alarm::{status_bit, AlarmId};
-use tandem_motion::axis::{
+use tandem_motion::catalog::alarm::{status_bit, AlarmId};
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{
     AxisConfig, AxisState, Command, Direction, HomingMark, Sense, SoftwareLimits, StartMode,
     StopMode, VelocityDirection,
 };
-use tandem_motion::drive::{DriveModel, ZeroMark};
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{Instruction, JobEventKind};
-use tandem_motion::modulo::Modulo;
+use tandem_motion::objects::job::{Instruction, JobEventKind};
+use tandem_motion::plant::drive::{DriveModel, ZeroMark};
 
 mod common;
 use common::{dyn_, Rig};
@@ -404,7 +406,8 @@ fn jog_runs_while_held_and_both_inputs_are_an_error() {
 
 #[test]
 fn superimposed_adds_to_a_positioning_move() {
-    // Seed 001 §3.2: MoveRelative 50 plus superimposed 50 gives 100 in total.
+    // S7-1500T Motion Control V4.0 function manual, 10.9.1 'MC_MoveSuperimposed: Position axes
+    // overlapping V4': MoveRelative 50 plus superimposed 50 gives 100 in total.
     let mut r = Rig::enabled(AxisConfig::example(0.001));
     let m = r
         .cmd(Command::MoveRelative {
@@ -961,7 +964,7 @@ fn active_homing_finds_nothing_between_two_switches() {
 #[test]
 fn absolute_encoder_adjustment_and_passive_mode_10() {
     let mut cfg = homing_cfg();
-    cfg.encoder = tandem_motion::axis::EncoderType::Absolute;
+    cfg.encoder = tandem_motion::objects::axis::EncoderType::Absolute;
     let mut r = Rig::enabled(cfg);
     assert!(
         r.axis.status().has(status_bit::HOMING_DONE),
@@ -1006,7 +1009,7 @@ fn absolute_encoder_adjustment_and_passive_mode_10() {
     cfg.homing.home_position = 500.0;
     cfg.homing.home_position_offset = 7.0;
     cfg.homing.passive_mark = HomingMark::ZeroMark;
-    cfg.homing.passive_direction = tandem_motion::axis::PassiveDirection::Negative;
+    cfg.homing.passive_direction = tandem_motion::objects::axis::PassiveDirection::Negative;
     let mut r = Rig::enabled(cfg);
     let h = r
         .cmd(Command::Home {

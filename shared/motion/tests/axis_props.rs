@@ -5,11 +5,11 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use proptest::prelude::*;
-use tandem_motion::axis::{
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{
     Axis, AxisConfig, Command, Direction, SoftwareLimits, StartMode, StopMode, VelocityDirection,
 };
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::modulo::Modulo;
 
 fn dynamics() -> impl Strategy<Value = Dynamics> {
     let value = prop_oneof![Just(-1.0), Just(0.0), 1.0f64..20000.0];
@@ -125,8 +125,8 @@ fn run(cfg: AxisConfig, script: &[(u16, Command)]) {
             ] {
                 assert!(x.is_finite(), "non-finite value in {s:?}");
             }
-            let enabled = |st: &tandem_motion::axis::AxisStatus| {
-                st.has(tandem_motion::alarm::status_bit::ENABLE)
+            let enabled = |st: &tandem_motion::objects::axis::AxisStatus| {
+                st.has(tandem_motion::catalog::alarm::status_bit::ENABLE)
             };
             if enabled(&prev) && enabled(&s) {
                 let dp = s.position_unwrapped - prev.position_unwrapped;
@@ -149,7 +149,7 @@ fn run(cfg: AxisConfig, script: &[(u16, Command)]) {
             }
             if let (Some(sw), true) = (
                 sw,
-                enabled(&s) && s.has(tandem_motion::alarm::status_bit::HOMING_DONE),
+                enabled(&s) && s.has(tandem_motion::catalog::alarm::status_bit::HOMING_DONE),
             ) {
                 // Software limits (active when homed) are never crossed (no MotionIn here): the
                 // look-ahead stops exactly on them.

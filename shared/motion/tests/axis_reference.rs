@@ -1,22 +1,24 @@
-//! Known answers taken from the references' own numbers (seed 001 §4.1, §4.6, §4.7, §3.3), and
-//! the remaining job semantics (MoveVelocity Direction/Current, override table cases).
+//! Known answers taken from the references' own numbers (S7-1500T Motion Control V4.0 function
+//! manual, 3.2.8.2 'Velocity profile', 3.2.10.2 'Positioning monitoring', 3.2.10.3 'Following error
+//! monitoring', 10.16 'Override response of Motion Control jobs V4'), and the remaining job
+//! semantics (MoveVelocity Direction/Current, override table cases).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use tandem_motion::alarm::AlarmId;
-use tandem_motion::axis::{
+use tandem_motion::catalog::alarm::AlarmId;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::kinematics::profile::{plan_velocity, Limits, State};
+use tandem_motion::objects::axis::{
     AxisConfig, AxisState, Command, HomingMark, StartMode, StopMode, VelocityDirection,
 };
-use tandem_motion::drive::{DriveModel, ZeroMark};
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::JobEventKind;
-use tandem_motion::profile::{plan_velocity, Limits, State};
+use tandem_motion::objects::job::JobEventKind;
+use tandem_motion::plant::drive::{DriveModel, ZeroMark};
 
 mod common;
 use common::{dyn_ as dynamics, Rig};
 
 #[test]
-fn ramp_and_smoothing_times_of_seed_001_4_1() {
+fn ramp_and_smoothing_times_of_the_velocity_profile_example() {
     // Accel 1000, Decel 500, Jerk 10000: smoothing 0.1 s on acceleration, 0.05 s on
     // deceleration; ramp-up 0 -> 100 = v/a + a/j = 0.2 s (the smoothing phases meet);
     // ramp-down 100 -> 0 = v/d + d/j = 0.25 s.
@@ -98,7 +100,7 @@ fn ramp_and_smoothing_times_of_seed_001_4_1() {
 }
 
 #[test]
-fn positioning_monitoring_example_of_seed_001_4_6() {
+fn positioning_monitoring_example_of_the_manual() {
     // Window 0.1, ToleranceTime 1.0, MinDwellTime 0.05: Done at the earliest 0.05 s after the
     // actual value entered the window. With the delay model the actual lags by T_t = 0.2 s.
     let mut cfg = AxisConfig::example(0.001);
@@ -143,7 +145,7 @@ fn positioning_monitoring_example_of_seed_001_4_6() {
 }
 
 #[test]
-fn following_error_limit_and_warning_of_seed_001_4_7() {
+fn following_error_limit_and_warning_of_the_manual() {
     // Permitted error grows linearly from MinValue (below MinVelocity) to MaxValue at the
     // maximum velocity; the warning comes at WarningLevel % of the current permitted value.
     // Constant velocity 255 on an axis with MaxVelocity 500, MinVelocity 10: permitted
@@ -310,7 +312,7 @@ fn override_table_cases_on_an_axis() {
 #[test]
 fn alarm_with_stop_reaction_keeps_the_axis_enabled_and_reset_returns_to_standstill() {
     let mut cfg = AxisConfig::example(0.001);
-    cfg.sw_limits = Some(tandem_motion::axis::SoftwareLimits {
+    cfg.sw_limits = Some(tandem_motion::objects::axis::SoftwareLimits {
         min: -5.0,
         max: 5.0,
     });
@@ -348,7 +350,8 @@ fn alarm_with_stop_reaction_keeps_the_axis_enabled_and_reset_returns_to_standsti
 fn non_position_controlled_mode_is_sticky_until_a_positioning_job() {
     // StartMode 0 enables without position control (StatusWord.X28); MoveVelocity with
     // PositionControlled FALSE keeps it after the job; Halt keeps the mode; MoveRelative forces
-    // position control (seed 001 §3.6).
+    // position control (S7-1500T Motion Control V4.0 function manual, 6.3.4 'Non
+    // position-controlled operation').
     let mut r = Rig::enabled(AxisConfig::example(0.001));
     r.cmd(Command::Power {
         enable: false,
@@ -363,7 +366,7 @@ fn non_position_controlled_mode_is_sticky_until_a_positioning_job() {
     })
     .unwrap();
     r.step(1);
-    let npc = tandem_motion::alarm::status_bit::NON_POSITION_CONTROLLED;
+    let npc = tandem_motion::catalog::alarm::status_bit::NON_POSITION_CONTROLLED;
     assert!(r.axis.status().has(npc));
     let v = r
         .cmd(Command::MoveVelocity {
@@ -421,7 +424,7 @@ fn a_state_beyond_new_limits_is_brought_back_as_fast_as_they_allow() {
     r.cmd(Command::MoveAbsolute {
         position: 10_000.0,
         dynamics: dynamics(100.0, 1000.0, 2000.0, 0.0),
-        direction: tandem_motion::axis::Direction::Shortest,
+        direction: tandem_motion::objects::axis::Direction::Shortest,
     })
     .unwrap();
     r.step(1);
@@ -443,7 +446,7 @@ fn a_state_beyond_new_limits_is_brought_back_as_fast_as_they_allow() {
 #[test]
 fn speed_axis_has_velocity_jobs_only() {
     let mut cfg = AxisConfig::example(0.001);
-    cfg.kind = tandem_motion::axis::AxisKind::Speed;
+    cfg.kind = tandem_motion::objects::axis::AxisKind::Speed;
     let mut r = Rig::enabled(cfg);
     assert_eq!(
         r.cmd(Command::MoveRelative {
@@ -471,7 +474,7 @@ fn speed_axis_has_velocity_jobs_only() {
     let s = r.axis.status();
     assert_eq!(s.velocity, 120.0);
     assert_eq!(
-        s.status_word & !tandem_motion::alarm::status_bit::SPEED_AXIS_MASK,
+        s.status_word & !tandem_motion::catalog::alarm::status_bit::SPEED_AXIS_MASK,
         0
     );
 }

@@ -730,8 +730,9 @@ fn leading_value_inverts_the_following_value_on_monotonic_cams() {
     assert_eq!(CamError::NoLeadingValue.error_id().code(), 0x8063);
 }
 
-/// The example of seed 000 §3.5 (MC_GetCamPoint Mode 1): master 0..10, the following value 4 is
-/// reached once below and once above 5.
+/// The example of S7-Technology V4.1 function manual, 3.5 '"Cam disk" technology object'
+/// (MC_GetCamPoint Mode 1): master 0..10, the following value 4 is reached once below and once
+/// above 5.
 #[test]
 fn approach_value_and_tie_rule() {
     let cam = Cam::interpolate(&CamDefinition {

@@ -1,5 +1,6 @@
-//! Cam track TO and MC_CamTrack: the catalogue examples of seed 003 §9 (AT-CT-*), named after
-//! their ids, and a property test of the track output against exact crossings.
+//! Cam track TO and MC_CamTrack: the known-answer cases AT-CT-* built from the examples and rules
+//! of the S7-1500T Measuring input and cam functions V5.0 function manual, named after their ids,
+//! and a property test of the track output against exact crossings.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 #[path = "common/machine_limits.rs"]
@@ -7,16 +8,16 @@ mod machine_limits;
 use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use tandem_motion::alarm::AlarmId;
-use tandem_motion::cam_track::{
+use tandem_motion::catalog::alarm::AlarmId;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::cycle_motion::AxisMotion;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::kinematics::profile::{plan_position, Limits, Profile, State};
+use tandem_motion::objects::cam_track::{
     match_on_enable, next_reference_position, CamTrack, CamTrackConfig, CamTrackData, CamTrackMode,
     CamTrackState, CamTrackType, McCamTrack, TrackCam, TrackOutputInterface,
 };
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::measuring::AxisMotion;
-use tandem_motion::modulo::Modulo;
-use tandem_motion::output_cam::{CamEdges, Edge};
-use tandem_motion::profile::{plan_position, Limits, Profile, State};
+use tandem_motion::objects::output_cam::{CamEdges, Edge};
 
 const MS: i64 = 1_000_000;
 
@@ -411,7 +412,8 @@ fn at_ct_10_mode1_change_and_disable_wait_for_the_track_end() {
     let data = CamTrackData::new(0.0, 100.0).with_cam(0, TrackCam::distance(10.0, 20.0));
     let new = data.with_cam(0, TrackCam::distance(30.0, 40.0));
     let sim = Sim::constant(5.0, 10.0); // 100 at 9.5 ms, 130 at 12.5 ms
-                                        // Mode 1: the change at 25 (2 ms) waits for the track end (100).
+                                        // Mode 1: the change at 25 (2 ms) waits for the track end
+                                        // (100).
     let mut t = track(CamTrackType::Distance, data);
     let e = run(&mut t, &sim, &MODE1, 0, 2);
     assert_positions(&positions(&e, 5.0, 10.0), &[(10.0, true), (20.0, false)]);

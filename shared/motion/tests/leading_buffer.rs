@@ -1,6 +1,7 @@
-//! Leading-value buffer (design §4): property tests of the interpolation between the buffered
-//! samples of a leader, the extrapolation past the newest, the ring, the refused pushes and the
-//! invalid samples; and that the cyclic path does not allocate.
+//! Leading-value buffer (see the leading values between nodes, docs/processes.md 'Leading values'):
+//! property tests of the interpolation between the buffered samples of a leader, the extrapolation
+//! past the newest, the ring, the refused pushes and the invalid samples; and that the cyclic path
+//! does not allocate.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 #[path = "common/counting.rs"]
@@ -8,10 +9,10 @@ mod counting;
 use counting::{arm, disarm, Counting};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use tandem_motion::leading::{
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::leading::{
     LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
-use tandem_motion::modulo::Modulo;
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;

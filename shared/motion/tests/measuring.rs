@@ -1,4 +1,5 @@
-//! Measuring input TO: the catalogue examples of seed 003 §9 (AT-MI-*), named after their ids,
+//! Measuring input TO: the known-answer cases AT-MI-* built from the examples and rules of the
+//! S7-1500T Measuring input and cam functions V5.0 function manual, named after their ids,
 //! and property tests of the measured positions and the cyclic counters.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
@@ -7,15 +8,16 @@ mod machine_limits;
 use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use tandem_motion::alarm::AlarmId;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::measuring::{
-    AxisMotion, CyclicMode, InputEdge, InputEdges, MeasuringContext, MeasuringInput,
-    MeasuringInputConfig, MeasuringRoute, MeasuringState, MeasuringTiming, MeasuringWindow,
-    OneTimeMode, SensorDirection, SimulatedSensor,
+use tandem_motion::catalog::alarm::AlarmId;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::cycle_motion::AxisMotion;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::kinematics::profile::{plan_position, Limits, Profile, State};
+use tandem_motion::objects::measuring::{
+    CyclicMode, MeasuringContext, MeasuringInput, MeasuringInputConfig, MeasuringRoute,
+    MeasuringState, MeasuringTiming, MeasuringWindow, OneTimeMode,
 };
-use tandem_motion::modulo::Modulo;
-use tandem_motion::profile::{plan_position, Limits, Profile, State};
+use tandem_motion::plant::sensor::{InputEdge, InputEdges, SensorDirection, SimulatedSensor};
 
 const MS: i64 = 1_000_000;
 

@@ -4,15 +4,15 @@
 //! commands and with their events drained every cycle.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use tandem_motion::alarm::AlarmId;
-use tandem_motion::axis::{
+use tandem_motion::catalog::alarm::AlarmId;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{
     Axis, AxisConfig, AxisKind, AxisState, Command, Direction, SoftwareLimits, StartMode, StopMode,
     VelocityDirection,
 };
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::JobEventKind;
-use tandem_motion::modulo::Modulo;
+use tandem_motion::objects::job::JobEventKind;
 
 mod common;
 use common::counting::{arm, disarm, Counting};
@@ -209,7 +209,7 @@ impl Subject {
             .unwrap();
             assert!(axis
                 .status()
-                .has(tandem_motion::alarm::status_bit::HOMING_DONE));
+                .has(tandem_motion::catalog::alarm::status_bit::HOMING_DONE));
         }
         axis.step(2 * MS);
         while axis.pop_event().is_some() {}

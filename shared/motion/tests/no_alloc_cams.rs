@@ -7,19 +7,20 @@
 
 mod common;
 use common::counting::{arm, disarm, Counting};
-use tandem_motion::cam_track::{
+use tandem_motion::kinematics::cycle_motion::AxisMotion;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::kinematics::profile::{plan_position, Limits, Profile, State};
+use tandem_motion::objects::cam_track::{
     CamTrack, CamTrackConfig, CamTrackData, CamTrackMode, CamTrackType, McCamTrack, TrackCam,
     TrackOutputInterface,
 };
-use tandem_motion::measuring::{
-    AxisMotion, CyclicMode, InputEdge, InputEdges, MeasuringContext, MeasuringInput,
-    MeasuringInputConfig, SensorDirection, SimulatedSensor,
+use tandem_motion::objects::measuring::{
+    CyclicMode, MeasuringContext, MeasuringInput, MeasuringInputConfig,
 };
-use tandem_motion::modulo::Modulo;
-use tandem_motion::output_cam::{
+use tandem_motion::objects::output_cam::{
     CamDirection, CamEdges, McOutputCam, OutputCam, OutputCamConfig, OutputCamType,
 };
-use tandem_motion::profile::{plan_position, Limits, Profile, State};
+use tandem_motion::plant::sensor::{InputEdge, InputEdges, SensorDirection, SimulatedSensor};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;

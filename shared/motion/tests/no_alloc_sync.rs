@@ -17,18 +17,18 @@
 
 use std::sync::Arc;
 
-use tandem_motion::alarm::status_bit;
-use tandem_motion::axis::{
-    ApplicationMode, Axis, AxisConfig, AxisKind, AxisState, Command, StartMode, StopMode,
-    SyncDirection, SyncProfileReference, VelocityDirection,
-};
 use tandem_motion::cam::{
     BoundaryCondition, Cam, CamDefinition, Interpolation, MotionLaw, SegmentDef,
 };
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{JobEvent, JobEventKind, JobId};
-use tandem_motion::leading::LeaderId;
+use tandem_motion::catalog::alarm::status_bit;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::axis::{
+    ApplicationMode, Axis, AxisConfig, AxisKind, AxisState, Command, StartMode, StopMode,
+    SyncDirection, SyncProfileReference, VelocityDirection,
+};
+use tandem_motion::objects::job::{JobEvent, JobEventKind, JobId};
+use tandem_motion::objects::leading::LeaderId;
 
 mod common;
 use common::counting::{arm, disarm, Counting};

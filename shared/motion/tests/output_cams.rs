@@ -1,5 +1,6 @@
-//! Output cam TO and MC_OutputCam: the catalogue examples of seed 003 §9 (AT-OC-*), named after
-//! their ids, and property tests of the edge times against exact crossings of the profile.
+//! Output cam TO and MC_OutputCam: the known-answer cases AT-OC-* built from the examples and rules
+//! of the S7-1500T Measuring input and cam functions V5.0 function manual, named after their ids,
+//! and property tests of the edge times against exact crossings of the profile.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 #[path = "common/machine_limits.rs"]
@@ -7,15 +8,15 @@ mod machine_limits;
 use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use tandem_motion::alarm::AlarmId;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::measuring::AxisMotion;
-use tandem_motion::modulo::Modulo;
-use tandem_motion::output_cam::{
+use tandem_motion::catalog::alarm::AlarmId;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::cycle_motion::AxisMotion;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, State};
+use tandem_motion::objects::output_cam::{
     combine, max_hysteresis, CamDirection, CamEdges, Edge, LogicOperation, McOutputCam, OutputCam,
     OutputCamConfig, OutputCamMode, OutputCamParameters, OutputCamType, PositionType,
 };
-use tandem_motion::profile::{plan_position, plan_velocity, Limits, Profile, State};
 
 const MS: i64 = 1_000_000;
 

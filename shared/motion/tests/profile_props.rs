@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use proptest::prelude::*;
-use tandem_motion::profile::{plan_position, plan_velocity, Limits, Profile, State};
+use tandem_motion::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, State};
 
 /// Samples a profile densely (and at every segment boundary) and checks the limits and the
 /// continuity of p, v and a between samples.

@@ -3,7 +3,7 @@
 //! for how Siemens acc/dec semantics are mapped onto ruckig's signed limits.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use tandem_motion::profile::{plan_position, plan_velocity, Limits, State};
+use tandem_motion::kinematics::profile::{plan_position, plan_velocity, Limits, State};
 
 const FIXTURE: &str = include_str!("fixtures/ruckig_1dof.csv");
 

@@ -1,7 +1,8 @@
 //! Camming: MC_CamIn with offsets, scalings, application modes, the three synchronization
-//! references, MC_CamOut and the change to a pending cam at the end of a cycle (seed 001 §1.6,
-//! §3.2). Exact synchronism: once InSync the follower equals the cam function of the leading
-//! value in every cycle.
+//! references, MC_CamOut and the change to a pending cam at the end of a cycle (S7-1500T Motion
+//! Control V4.0 function manual, 3.5.7 'Camming' and 10.12.5
+//! 'MC_CamIn V4'). Exact synchronism: once InSync the follower equals the cam function of the
+//! leading value in every cycle.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod common;
@@ -9,14 +10,14 @@ mod common;
 use common::{dynamics, Pair, LEADER};
 use proptest::prelude::*;
 use std::sync::Arc;
-use tandem_motion::axis::{
+use tandem_motion::cam::{Cam, CamDefinition, Interpolation, MotionLaw, SegmentDef};
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::axis::{
     ApplicationMode, AxisConfig, AxisState, Command, SyncDirection, SyncProfileReference,
     VelocityDirection,
 };
-use tandem_motion::cam::{Cam, CamDefinition, Interpolation, MotionLaw, SegmentDef};
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::JobEventKind;
+use tandem_motion::objects::job::JobEventKind;
 
 /// Rise 0 -> 100 over 0..180 and return over 180..360 (5th-degree polynomial laws): cyclic.
 fn rise_return() -> Arc<Cam> {
@@ -384,8 +385,9 @@ fn line_cam() -> Arc<Cam> {
 
 #[test]
 fn reference_examples_slave_offset_and_sync_window() {
-    // Seed 000 §3.9 example 7 (in S7-1500 terms: SlaveOffset): the cam gives 70 at master 50;
-    // with a slave offset of 80 the follower is synchronous at 150 when the master is at 50.
+    // S7-Technology V4.1 function manual, 4.7.4 'Synchronization' example 7 (in S7-1500
+    // terms: SlaveOffset): the cam gives 70 at master 50; with a slave offset of 80 the follower is
+    // synchronous at 150 when the master is at 50.
     let mut p = pair();
     leader_runs(&mut p, 50.0);
     p.follower.provide_cam(1, line_cam());
@@ -397,8 +399,9 @@ fn reference_examples_slave_offset_and_sync_window() {
         ..CamIn::direct(ApplicationMode::Once)
     };
     let id = p.f(c.command()).unwrap();
-    // Seed 000 §3.9 examples 4/5 (S7-1500 terms): synchronizing over the 30 before the sync
-    // position, i.e. while the master moves 20 -> 50.
+    // S7-Technology V4.1 function manual, 4.7.4 'Synchronization' examples 4/5 (S7-1500
+    // terms): synchronizing over the 30 before the sync position, i.e. while the master moves 20 ->
+    // 50.
     let mut started = None;
     for _ in 0..3000 {
         p.step(1);

@@ -1,17 +1,19 @@
-//! Synchronous operation: MC_GearIn, MC_GearInPos, MC_GearOut, phasing (seed 001 §1.6, §3.2,
-//! table 2). A leader and a follower in one process, the leader stepped first (D = 0).
+//! Synchronous operation: MC_GearIn, MC_GearInPos, MC_GearOut, phasing (S7-1500T Motion Control
+//! V4.0 function manual, 3.5 'Synchronous axis technology object', 10.12 'Synchronous motion',
+//! 10.16.2 'Override response V4: Synchronous operation jobs'). A leader and a follower in one
+//! process, the leader stepped first (D = 0).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use proptest::prelude::*;
-use tandem_motion::alarm::{status_bit, AlarmId};
-use tandem_motion::axis::{
+use tandem_motion::catalog::alarm::{status_bit, AlarmId};
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{
     AxisConfig, AxisState, Command, Direction, StartMode, StopMode, SyncDirection,
     SyncProfileReference, VelocityDirection,
 };
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::JobEventKind;
-use tandem_motion::modulo::Modulo;
+use tandem_motion::objects::job::JobEventKind;
 
 mod common;
 use common::{dynamics, power, Pair, LEADER};
@@ -460,7 +462,7 @@ fn actual_value_coupling_compensates_the_leader_delay() {
     // by cycle (1 ms) + following time (3 ms) brings it back: at constant velocity the follower
     // coupled by actual value is where a setpoint-coupled one would be.
     let mut lc = AxisConfig::example(0.001);
-    lc.drive = tandem_motion::drive::DriveModel::Delay { delay: 0.004 };
+    lc.drive = tandem_motion::plant::drive::DriveModel::Delay { delay: 0.004 };
     lc.following_error.enable = false;
     lc.extrapolation.position_t1 = 0.002;
     lc.extrapolation.velocity_t1 = 0.005;
@@ -562,7 +564,8 @@ fn velocity_gearing_ignores_a_leader_position_jump_and_offsets_shift_the_followe
 
 #[test]
 fn superimposed_on_the_leader_moves_its_followers_and_exceedances_are_flagged() {
-    // Seed 001 §3.2 MC_MoveSuperimposed: on a leader it moves leader and followers.
+    // S7-1500T Motion Control V4.0 function manual, 10.9.1 'MC_MoveSuperimposed: Position axes
+    // overlapping V4': on a leader it moves leader and followers.
     let mut fc = AxisConfig::example(0.001);
     fc.following_error.enable = false;
     let mut p = Pair::new(AxisConfig::example(0.001), fc);
@@ -607,7 +610,7 @@ fn superimposed_on_the_leader_moves_its_followers_and_exceedances_are_flagged() 
 fn synchronized_motion_simulation_keeps_the_coupling_through_a_disable() {
     let mut fc = AxisConfig::example(0.001);
     fc.following_error.enable = false;
-    fc.drive = tandem_motion::drive::DriveModel::Delay { delay: 0.002 };
+    fc.drive = tandem_motion::plant::drive::DriveModel::Delay { delay: 0.002 };
     let mut p = Pair::new(AxisConfig::example(0.001), fc);
     let g = p.f(gear_in(1, 1)).unwrap();
     p.until(g, JobEventKind::InGear, 1000);
@@ -710,7 +713,7 @@ proptest! {
 /// Each reaction shows in ErrorDetail. The follower never jumps.
 #[test]
 fn a_missing_leading_value_raises_601_with_the_configured_reaction() {
-    use tandem_motion::alarm::Reaction;
+    use tandem_motion::catalog::alarm::Reaction;
     for configured in [
         None,
         Some(Reaction::StopCurrentDynamics),

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use rsruckig::prelude::*;
-use tandem_motion::profile::{plan_position, plan_velocity, Limits, State};
+use tandem_motion::kinematics::profile::{plan_position, plan_velocity, Limits, State};
 
 struct Rng(u64);
 impl Rng {

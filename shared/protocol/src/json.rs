@@ -7,7 +7,7 @@ use crate::wire::{
     JOB_ERROR, JOB_REACHED, OUTCOME_ACCEPTED, OUTCOME_BUSY, OUTCOME_INVALID, OUTCOME_REJECTED,
 };
 use serde::{Deserialize, Serialize};
-use tandem_motion::error_id::ErrorId;
+use tandem_motion::catalog::error_id::ErrorId;
 
 /// The binary form of a leading value between hosts (fixed-width integers: 64 bytes).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]

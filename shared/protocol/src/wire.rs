@@ -3,10 +3,10 @@
 //! (`IncompatibleTypes`) instead of misreading it.
 
 use iceoryx2::prelude::ZeroCopySend;
-use tandem_motion::axis::{AxisState, AxisStatus};
-use tandem_motion::job::JobEventKind;
-use tandem_motion::leading::LeadingSample;
-use tandem_motion::modulo::Modulo;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{AxisState, AxisStatus};
+use tandem_motion::objects::job::JobEventKind;
+use tandem_motion::objects::leading::LeadingSample;
 
 /// [`LeadingValueSample::status`] bit: the value is valid.
 pub const LV_VALID: u32 = 1;

@@ -3,7 +3,7 @@
 
 use std::fmt;
 use std::io;
-use tandem_motion::error_id::ErrorId;
+use tandem_motion::catalog::error_id::ErrorId;
 
 /// A technology object whose configuration the engine refuses, when an
 /// [`Executive`](crate::exec::Executive) is created: which object, and the engine's reason.
@@ -14,7 +14,7 @@ pub enum ExecError {
         /// Its name.
         name: String,
         /// The engine's reason.
-        reason: tandem_motion::axis::ConfigError,
+        reason: tandem_motion::objects::axis::AxisConfigError,
     },
     /// An external encoder.
     Encoder {
@@ -30,7 +30,7 @@ pub enum ExecError {
         /// Its name.
         name: String,
         /// The engine's reason.
-        reason: tandem_motion::measuring::ConfigError,
+        reason: tandem_motion::objects::measuring::MeasuringConfigError,
     },
 }
 

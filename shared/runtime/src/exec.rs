@@ -22,13 +22,13 @@ use std::sync::Arc;
 use tandem_config::{
     AxisIndex, Cell, Coupling, EncoderIndex, EncoderSource, Leader, LEADING_BUFFER,
 };
-use tandem_motion::action::Action;
-use tandem_motion::axis::{Axis, AxisStatus, CamId, Command};
 use tandem_motion::cam::{Cam, CamDefinition};
-use tandem_motion::encoder::{EncoderStatus, ExternalEncoder};
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{Instruction, JobEvent, JobId};
-use tandem_motion::leading::{
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::objects::action::Action;
+use tandem_motion::objects::axis::{Axis, AxisStatus, CamId, Command};
+use tandem_motion::objects::encoder::{EncoderStatus, ExternalEncoder};
+use tandem_motion::objects::job::{Instruction, JobEvent, JobId};
+use tandem_motion::objects::leading::{
     LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
 
@@ -852,7 +852,7 @@ impl<'c> Executive<'c> {
             let (a, distance, input) = self.objects.out.corrections[k];
             let command = Command::MoveSuperimposed {
                 distance,
-                dynamics: tandem_motion::dynamics::Dynamics::DEFAULT,
+                dynamics: tandem_motion::kinematics::dynamics::Dynamics::DEFAULT,
             };
             self.commands += 1;
             writeln!(

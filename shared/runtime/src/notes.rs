@@ -2,7 +2,7 @@
 //! in fixed-capacity lists, and the log's formatting of times and job events.
 
 use std::fmt;
-use tandem_motion::job::{Instruction, JobEventKind, JobId};
+use tandem_motion::objects::job::{Instruction, JobEventKind, JobId};
 
 /// Formats ns as seconds with 9 decimals, exactly.
 pub fn seconds(t_ns: i64) -> String {

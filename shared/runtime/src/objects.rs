@@ -5,20 +5,21 @@ use crate::error::ExecError;
 use crate::notes::{keep, seconds, Describe, IoNote, Secs, NOTES};
 use std::io::{self, Write};
 use tandem_config::{AxisIndex, CamTrackEntry, Cell, MeasuringInputEntry, OutputCamEntry};
-use tandem_motion::action::Action;
-use tandem_motion::alarm::AlarmInstance;
-use tandem_motion::axis::AxisStatus;
-use tandem_motion::cam_track::{CamTrack, CamTrackMode, McCamTrack};
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{JobEventKind, JobId};
-use tandem_motion::measuring::{
-    AxisMotion, InputEdge, InputEdges, MeasuringInput, MeasuringJobKind, MeasuringState,
-    MeasuringWindow, SimulatedSensor,
+use tandem_motion::catalog::alarm::AlarmInstance;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::cycle_motion::AxisMotion;
+use tandem_motion::kinematics::profile::State;
+use tandem_motion::objects::action::Action;
+use tandem_motion::objects::axis::AxisStatus;
+use tandem_motion::objects::cam_track::{CamTrack, CamTrackMode, McCamTrack};
+use tandem_motion::objects::job::{JobEventKind, JobId};
+use tandem_motion::objects::measuring::{
+    MeasuringInput, MeasuringJobKind, MeasuringState, MeasuringWindow,
 };
-use tandem_motion::output_cam::{
+use tandem_motion::objects::output_cam::{
     CamDirection, CamEdges, McOutputCam, OutputCam, OutputCamMode, PositionType,
 };
-use tandem_motion::profile::State;
+use tandem_motion::plant::sensor::{InputEdge, InputEdges, SimulatedSensor};
 
 /// The per-output-cam columns of the trace, in order (prefixed with `<output cam>.`).
 pub const OUTPUT_CAM_COLUMNS: &[&str] = &["output", "last_edge_s"];
@@ -69,7 +70,7 @@ pub(crate) fn cycle_motion(
     now: &AxisStatus,
     t0: i64,
     t1: i64,
-    modulo: Option<tandem_motion::modulo::Modulo>,
+    modulo: Option<tandem_motion::kinematics::modulo::Modulo>,
     homing: bool,
 ) -> CycleMotion {
     let dt = (t1 - t0) as f64 * 1e-9;
@@ -95,7 +96,7 @@ pub(crate) fn cycle_motion(
             m
         }
     };
-    let enabled = now.has(tandem_motion::alarm::status_bit::ENABLE);
+    let enabled = now.has(tandem_motion::catalog::alarm::status_bit::ENABLE);
     let setpoint = build(
         State {
             p: prev.position_unwrapped,
@@ -525,7 +526,7 @@ fn step_kind<T: CycleObject>(
 fn refused<'n>(
     kind: &'static str,
     name: &'n str,
-) -> impl FnOnce(tandem_motion::measuring::ConfigError) -> ExecError + 'n {
+) -> impl FnOnce(tandem_motion::objects::measuring::MeasuringConfigError) -> ExecError + 'n {
     move |reason| ExecError::Object {
         kind,
         name: name.to_string(),
@@ -691,7 +692,7 @@ impl Objects {
         mode: i32,
         window: Option<(f64, f64)>,
     ) -> Result<(), ErrorId> {
-        use tandem_motion::measuring::{CyclicMode, MeasuringContext, OneTimeMode};
+        use tandem_motion::objects::measuring::{CyclicMode, MeasuringContext, OneTimeMode};
         let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
         let window = window.map(|(start, end)| MeasuringWindow { start, end });
         let ctx = MeasuringContext {

@@ -11,8 +11,8 @@ pub use crate::notes::{seconds, Secs};
 use std::io::{self, Write};
 use tandem_config::script::Script;
 use tandem_config::Cell;
-use tandem_motion::axis::AxisStatus;
-use tandem_motion::encoder::EncoderStatus;
+use tandem_motion::objects::axis::AxisStatus;
+use tandem_motion::objects::encoder::EncoderStatus;
 
 /// The per-axis columns of the trace, in order (prefixed with `<axis>.`).
 pub const AXIS_COLUMNS: &[&str] = &[
@@ -88,7 +88,7 @@ pub fn write_row(
         )?;
     }
     for e in encoders {
-        let state = if e.has(tandem_motion::alarm::status_bit::ENABLE) {
+        let state = if e.has(tandem_motion::catalog::alarm::status_bit::ENABLE) {
             "Enabled"
         } else {
             "Disabled"

@@ -2,8 +2,8 @@
 //! ([`Rig`]), and a leader with a synchronous follower stepped together ([`Pair`]).
 //!
 //! ```
-//! use tandem_motion::axis::{AxisConfig, Command};
-//! use tandem_motion::job::JobEventKind;
+//! use tandem_motion::objects::axis::{AxisConfig, Command};
+//! use tandem_motion::objects::job::JobEventKind;
 //! use tandem_testkit::rig::{dynamics, Rig};
 //!
 //! let mut rig = Rig::enabled(AxisConfig::example(0.001));
@@ -17,11 +17,13 @@
 //! assert!(done > 0.1 && done < 0.5, "done at {done} s");
 //! ```
 
-use tandem_motion::axis::{Axis, AxisConfig, AxisKind, AxisStatus, Command, StartMode, StopMode};
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{JobEvent, JobEventKind, JobId};
-use tandem_motion::leading::LeadingValue;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::axis::{
+    Axis, AxisConfig, AxisKind, AxisStatus, Command, StartMode, StopMode,
+};
+use tandem_motion::objects::job::{JobEvent, JobEventKind, JobId};
+use tandem_motion::objects::leading::LeadingValue;
 
 /// One cycle of the rig: 1 ms, in ns.
 pub const MS: i64 = 1_000_000;

@@ -14,7 +14,7 @@
 //! ```
 
 use proptest::prelude::*;
-use tandem_motion::profile::Limits;
+use tandem_motion::kinematics::profile::Limits;
 
 /// Jerk-limited dynamics of a machine axis: velocity 50..400/s, acceleration and deceleration
 /// 500..5000/s², jerk 5,000..200,000/s³.

@@ -637,8 +637,8 @@ fn print_table(outcomes: &[Outcome], seconds: f64, with_log: bool) {
          end of the run; `before`: just before it. steal%: the hypervisor's steal over the run, in % of both CPUs' \
          time (from /proc/stat). An AxisStatus is {} bytes; with a log or \
          trace the node keeps 256 rows of them (N x {} KiB).",
-        core::mem::size_of::<tandem_motion::axis::AxisStatus>(),
-        256 * core::mem::size_of::<tandem_motion::axis::AxisStatus>() / 1024
+        core::mem::size_of::<tandem_motion::objects::axis::AxisStatus>(),
+        256 * core::mem::size_of::<tandem_motion::objects::axis::AxisStatus>() / 1024
     );
 }
 

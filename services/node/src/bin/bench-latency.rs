@@ -24,7 +24,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use std::process::{Child, ExitCode, Stdio};
 use std::time::{Duration, Instant};
-use tandem_motion::leading::{LeadingSample, LeadingValue, LeadingValueBuffer};
+use tandem_motion::objects::leading::{LeadingSample, LeadingValue, LeadingValueBuffer};
 use tandem_protocol::ipc as tipc;
 use tandem_protocol::wire::LeadingValueSample;
 use tandem_rt as rt;

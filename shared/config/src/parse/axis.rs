@@ -3,15 +3,15 @@
 use super::{pick, FieldError};
 use crate::error::Problem;
 use crate::schema::{AxisSection, ExtrapolationSection, HomingSection};
-use tandem_motion::alarm::Reaction;
-use tandem_motion::axis::{
+use tandem_motion::catalog::alarm::Reaction;
+use tandem_motion::kinematics::dynamics::{DynamicDefaults, DynamicLimits};
+use tandem_motion::kinematics::extrapolation::{ExtrapolationConfig, VelocityMode};
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::axis::{
     AxisConfig, AxisKind, EncoderType, FollowingErrorMonitoring, HomingConfig, HomingMark,
     MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
 };
-use tandem_motion::drive::{DriveModel, Plant, ZeroMark};
-use tandem_motion::dynamics::{DynamicDefaults, DynamicLimits};
-use tandem_motion::extrapolation::{ExtrapolationConfig, VelocityMode};
-use tandem_motion::modulo::Modulo;
+use tandem_motion::plant::drive::{DriveModel, Plant, ZeroMark};
 
 /// The encoder types by name.
 pub(super) const ENCODER_TYPES: [(&str, EncoderType); 2] = [

@@ -5,8 +5,8 @@ use super::{node_named, pick, Ctx};
 use crate::cell::{AxisEntry, AxisIndex, EncoderEntry, EncoderSource, LeadingValueConfig, Node};
 use crate::error::{ConfigError, Problem};
 use crate::schema::{CellFile, EncoderSection};
-use tandem_motion::encoder::EncoderConfig;
-use tandem_motion::modulo::Modulo;
+use tandem_motion::kinematics::modulo::Modulo;
+use tandem_motion::objects::encoder::EncoderConfig;
 
 /// Every external encoder (after the axes: a source may name one). Leading values follow.
 pub(super) fn encoders(

@@ -299,7 +299,7 @@ fn axes(cx: Ctx<'_>, raw: &CellFile, nodes: &[Node]) -> Result<Vec<AxisEntry>, C
         config.validate().map_err(|e| {
             let mut path = vec!["axes", name.as_str()];
             path.extend(e.field.split('.'));
-            cx.at_or_table(&path, Problem::Invalid(e.problem))
+            cx.at_or_table(&path, Problem::Axis(e.problem))
         })?;
         axes.push(AxisEntry {
             name: name.clone(),

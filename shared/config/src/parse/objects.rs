@@ -11,15 +11,14 @@ use crate::schema::{
     CamTrackSection, CellFile, MeasuringInputSection, OutputCamSection, RegistrationSection,
     SensorSection, TrackCamSection,
 };
-use tandem_motion::cam_track::{
+use tandem_motion::objects::cam_track::{
     CamTrack, CamTrackConfig, CamTrackData, CamTrackType, TrackCam, TrackOutputInterface, MAX_CAMS,
 };
-use tandem_motion::measuring::{
-    MeasuringInput, MeasuringInputConfig, MeasuringRoute, SensorDirection,
-};
-use tandem_motion::output_cam::{
+use tandem_motion::objects::measuring::{MeasuringInput, MeasuringInputConfig, MeasuringRoute};
+use tandem_motion::objects::output_cam::{
     OutputCamConfig, OutputCamParameters, OutputCamType, PositionType,
 };
+use tandem_motion::plant::sensor::SensorDirection;
 
 /// The output cams, cam tracks and measuring inputs of a cell.
 pub(super) struct Objects {

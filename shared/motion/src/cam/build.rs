@@ -1,7 +1,8 @@
 //! `MC_InterpolateCam`: from a [`CamDefinition`] to the pieces of a [`Cam`] (allocating, off
 //! the cyclic path).
 //!
-//! Steps (seed 001 §1.11, seed 000 §3.5):
+//! Steps (S7-1500T Motion Control V4.0 function manual, 3.10 'Cam technology object', S7-Technology
+//! V4.1 function manual, 3.5 '"Cam disk" technology object'):
 //! 1. validate (finite, `|v| ≤ 1e12`, `x0 < x1`, law parameters);
 //! 2. segments in definition order: a later segment is used in full, an earlier one keeps only
 //!    what lies outside it, however narrow;

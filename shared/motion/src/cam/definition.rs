@@ -1,6 +1,7 @@
 //! The definition of a cam: interpolation points, segments and interpolation settings (the CAL
-//! tags `Point[]`, `Segment[]` and `InterpolationSettings` of the S7-1500T cam TO, seed 001
-//! §1.11), as plain data without serde. The config crate maps its TOML onto these types.
+//! tags `Point[]`, `Segment[]` and `InterpolationSettings` of the S7-1500T cam TO, S7-1500T Motion
+//! Control V4.0 function manual, 3.10 'Cam technology object'), as plain data without serde. The
+//! config crate maps its TOML onto these types.
 
 use super::MotionLaw;
 
@@ -33,12 +34,13 @@ pub enum SegmentDef {
         /// Following value at `x1`.
         y1: f64,
     },
-    /// The S7-1500T technology-DB segment (`<TO>.Segment[i]`, seed 001 §A.7.4):
-    /// `y = a0 + a1·x + … + a6·x⁶ + sineAmplitude·sin(2π·x/sinePeriod + sinePhase)` with `x`
-    /// the **absolute** leading value. This is a literal reading of the tag descriptions
-    /// ("coefficient for xᵏ", "period length", "phase offset \[rad\]"); the manual's formula
-    /// itself is not in the reference text, so treat the sine part as unverified. With
-    /// `sine_amplitude = 0` the period is ignored; otherwise it must be non-zero.
+    /// The S7-1500T technology-DB segment (`<TO>.Segment[i]`, S7-1500T Motion Control V4.0 function
+    /// manual, A.7.4 'Segment tags (cam)'): `y = a0 + a1·x + … + a6·x⁶ +
+    /// sineAmplitude·sin(2π·x/sinePeriod + sinePhase)` with `x` the **absolute** leading value.
+    /// This is a literal reading of the tag descriptions ("coefficient for xᵏ", "period length",
+    /// "phase offset \[rad\]"); the manual's formula itself is not in the reference text, so treat
+    /// the sine part as unverified. With `sine_amplitude = 0` the period is ignored; otherwise it
+    /// must be non-zero.
     #[doc(alias = "Segment")]
     S7Polynomial {
         /// `xmin`.
@@ -181,7 +183,8 @@ impl BoundaryCondition {
 /// Everything [`super::Cam::interpolate`] needs: the input of `MC_InterpolateCam`.
 ///
 /// Order matters: among points with the same `x` the **last** one wins, and a later segment
-/// overwrites an earlier one where they overlap (seed 001 §1.11).
+/// overwrites an earlier one where they overlap (S7-1500T Motion Control V4.0 function manual, 3.10
+/// 'Cam technology object').
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CamDefinition {
     /// Interpolation points `(x, y)` in any order.

@@ -1,6 +1,8 @@
 //! The cam technology object: a transfer function `y = f(x)` from the leading value `x` to the
 //! following value `y`, defined by interpolation points and segments and closed by
-//! interpolation (seed 001 §1.11, seed 000 §3.5; the user guide is `docs/cams.md`).
+//! interpolation (S7-1500T Motion Control V4.0 function manual, 3.10 'Cam technology object',
+//! S7-Technology V4.1 function manual, 3.5 '"Cam disk" technology object'; the user guide is
+//! `docs/cams.md`).
 //!
 //! * [`CamDefinition`]: points, [`SegmentDef`]s (polynomials, VDI 2143 [`MotionLaw`]s, the S7
 //!   technology-DB polynomial), [`Interpolation`] and [`BoundaryCondition`]; plain data.
@@ -11,7 +13,8 @@
 //!   closed-form piece.
 //! * [`parse_csv`] reads `x,y` point lists.
 //!
-//! # Rules (seed 001 §1.11, seed 000 §3.5)
+//! # Rules (S7-1500T Motion Control V4.0 function manual, 3.10 'Cam technology object',
+//! S7-Technology V4.1 function manual, 3.5 '"Cam disk" technology object')
 //!
 //! * Points may come in any order; among points with equal `x` the last one wins.
 //! * Overlapping segments: the later segment is used in full; the earlier one keeps its parts
@@ -62,7 +65,7 @@
 
 use core::fmt;
 
-use crate::error_id::ErrorId;
+use crate::catalog::error_id::ErrorId;
 
 mod build;
 mod csv;
@@ -80,8 +83,9 @@ use inverse::Run;
 use piece::{Formula, Piece};
 
 /// Gaps (in x) between segments up to this width are closed by pulling the ends together;
-/// points this close to a segment are dropped; larger gaps get a transition (seed 001 §1.11,
-/// the `1.0E-4` of `MC_InterpolateCam`).
+/// points this close to a segment are dropped; larger gaps get a transition (S7-1500T Motion
+/// Control V4.0 function manual, 3.10 'Cam technology object', the `1.0E-4` of
+/// `MC_InterpolateCam`).
 pub const GAP_THRESHOLD: f64 = 1e-4;
 
 /// Largest magnitude of an x or y value (the `-1.0E12 to 1.0E12` range of the S7 cam tags).
@@ -135,7 +139,8 @@ pub enum CamError {
 }
 
 impl CamError {
-    /// The ErrorID of the S7 instruction (seed 001 §5.3).
+    /// The ErrorID of the S7 instruction (S7-1500T Motion Control V4.0 function manual, A.9 'Error
+    /// ID for Motion Control instructions').
     pub const fn error_id(self) -> ErrorId {
         match self {
             CamError::Empty => ErrorId::CamEmpty,
@@ -390,11 +395,11 @@ impl Cam {
 
     /// `MC_GetCamLeadingValue`: a leading value `x` with `f(x) = y`. When several exist the one
     /// nearest to `approach` is returned, and of two equally near (within `1e-12` relative) the
-    /// lower one (seed 000 §3.5, MC_GetCamPoint Mode 1); `approach` may lie outside the cam.
-    /// Where the cam is constant at `y` over an interval, the point of that interval nearest to
-    /// `approach`. No solution (also a `y` inside a jump) gives [`CamError::NoLeadingValue`]
-    /// (`16#8063`); a non-finite `approach` [`CamError::IllegalApproachLeadingValue`]
-    /// (`16#8062`).
+    /// lower one (S7-Technology V4.1 function manual, 3.5 '"Cam disk" technology object',
+    /// MC_GetCamPoint Mode 1); `approach` may lie outside the cam. Where the cam is constant at `y`
+    /// over an interval, the point of that interval nearest to `approach`. No solution (also a `y`
+    /// inside a jump) gives [`CamError::NoLeadingValue`] (`16#8063`); a non-finite `approach`
+    /// [`CamError::IllegalApproachLeadingValue`] (`16#8062`).
     ///
     /// Monotonic cams: binary search, O(log n); otherwise every monotonic run is checked
     /// (O(n), pruned by distance). The root is found by Newton's method inside the run's

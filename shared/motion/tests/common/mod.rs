@@ -4,11 +4,13 @@
 
 pub mod counting;
 
-use tandem_motion::axis::{Axis, AxisConfig, AxisKind, AxisStatus, Command, StartMode, StopMode};
-use tandem_motion::dynamics::Dynamics;
-use tandem_motion::error_id::ErrorId;
-use tandem_motion::job::{JobEvent, JobEventKind, JobId};
-use tandem_motion::leading::LeadingValue;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::axis::{
+    Axis, AxisConfig, AxisKind, AxisStatus, Command, StartMode, StopMode,
+};
+use tandem_motion::objects::job::{JobEvent, JobEventKind, JobId};
+use tandem_motion::objects::leading::LeadingValue;
 
 pub const MS: i64 = 1_000_000;
 

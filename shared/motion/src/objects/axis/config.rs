@@ -1,11 +1,12 @@
 //! Configuration of an axis technology object (the "technology DB" start values).
 
-use crate::drive::{DriveModel, Plant};
-use crate::dynamics::{DynamicDefaults, DynamicLimits};
-use crate::extrapolation::ExtrapolationConfig;
-use crate::modulo::Modulo;
+use crate::kinematics::dynamics::{DynamicDefaults, DynamicLimits};
+use crate::kinematics::extrapolation::ExtrapolationConfig;
+use crate::kinematics::modulo::Modulo;
+use crate::plant::drive::{DriveModel, Plant};
 
-/// Speed, positioning or synchronous axis (seed 001 §1.4 to §1.6).
+/// Speed, positioning or synchronous axis (S7-1500T Motion Control V4.0 function manual,
+/// 3.3 'Speed-controlled axis technology object', 3.5 'Synchronous axis technology object').
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum AxisKind {
     /// `TO_SpeedAxis`: velocity setpoints only, no position control, no homing.
@@ -119,7 +120,8 @@ impl Default for HomingConfig {
     }
 }
 
-/// `PositioningMonitoring.*` (seed 001 §4.6).
+/// `PositioningMonitoring.*` (S7-1500T Motion Control V4.0 function manual, 3.2.10.2 'Positioning
+/// monitoring').
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct PositioningMonitoring {
     /// `Window` (>= 0).
@@ -130,7 +132,8 @@ pub struct PositioningMonitoring {
     pub min_dwell_time: f64,
 }
 
-/// `FollowingError.*` (seed 001 §4.7).
+/// `FollowingError.*` (S7-1500T Motion Control V4.0 function manual, 3.2.10.3 'Following error
+/// monitoring').
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct FollowingErrorMonitoring {
     /// `EnableMonitoring`.
@@ -145,7 +148,8 @@ pub struct FollowingErrorMonitoring {
     pub warning_level: f64,
 }
 
-/// `StandstillSignal.*` (seed 001 §4.8).
+/// `StandstillSignal.*` (S7-1500T Motion Control V4.0 function manual, 3.2.10.4 'Standstill
+/// signal').
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct StandstillSignal {
     /// `VelocityThreshold`.
@@ -154,7 +158,8 @@ pub struct StandstillSignal {
     pub min_dwell_time: f64,
 }
 
-/// `PositionLimits_SW.*` (active when present; seed 001 §4.5).
+/// `PositionLimits_SW.*` (active when present; S7-1500T Motion Control V4.0 function manual,
+/// 3.2.7.3 'Software limit switch').
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct SoftwareLimits {
     /// `MinPosition`.
@@ -174,8 +179,9 @@ pub struct AxisConfig {
     pub modulo: Option<Modulo>,
     /// Encoder type.
     pub encoder: EncoderType,
-    /// Virtual axis / simulation mode (seed 001 §7): homing completes at once without motion,
-    /// hardware limit switches have no effect.
+    /// Virtual axis / simulation mode (S7-1500T Motion Control V4.0 function manual, 3.2.5.7 'Axis
+    /// in simulation'): homing completes at once without motion, hardware limit switches have no
+    /// effect.
     pub virtual_axis: bool,
     /// Servo cycle (s, > 0).
     pub cycle: f64,
@@ -207,53 +213,122 @@ pub struct AxisConfig {
     /// The reaction to alarm 601 when a leading value is missing (a leader on another node that
     /// stopped publishing): stop with the current or the maximum dynamics (default, the table
     /// value), emergency stop, or remove the enable. `None`: the table value.
-    pub leader_missing_reaction: Option<crate::alarm::Reaction>,
+    pub leader_missing_reaction: Option<crate::catalog::alarm::Reaction>,
+}
+
+/// What is wrong with a value of an [`AxisConfig`] (see [`AxisConfigError`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum AxisConfigProblem {
+    /// Not a positive number.
+    NotPositive,
+    /// Negative or not a number.
+    Negative,
+    /// Not a finite number.
+    NotFinite,
+    /// A reaction that does not stop the follower when its leading value is missing.
+    LeaderMissingMustStop,
+    /// The default exceeds `max_velocity`.
+    ExceedsMaxVelocity,
+    /// The default exceeds `max_acceleration`.
+    ExceedsMaxAcceleration,
+    /// The default exceeds `max_deceleration`.
+    ExceedsMaxDeceleration,
+    /// The default exceeds `max_jerk`.
+    ExceedsMaxJerk,
+    /// A modulo setting on a speed axis.
+    SpeedAxisModulo,
+    /// The upper software limit is not above the lower one (alarm 104).
+    SoftwareLimitsReversed,
+    /// Software limit switches on a modulo axis (not supported yet).
+    SoftwareLimitsOnModulo,
+    /// The maximum following error is below the minimum.
+    FollowingErrorMaxBelowMin,
+    /// A warning level outside 0..=100 %.
+    WarningLevelOutOfRange,
+    /// A velocity precontrol outside 0..=150 %.
+    KpcOutOfRange,
+    /// A reference cam whose high end is not above its low end.
+    ReferenceCamReversed,
+    /// The upper hardware limit switch is not above the lower one.
+    HardwareLimitsReversed,
+}
+
+impl AxisConfigProblem {
+    /// The problem in words, as the configuration's error messages show it.
+    pub const fn text(self) -> &'static str {
+        match self {
+            Self::NotPositive => "must be a positive number",
+            Self::Negative => "must be zero or a positive number",
+            Self::NotFinite => "must be a finite number",
+            Self::LeaderMissingMustStop => "a follower without its leading value must stop: stop_current_dynamics, stop_max_dynamics, emergency_stop or remove_enable",
+            Self::ExceedsMaxVelocity => "exceeds max_velocity",
+            Self::ExceedsMaxAcceleration => "exceeds max_acceleration",
+            Self::ExceedsMaxDeceleration => "exceeds max_deceleration",
+            Self::ExceedsMaxJerk => "exceeds max_jerk",
+            Self::SpeedAxisModulo => "a speed axis has no modulo",
+            Self::SoftwareLimitsReversed => "must be greater than sw_limits.min (alarm 104)",
+            Self::SoftwareLimitsOnModulo => "software limit switches on a modulo axis are not supported yet",
+            Self::FollowingErrorMaxBelowMin => "must not be less than following_error.min_value",
+            Self::WarningLevelOutOfRange => "must be between 0 and 100 (%)",
+            Self::KpcOutOfRange => "must be between 0 and 150 %",
+            Self::ReferenceCamReversed => "must be [low, high] with high > low",
+            Self::HardwareLimitsReversed => "must be greater than plant.hw_limit_min",
+        }
+    }
+}
+
+impl core::fmt::Display for AxisConfigProblem {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.text())
+    }
 }
 
 /// A configuration value that is not acceptable: which field, and why.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub struct ConfigError {
+pub struct AxisConfigError {
     /// The key, as in the cell file (e.g. `dynamics.max_velocity`).
     pub field: &'static str,
     /// What is wrong with it.
-    pub problem: &'static str,
+    pub problem: AxisConfigProblem,
 }
 
-impl core::fmt::Display for ConfigError {
+impl core::fmt::Display for AxisConfigError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(f, "{}: {}", self.field, self.problem)
     }
 }
 
-fn positive(field: &'static str, x: f64) -> Result<(), ConfigError> {
+impl std::error::Error for AxisConfigError {}
+
+fn positive(field: &'static str, x: f64) -> Result<(), AxisConfigError> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
-        Err(ConfigError {
+        Err(AxisConfigError {
             field,
-            problem: "must be a positive number",
+            problem: AxisConfigProblem::NotPositive,
         })
     }
 }
 
-fn non_negative(field: &'static str, x: f64) -> Result<(), ConfigError> {
+fn non_negative(field: &'static str, x: f64) -> Result<(), AxisConfigError> {
     if x.is_finite() && x >= 0.0 {
         Ok(())
     } else {
-        Err(ConfigError {
+        Err(AxisConfigError {
             field,
-            problem: "must be zero or a positive number",
+            problem: AxisConfigProblem::Negative,
         })
     }
 }
 
-fn finite(field: &'static str, x: f64) -> Result<(), ConfigError> {
+fn finite(field: &'static str, x: f64) -> Result<(), AxisConfigError> {
     if x.is_finite() {
         Ok(())
     } else {
-        Err(ConfigError {
+        Err(AxisConfigError {
             field,
-            problem: "must be a finite number",
+            problem: AxisConfigProblem::NotFinite,
         })
     }
 }
@@ -313,17 +388,31 @@ impl AxisConfig {
     }
 
     /// Checks every value; the first problem found is returned with the key that has it.
-    pub fn validate(&self) -> Result<(), ConfigError> {
+    pub fn validate(&self) -> Result<(), AxisConfigError> {
         positive("cycle", self.cycle)?;
         if matches!(
             self.leader_missing_reaction,
-            Some(crate::alarm::Reaction::None | crate::alarm::Reaction::TrackSetpoints)
+            Some(
+                crate::catalog::alarm::Reaction::None
+                    | crate::catalog::alarm::Reaction::TrackSetpoints
+            )
         ) {
-            return Err(ConfigError {
+            return Err(AxisConfigError {
                 field: "leader_missing_reaction",
-                problem: "a follower without its leading value must stop: stop_current_dynamics, stop_max_dynamics, emergency_stop or remove_enable",
+                problem: AxisConfigProblem::LeaderMissingMustStop,
             });
         }
+        self.validate_dynamics()?;
+        self.validate_ranges()?;
+        self.validate_monitoring()?;
+        self.validate_homing_and_drive()?;
+        self.validate_plant()?;
+        self.validate_extrapolation()?;
+        Ok(())
+    }
+
+    /// The dynamic limits and defaults: positive, the defaults within the limits.
+    fn validate_dynamics(&self) -> Result<(), AxisConfigError> {
         positive("dynamics.max_velocity", self.limits.max_velocity)?;
         positive("dynamics.max_acceleration", self.limits.max_acceleration)?;
         positive("dynamics.max_deceleration", self.limits.max_deceleration)?;
@@ -337,36 +426,41 @@ impl AxisConfig {
             self.defaults.emergency_deceleration,
         )?;
         if self.defaults.velocity > self.limits.max_velocity {
-            return Err(ConfigError {
+            return Err(AxisConfigError {
                 field: "dynamics.velocity",
-                problem: "exceeds max_velocity",
+                problem: AxisConfigProblem::ExceedsMaxVelocity,
             });
         }
         if self.defaults.acceleration > self.limits.max_acceleration {
-            return Err(ConfigError {
+            return Err(AxisConfigError {
                 field: "dynamics.acceleration",
-                problem: "exceeds max_acceleration",
+                problem: AxisConfigProblem::ExceedsMaxAcceleration,
             });
         }
         if self.defaults.deceleration > self.limits.max_deceleration {
-            return Err(ConfigError {
+            return Err(AxisConfigError {
                 field: "dynamics.deceleration",
-                problem: "exceeds max_deceleration",
+                problem: AxisConfigProblem::ExceedsMaxDeceleration,
             });
         }
         if self.defaults.jerk > self.limits.max_jerk {
-            return Err(ConfigError {
+            return Err(AxisConfigError {
                 field: "dynamics.jerk",
-                problem: "exceeds max_jerk",
+                problem: AxisConfigProblem::ExceedsMaxJerk,
             });
         }
+        Ok(())
+    }
+
+    /// The modulo range and the software limit switches.
+    fn validate_ranges(&self) -> Result<(), AxisConfigError> {
         if let Some(m) = self.modulo {
             finite("modulo.start", m.start)?;
             positive("modulo.length", m.length)?;
             if self.kind == AxisKind::Speed {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "modulo",
-                    problem: "a speed axis has no modulo",
+                    problem: AxisConfigProblem::SpeedAxisModulo,
                 });
             }
         }
@@ -374,18 +468,23 @@ impl AxisConfig {
             finite("sw_limits.min", sw.min)?;
             finite("sw_limits.max", sw.max)?;
             if sw.max <= sw.min {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "sw_limits.max",
-                    problem: "must be greater than sw_limits.min (alarm 104)",
+                    problem: AxisConfigProblem::SoftwareLimitsReversed,
                 });
             }
             if self.modulo.is_some() {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "sw_limits",
-                    problem: "software limit switches on a modulo axis are not supported yet",
+                    problem: AxisConfigProblem::SoftwareLimitsOnModulo,
                 });
             }
         }
+        Ok(())
+    }
+
+    /// Positioning, following error and standstill monitoring.
+    fn validate_monitoring(&self) -> Result<(), AxisConfigError> {
         non_negative("positioning.window", self.positioning.window)?;
         non_negative(
             "positioning.tolerance_time",
@@ -401,15 +500,15 @@ impl AxisConfig {
             positive("following_error.max_value", fe.max_value)?;
             non_negative("following_error.min_velocity", fe.min_velocity)?;
             if fe.max_value < fe.min_value {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "following_error.max_value",
-                    problem: "must not be less than following_error.min_value",
+                    problem: AxisConfigProblem::FollowingErrorMaxBelowMin,
                 });
             }
             if !(0.0..=100.0).contains(&fe.warning_level) {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "following_error.warning_level",
-                    problem: "must be between 0 and 100 (%)",
+                    problem: AxisConfigProblem::WarningLevelOutOfRange,
                 });
             }
         }
@@ -418,6 +517,11 @@ impl AxisConfig {
             self.standstill.velocity_threshold,
         )?;
         non_negative("standstill.min_dwell_time", self.standstill.min_dwell_time)?;
+        Ok(())
+    }
+
+    /// The homing velocities and positions, the drive model.
+    fn validate_homing_and_drive(&self) -> Result<(), AxisConfigError> {
         positive("homing.approach_velocity", self.homing.approach_velocity)?;
         positive(
             "homing.referencing_velocity",
@@ -433,19 +537,24 @@ impl AxisConfig {
             DriveModel::PositionLoop { kv, kpc, t_vtc } => {
                 positive("drive.kv", kv)?;
                 if !(0.0..=1.5).contains(&kpc) {
-                    return Err(ConfigError {
+                    return Err(AxisConfigError {
                         field: "drive.kpc",
-                        problem: "must be between 0 and 150 %",
+                        problem: AxisConfigProblem::KpcOutOfRange,
                     });
                 }
                 non_negative("drive.t_vtc", t_vtc)?;
             }
         }
+        Ok(())
+    }
+
+    /// The simulated plant (reference cam, zero marks, hardware limits) and the initial position.
+    fn validate_plant(&self) -> Result<(), AxisConfigError> {
         if let Some((lo, hi)) = self.plant.reference_cam {
             if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "plant.reference_cam",
-                    problem: "must be [low, high] with high > low",
+                    problem: AxisConfigProblem::ReferenceCamReversed,
                 });
             }
         }
@@ -455,13 +564,18 @@ impl AxisConfig {
         }
         if let (Some(lo), Some(hi)) = (self.plant.hw_limit_min, self.plant.hw_limit_max) {
             if hi <= lo {
-                return Err(ConfigError {
+                return Err(AxisConfigError {
                     field: "plant.hw_limit_max",
-                    problem: "must be greater than plant.hw_limit_min",
+                    problem: AxisConfigProblem::HardwareLimitsReversed,
                 });
             }
         }
         finite("initial_position", self.initial_position)?;
+        Ok(())
+    }
+
+    /// The filters and times of actual-value extrapolation.
+    fn validate_extrapolation(&self) -> Result<(), AxisConfigError> {
         let ex = &self.extrapolation;
         non_negative("extrapolation.position_t1", ex.position_t1)?;
         non_negative("extrapolation.position_t2", ex.position_t2)?;

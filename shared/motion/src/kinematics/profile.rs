@@ -4,7 +4,7 @@
 //! acceleration, deceleration and jerk limits, either to a target position at rest
 //! ([`plan_position`]) or to a target velocity with zero acceleration ([`plan_velocity`]).
 //! Jerk `0` means a trapezoidal profile (the acceleration may jump), as in the references
-//! (seed 001 §4.1).
+//! (S7-1500T Motion Control V4.0 function manual, 3.2.8.2 'Velocity profile').
 //!
 //! # Limit semantics
 //! As in S7-1500T, `acc` bounds `|a|` while `|v|` increases and `dec` bounds `|a|` while `|v|`
@@ -102,6 +102,8 @@ impl core::fmt::Display for ProfileError {
         }
     }
 }
+
+impl std::error::Error for ProfileError {}
 
 /// One constant-jerk piece of a profile, starting at `t0` (s, from the profile start).
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
@@ -691,85 +693,24 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
     };
 
     let sub = State { p: 0.0, ..s0 };
-    let dpk = |x: f64| dist(sub, lim, Family::Peak, x);
     // The distance grows along the families: Peak(-vmax) <= Peak(0) = Relaxed(0) <=
     // Relaxed(tau_max) = Peak(vn) <= Peak(vmax). Evaluate only the brackets needed.
-    let d_vn = dpk(vn);
+    let d_vn = dist(sub, lim, Family::Peak, vn);
     // Length scale of the motion (the net travel may be much shorter than the way there).
     let scale = goal.abs().max(s0.p.abs()).max(d_vn.abs()).max(1e-9);
-    let tol = 1e-13 * scale;
-    let select = |closed_form: bool| -> Result<(Family, f64, f64), ProfileError> {
-        Ok(if d > d_vn {
-            let d_pos = dpk(vmax);
-            if d >= d_pos {
-                (Family::Peak, vmax, (d - d_pos) / vmax)
-            } else {
-                // Where the up-ramp and the down-ramp start to saturate their bounds.
-                let (x_up, x_dn) = if trap {
-                    (vn, 0.0)
-                } else {
-                    (pre.saturation(1.0, vn), pre.dec * pre.dec * pre.ij)
-                };
-                let c2 = 1.0 / pre.acc + 1.0 / pre.dec;
-                let x = solve_peak(
-                    dpk,
-                    d,
-                    (vn, vmax),
-                    (d_vn - d, d_pos - d),
-                    Shape {
-                        sat: (x_up, x_dn),
-                        c2,
-                        closed_form,
-                    },
-                    tol,
-                )
-                .ok_or(ProfileError::NoSolution)?;
-                (Family::Peak, x, 0.0)
-            }
-        } else {
-            let d_zero = dpk(0.0);
-            if d > d_zero {
-                if tau_max > 0.0 && d < d_vn {
-                    let x = brent(
-                        |x| dist(sub, lim, Family::Relaxed, x) - d,
-                        (0.0, tau_max),
-                        (d_zero - d, d_vn - d),
-                        tol,
-                    )
-                    .ok_or(ProfileError::NoSolution)?;
-                    (Family::Relaxed, x, 0.0)
-                } else {
-                    (Family::Peak, vn, 0.0)
-                }
-            } else {
-                let d_neg = dpk(-vmax);
-                if d <= d_neg {
-                    (Family::Peak, -vmax, (d_neg - d) / vmax)
-                } else {
-                    let (x_up, x_dn) = if trap {
-                        (0.0, 0.0)
-                    } else {
-                        (pre.saturation(-1.0, vn), -pre.dec * pre.dec * pre.ij)
-                    };
-                    let c2 = -(1.0 / pre.acc + 1.0 / pre.dec);
-                    let x = solve_peak(
-                        dpk,
-                        d,
-                        (-vmax, 0.0),
-                        (d_neg - d, d_zero - d),
-                        Shape {
-                            sat: (x_up, x_dn),
-                            c2,
-                            closed_form,
-                        },
-                        tol,
-                    )
-                    .ok_or(ProfileError::NoSolution)?;
-                    (Family::Peak, x, 0.0)
-                }
-            }
-        })
+    let choice = PositionChoice {
+        sub,
+        lim,
+        pre: &pre,
+        d,
+        d_vn,
+        vn,
+        vmax,
+        tau_max,
+        trap,
+        tol: 1e-13 * scale,
     };
+    let select = |closed_form: bool| choice.select(closed_form);
 
     // Replay: recovery prefix, then the chosen family, all in one recorded builder. A closed-form
     // root that does not land (a breakpoint formula did not hold) is solved again iteratively.
@@ -785,6 +726,113 @@ pub fn plan_position(start: State, target: f64, lim: &Limits) -> Result<Profile,
         return Err(ProfileError::NoSolution);
     }
     Ok(finish(b, start.p, sigma, State::rest(target)))
+}
+
+/// The choice of the family and its parameter for [`plan_position`]: the distance `d` still to
+/// go after the recovery prefix `pre` (ending in `sub`, at position 0), and the peak-family
+/// distance `d_vn` at the natural velocity `vn`.
+struct PositionChoice<'a> {
+    sub: State,
+    lim: &'a Limits,
+    pre: &'a Builder<MAX_SEGMENTS>,
+    d: f64,
+    d_vn: f64,
+    vn: f64,
+    vmax: f64,
+    tau_max: f64,
+    trap: bool,
+    tol: f64,
+}
+
+impl PositionChoice<'_> {
+    /// The distance of the peak family with peak velocity `x`.
+    fn dpk(&self, x: f64) -> f64 {
+        dist(self.sub, self.lim, Family::Peak, x)
+    }
+
+    /// `(family, parameter, cruise)` that reaches `d`; `closed_form` allows the closed-form
+    /// root of the peak family.
+    fn select(&self, closed_form: bool) -> Result<(Family, f64, f64), ProfileError> {
+        if self.d > self.d_vn {
+            self.select_beyond_natural(closed_form)
+        } else {
+            self.select_within_natural(closed_form)
+        }
+    }
+
+    /// `d` beyond the natural peak: a higher peak velocity (up to `vmax`, then a cruise).
+    fn select_beyond_natural(&self, closed_form: bool) -> Result<(Family, f64, f64), ProfileError> {
+        let (d, d_vn, vn, vmax, pre) = (self.d, self.d_vn, self.vn, self.vmax, self.pre);
+        let d_pos = self.dpk(vmax);
+        if d >= d_pos {
+            return Ok((Family::Peak, vmax, (d - d_pos) / vmax));
+        }
+        // Where the up-ramp and the down-ramp start to saturate their bounds.
+        let (x_up, x_dn) = if self.trap {
+            (vn, 0.0)
+        } else {
+            (pre.saturation(1.0, vn), pre.dec * pre.dec * pre.ij)
+        };
+        let c2 = 1.0 / pre.acc + 1.0 / pre.dec;
+        let x = solve_peak(
+            |x| self.dpk(x),
+            d,
+            (vn, vmax),
+            (d_vn - d, d_pos - d),
+            Shape {
+                sat: (x_up, x_dn),
+                c2,
+                closed_form,
+            },
+            self.tol,
+        )
+        .ok_or(ProfileError::NoSolution)?;
+        Ok((Family::Peak, x, 0.0))
+    }
+
+    /// `d` up to the natural peak: a relaxed acceleration, the natural peak, or a lower (down
+    /// to `-vmax`, then a cruise) peak velocity.
+    fn select_within_natural(&self, closed_form: bool) -> Result<(Family, f64, f64), ProfileError> {
+        let (d, d_vn, vn, vmax, pre) = (self.d, self.d_vn, self.vn, self.vmax, self.pre);
+        let d_zero = self.dpk(0.0);
+        if d > d_zero {
+            if self.tau_max > 0.0 && d < d_vn {
+                let x = brent(
+                    |x| dist(self.sub, self.lim, Family::Relaxed, x) - d,
+                    (0.0, self.tau_max),
+                    (d_zero - d, d_vn - d),
+                    self.tol,
+                )
+                .ok_or(ProfileError::NoSolution)?;
+                return Ok((Family::Relaxed, x, 0.0));
+            }
+            return Ok((Family::Peak, vn, 0.0));
+        }
+        let d_neg = self.dpk(-vmax);
+        if d <= d_neg {
+            return Ok((Family::Peak, -vmax, (d_neg - d) / vmax));
+        }
+        let (x_up, x_dn) = if self.trap {
+            (0.0, 0.0)
+        } else {
+            (pre.saturation(-1.0, vn), -pre.dec * pre.dec * pre.ij)
+        };
+        let c2 = -(1.0 / pre.acc + 1.0 / pre.dec);
+        let x = solve_peak(
+            |x| self.dpk(x),
+            d,
+            (-vmax, 0.0),
+            (d_neg - d, d_zero - d),
+            Shape {
+                sat: (x_up, x_dn),
+                c2,
+                closed_form,
+            },
+            self.tol,
+        )
+        .ok_or(ProfileError::NoSolution)?;
+        Ok((Family::Peak, x, 0.0))
+    }
 }
 
 /// Plans a time-optimal profile from `start` to the velocity `target_v` with zero acceleration.

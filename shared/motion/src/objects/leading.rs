@@ -1,9 +1,10 @@
-//! Leading values: what a follower reads of its leader each cycle (design §4).
+//! Leading values: what a follower reads of its leader each cycle (see the leading values between
+//! nodes, docs/processes.md 'Leading values').
 //!
 //! Positions are continuous (unwrapped) so that a modulo wrap is never mistaken for a jump; the
 //! modulo settings travel with the value.
 
-use crate::modulo::Modulo;
+use crate::kinematics::modulo::Modulo;
 
 /// Identifies a leader for the runtime that feeds leading values (an index or a hash the
 /// runtime chooses; the engine only compares them).
@@ -23,7 +24,8 @@ pub struct LeadingValue {
     pub modulo: Option<Modulo>,
 }
 
-/// One timestamped sample of a leader as it travels on the bus (design §4).
+/// One timestamped sample of a leader as it travels on the bus (see the leading values between
+/// nodes, docs/processes.md 'Leading values').
 ///
 /// Positions are continuous (unwrapped), as in [`LeadingValue`].
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -131,7 +133,7 @@ const EMPTY: LeadingSample = LeadingSample {
 };
 
 /// The last `N` samples of one leader, in time order, and the leading value at any time they
-/// cover (design §4).
+/// cover (see the leading values between nodes, docs/processes.md 'Leading values').
 ///
 /// A follower computing its setpoint for time `t` asks for its leader at `t - D` (`D` the
 /// leader's leading-value delay). Between two samples the value is the quintic Hermite

@@ -1,10 +1,13 @@
-//! The cam track technology object and `MC_CamTrack` (seed 003 §4; seed 000 §4.2).
+//! The cam track technology object and `MC_CamTrack` (S7-1500T Measuring input and cam functions
+//! V5.0 function manual, 3.3 'Cam track technology object'; S7-Technology V4.1 function manual, 3.7
+//! '"Cam track" technology object').
 //!
 //! # Interface
 //!
-//! Like an output cam ([`crate::output_cam`]), a [`CamTrack`] is stepped once per cycle with the
-//! motion of its axis ([`AxisMotion`], see [`crate::measuring`]) and reports the edges of its
-//! single track output in a [`CamEdges`] list, each with its exact time (ns):
+//! Like an output cam ([`crate::objects::output_cam`]), a [`CamTrack`] is stepped once per cycle
+//! with the motion of its axis ([`AxisMotion`], see [`crate::kinematics::cycle_motion`]) and
+//! reports the edges of its single track output in a [`CamEdges`] list, each with its exact time
+//! (ns):
 //!
 //! ```text
 //! track.set_data(data)                        // TO data (staged, `StatusWord.X6`)
@@ -28,9 +31,10 @@
 //! `MatchPosition` is set as if the position had been reached by positive motion from
 //! `ReferencePosition` (on a modulo axis from the reduced reference position, within one modulo
 //! length), and from then on the track follows the continuous motion, so a modulo length that is
-//! not a multiple of the track length carries on without realigning (seed 003 §4.3).
-//! `MatchPosition` (reported reduced on modulo axes) is the lower end of the current track
-//! cycle, `TrackPosition` the position in it.
+//! not a multiple of the track length carries on without realigning (S7-1500T Measuring input and
+//! cam functions V5.0 function manual, 3.3.1 'Modulo function'). `MatchPosition`
+//! (reported reduced on modulo axes) is the lower end of the current track cycle, `TrackPosition`
+//! the position in it.
 //!
 //! A homing jump on a linear axis re-references the track to `ReferencePosition`; on a modulo
 //! axis the jump counts as positive motion when `(new - old) mod L_mod <= L_mod / 2` and as
@@ -56,13 +60,14 @@
 //! track length / reference position), 702 (actual value not valid). `MC_Reset` acknowledges
 //! them; an enabled track then resumes as at its first activation.
 
-use crate::alarm::{AlarmId, AlarmInstance};
-use crate::error_id::ErrorId;
-pub use crate::measuring::AxisMotion;
-use crate::measuring::{ConfigError, RangeSet};
-use crate::modulo::Modulo;
-use crate::output_cam::{max_hysteresis, point_crossings, Path, PathEvent};
-pub use crate::output_cam::{CamEdges, Edge, OutputCamParameters, PositionType};
+use crate::catalog::alarm::{AlarmId, AlarmInstance};
+use crate::catalog::error_id::ErrorId;
+use crate::kinematics::crossing::{point_crossings, Path, PathEvent, RangeSet};
+use crate::kinematics::cycle_motion::AxisMotion;
+use crate::kinematics::modulo::Modulo;
+use crate::objects::measuring::MeasuringConfigError;
+use crate::objects::output_cam::max_hysteresis;
+pub use crate::objects::output_cam::{CamEdges, Edge, OutputCamParameters, PositionType};
 
 /// Maximum number of cams on a track.
 pub const MAX_CAMS: usize = 32;
@@ -733,9 +738,9 @@ pub struct CamTrack {
 
 impl CamTrack {
     /// A cam track with the given configuration and data.
-    pub fn new(config: CamTrackConfig, data: CamTrackData) -> Result<Self, ConfigError> {
+    pub fn new(config: CamTrackConfig, data: CamTrackData) -> Result<Self, MeasuringConfigError> {
         if data.check(config.track_type).is_err() {
-            return Err(ConfigError("cam track data"));
+            return Err(MeasuringConfigError::CamTrackData);
         }
         Ok(Self {
             config,
@@ -814,8 +819,9 @@ impl CamTrack {
     }
 
     /// `ReferencePosition` for a seamless change at the end of the current track cycle
-    /// (seed 003 §4.8): `MatchPosition + L` (positive motion) or `MatchPosition - L`, reduced on
-    /// modulo axes.
+    /// (S7-1500T Measuring input and cam functions V5.0 function manual, 3.3.3 'Changing the cam
+    /// track data during operation'): `MatchPosition + L` (positive motion) or `MatchPosition - L`,
+    /// reduced on modulo axes.
     pub fn next_reference_position(&self, positive: bool) -> f64 {
         next_reference_position(
             self.status.match_position,
@@ -915,20 +921,8 @@ impl CamTrack {
     /// One cycle: the track output's edges of this cycle go to `edges` (cleared first).
     pub fn step(&mut self, motion: &AxisMotion, edges: &mut CamEdges) {
         edges.clear();
-        self.core.n_events = 0;
-        self.core.floor = f64::NEG_INFINITY;
-        self.core.t0_ns = motion.t0_ns;
-        self.core.t1_ns = motion.t1_ns;
-        self.core.modulo = motion.modulo;
-        self.core.stopped_at = None;
-        self.core.switched_at = None;
+        let h = self.begin_cycle(motion);
         let bits_before = self.core.bits;
-
-        let cap = max_hysteresis(motion.modulo.map(|m| m.length), self.config.working_range);
-        let h_cfg = self.core.data.parameters.hysteresis;
-        let h = cap.map_or(h_cfg, |c| h_cfg.min(c));
-        self.status.hysteresis = h;
-        self.status.hysteresis_limited = h < h_cfg;
 
         let enabled = self.owner.is_some();
         if enabled
@@ -944,6 +938,42 @@ impl CamTrack {
             return;
         }
 
+        self.enter_cycle(motion);
+        self.end_time_cams(motion);
+        self.walk_path(motion, h);
+        self.track_position(motion);
+
+        let cut = self.core.stopped_at;
+        if cut.is_some() {
+            // A Mode 1 disable reached the end of the track cycle.
+            self.owner = None;
+            self.stop();
+        }
+        self.output(edges, motion, bits_before, cut);
+    }
+
+    /// Resets the per-cycle state of the core and limits the hysteresis (a quarter of the modulo
+    /// length or working range); returns the effective hysteresis.
+    fn begin_cycle(&mut self, motion: &AxisMotion) -> f64 {
+        self.core.n_events = 0;
+        self.core.floor = f64::NEG_INFINITY;
+        self.core.t0_ns = motion.t0_ns;
+        self.core.t1_ns = motion.t1_ns;
+        self.core.modulo = motion.modulo;
+        self.core.stopped_at = None;
+        self.core.switched_at = None;
+
+        let cap = max_hysteresis(motion.modulo.map(|m| m.length), self.config.working_range);
+        let h_cfg = self.core.data.parameters.hysteresis;
+        let h = cap.map_or(h_cfg, |c| h_cfg.min(c));
+        self.status.hysteresis = h;
+        self.status.hysteresis_limited = h < h_cfg;
+        h
+    }
+
+    /// The state at the cycle start: set up on the first enabled cycle; a position jump
+    /// (treated as motion by at most half a modulo length) or newly written data applied.
+    fn enter_cycle(&mut self, motion: &AxisMotion) {
         let x0 = motion.start.p;
         if !self.live {
             self.live = true;
@@ -958,7 +988,8 @@ impl CamTrack {
             if let Some(j) = motion.jump {
                 self.path.reset(motion);
                 if let Some(m) = motion.modulo {
-                    // Treated as motion by at most half a modulo length (seed 003 §4.4).
+                    // Treated as motion by at most half a modulo length (S7-1500T Measuring input
+                    // and cam functions V5.0 function manual, 3.3.1 'Modulo function' (homing)).
                     let diff = m.forward(x0 - j, x0);
                     let as_motion = if diff <= 0.5 * m.length {
                         diff
@@ -976,9 +1007,11 @@ impl CamTrack {
                 self.core.apply(x0, self.path.dir, 0.0, true);
             }
         }
+    }
 
-        // Time cams whose logical on time ends in this cycle (they stay `running` until the end
-        // of the cycle, so that a crossing before the end does not retrigger them).
+    /// Time cams whose logical on time ends in this cycle switch off (they stay `running`
+    /// until the end of the cycle, so that a crossing before the end does not retrigger them).
+    fn end_time_cams(&mut self, motion: &AxisMotion) {
         for i in 0..MAX_CAMS {
             if let Some(end) = self.core.running.get(i).copied().flatten() {
                 if end <= motion.t1_ns {
@@ -987,7 +1020,11 @@ impl CamTrack {
                 }
             }
         }
+    }
 
+    /// Walks the effective path of the cycle (hysteresis `h`): the cams' crossings become
+    /// events; ended time cams are released at the cycle end.
+    fn walk_path(&mut self, motion: &AxisMotion, h: f64) {
         let mut path = self.path;
         let core = &mut self.core;
         path.walk(motion, h, |ev| match ev {
@@ -1009,21 +1046,15 @@ impl CamTrack {
                 *r = None;
             }
         }
+    }
 
-        // Match and track position at the cycle end.
+    /// Match and track position at the cycle end.
+    fn track_position(&mut self, motion: &AxisMotion) {
         let x1 = motion.end.p;
         let k = cycle_index(x1, self.core.anchor, self.core.data.track_length);
         let m_cont = self.core.anchor + k * self.core.data.track_length;
         self.status.track_position = x1 - m_cont;
         self.status.match_position = motion.modulo.map_or(m_cont, |m| m.wrap(m_cont));
-
-        let cut = self.core.stopped_at;
-        if cut.is_some() {
-            // A Mode 1 disable reached the end of the track cycle.
-            self.owner = None;
-            self.stop();
-        }
-        self.output(edges, motion, bits_before, cut);
     }
 
     fn stop(&mut self) {
@@ -1046,17 +1077,36 @@ impl CamTrack {
     ) {
         let n = self.core.n_events.min(EVENT_CAPACITY);
         let mut order = [0u16; EVENT_CAPACITY];
-        for (i, o) in order.iter_mut().enumerate().take(n) {
+        let order = &mut order[..n];
+        self.sort_events(order);
+        let raw = self.raw_edges(order, motion, bits_before, cut);
+        // Interface cap.
+        self.cap_to_interface(&raw, edges);
+        self.update_status(&raw, edges);
+    }
+
+    /// The indices of the cycle's cam events in time order (equal times in the order found).
+    fn sort_events(&self, order: &mut [u16]) {
+        for (i, o) in order.iter_mut().enumerate() {
             *o = i as u16;
         }
-        let order = &mut order[..n];
-        {
-            let evs = &self.core.events[..n];
-            order.sort_unstable_by(|&a, &b| {
-                let (ea, eb) = (&evs[a as usize], &evs[b as usize]);
-                ea.dt.total_cmp(&eb.dt).then(a.cmp(&b))
-            });
-        }
+        let evs = &self.core.events[..order.len()];
+        order.sort_unstable_by(|&a, &b| {
+            let (ea, eb) = (&evs[a as usize], &evs[b as usize]);
+            ea.dt.total_cmp(&eb.dt).then(a.cmp(&b))
+        });
+    }
+
+    /// The track output's edges before the interface cap: the state at the cycle start, then
+    /// the events in `order` (equal times together) with compensation, the monotone clamp and
+    /// `cut`.
+    fn raw_edges(
+        &mut self,
+        order: &[u16],
+        motion: &AxisMotion,
+        bits_before: u32,
+        cut: Option<f64>,
+    ) -> CamEdges {
         let p = self.core.data.parameters;
         let live = self.live || cut.is_some();
         let mut raw = CamEdges::default();
@@ -1130,8 +1180,12 @@ impl CamTrack {
         let floor_ns = self.core.switched_at.map_or(i64::MIN, |dt| motion.ns(dt));
         self.last_edge_ns = last.max(floor_ns);
         self.phys = phys;
+        raw
+    }
 
-        // Interface cap.
+    /// Passes the raw edges to `edges` as the output interface can switch them (software: all;
+    /// TM Timer DQ: the last rising and falling edge; DQ module: the last edge).
+    fn cap_to_interface(&mut self, raw: &CamEdges, edges: &mut CamEdges) {
         let mut hw = self.hw_output;
         match self.config.interface {
             TrackOutputInterface::Software => {
@@ -1165,11 +1219,16 @@ impl CamTrack {
                 }
             }
         }
+        self.hw_output = hw;
+    }
+
+    /// The status after the cycle's output: suppressed and dropped edges, the output, the cams'
+    /// state and the track state.
+    fn update_status(&mut self, raw: &CamEdges, edges: &CamEdges) {
         self.status.edges_suppressed +=
             raw.len().saturating_sub(edges.len()) as u64 + raw.dropped();
-        self.hw_output = hw;
         self.status.events_dropped += core::mem::take(&mut self.core.dropped);
-        self.status.track_output = hw;
+        self.status.track_output = self.hw_output;
         self.status.single_cam_state = if self.live { self.core.bits } else { 0 };
         self.status.output_inverted = self.owner.is_some() && self.input.invert_output;
         self.status.alarm = self.alarm;
@@ -1184,8 +1243,9 @@ impl CamTrack {
     }
 }
 
-/// `ReferencePosition` for a seamless Mode 1 change (seed 003 §4.8): `match + length` for
-/// positive motion, `match - length` for negative, reduced into the modulo range.
+/// `ReferencePosition` for a seamless Mode 1 change (S7-1500T Measuring input and cam functions
+/// V5.0 function manual, 3.3.3 'Changing the cam track data during operation'): `match +
+/// length` for positive motion, `match - length` for negative, reduced into the modulo range.
 pub fn next_reference_position(
     match_position: f64,
     length: f64,
@@ -1200,9 +1260,10 @@ pub fn next_reference_position(
     modulo.map_or(r, |m| m.wrap(r))
 }
 
-/// The continuous position of a track start for enabling a track at `x` (seed 003 §4.3): as
-/// if `x` had been reached by positive motion from `reference` (on a modulo axis from the
-/// reduced reference, within one modulo length).
+/// The continuous position of a track start for enabling a track at `x` (S7-1500T Measuring input
+/// and cam functions V5.0 function manual, 3.3.1 'Modulo function'): as if `x`
+/// had been reached by positive motion from `reference` (on a modulo axis from the reduced
+/// reference, within one modulo length).
 fn enable_anchor(x: f64, reference: f64, length: f64, modulo: Option<Modulo>) -> f64 {
     match modulo {
         None => reference,
@@ -1232,7 +1293,8 @@ fn cycle_index(x: f64, anchor: f64, length: f64) -> f64 {
 }
 
 /// `MatchPosition` (reduced on modulo axes) and `TrackPosition` for enabling a track at
-/// `position` (seed 003 §4.3).
+/// `position` (S7-1500T Measuring input and cam functions V5.0 function manual, 3.3.1 'Modulo
+/// function').
 pub fn match_on_enable(
     position: f64,
     reference: f64,

@@ -1,11 +1,13 @@
-//! The output cam technology object and `MC_OutputCam` (seed 003 §3; seed 000 §4.1).
+//! The output cam technology object and `MC_OutputCam` (S7-1500T Measuring input and cam functions
+//! V5.0 function manual, 3.2 'Output cam technology object'; S7-Technology V4.1 function manual,
+//! 3.6 '"Output cam" technology object').
 //!
 //! # Interface
 //!
 //! An [`OutputCam`] is stepped once per cycle with the motion of the position it refers to (the
 //! caller passes the setpoint or the actual value, as [`OutputCamConfig::position_type`] says),
-//! an [`AxisMotion`] (see [`crate::measuring`] for its definition: continuous positions, quintic
-//! Hermite between samples, optional knots, modulo, jump, validity):
+//! an [`AxisMotion`] (see [`crate::kinematics::cycle_motion`] for its definition: continuous
+//! positions, quintic Hermite between samples, optional knots, modulo, jump, validity):
 //!
 //! ```text
 //! cam.call(instance, &McOutputCam { .. })      // the FB call (Enable-type), any time
@@ -20,7 +22,8 @@
 //! edge of the output is reported at that previous edge's time (a zero-length pulse, when the
 //! compensations exceed the cam's length in time). The caller that wants leads longer than its
 //! look-ahead passes a motion that runs ahead of the output (S7 computes the switching times
-//! two servo cycles ahead, seed 003 §3.2); edges may therefore carry times before `t0_ns`.
+//! two servo cycles ahead, S7-1500T Measuring input and cam functions V5.0 function manual, 3.2
+//! 'Output cam technology object'); edges may therefore carry times before `t0_ns`.
 //!
 //! # Switching rules
 //!
@@ -33,7 +36,9 @@
 //! - Time cam: ON when the start position is crossed in an enabled direction, for `Duration`;
 //!   not retriggered while on (the logical on time is `[t, t + Duration)`), not cut short by a
 //!   reversal or homing, not started by a homing jump. Not started by a crossing in the first
-//!   [`OutputCamConfig::arming_cycles`] cycles after the enable (seed 003 §3.10 timing rule).
+//!   [`OutputCamConfig::arming_cycles`] cycles after the enable (S7-1500T Measuring input and
+//!   cam functions V5.0 function manual, 6.4.1 'MC_OutputCam: Activate/deactivate output cam V5',
+//!   timing rule).
 //! - Hysteresis `H` (capped at a quarter of the modulo length or of the working range): a
 //!   direction reversal at `p` arms a band from `p` back by `H`; inside it the effective position
 //!   and direction are frozen. Leaving the band against the old direction is the reversal: the
@@ -54,11 +59,12 @@
 //! 1e12), `16#8042` Duration (time cam, not > 0), `16#800A` Mode, `16#8007` Direction,
 //! `16#800C` a second active instance, `16#8001` while an alarm is pending.
 
-use crate::alarm::{supplement, AlarmId, AlarmInstance};
-use crate::error_id::ErrorId;
-pub use crate::measuring::AxisMotion;
-use crate::measuring::{RangeSet, Run};
-use crate::timed_list::{Timed, TimedList};
+use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance};
+use crate::catalog::error_id::ErrorId;
+use crate::kinematics::crossing::{point_crossings, Path, PathEvent, RangeSet};
+use crate::kinematics::cycle_motion::AxisMotion;
+use crate::kinematics::timed_list::{Timed, TimedList};
+use crate::objects::measuring::MeasuringConfigError;
 
 // ---------------------------------------------------------------------------------------------
 // Edges
@@ -150,170 +156,6 @@ pub fn combine(
         }
     }
     (start, cur)
-}
-
-// ---------------------------------------------------------------------------------------------
-// The effective path: hysteresis and direction
-// ---------------------------------------------------------------------------------------------
-
-/// What the effective position does, in time order (times in s after the cycle start).
-#[derive(Copy, Clone, Debug)]
-pub(crate) enum PathEvent<'a> {
-    /// The effective position follows the motion of `run` from `from` to `to` (monotone).
-    Move { run: &'a Run, from: f64, to: f64 },
-    /// The effective direction changes to `dir` at `dt`, the effective position being `at`.
-    Turn { dt: f64, dir: i8, at: f64 },
-    /// The hysteresis band is left against the old direction at `dt`: the direction becomes
-    /// `dir` and the effective position jumps from `from` to `to`.
-    Sweep {
-        dt: f64,
-        dir: i8,
-        from: f64,
-        to: f64,
-    },
-}
-
-/// The effective direction and the armed hysteresis band (seed 003 §3.7).
-#[derive(Copy, Clone, Debug, Default, PartialEq)]
-pub(crate) struct Path {
-    /// +1, -1, or 0 (no motion seen since the reset).
-    pub dir: i8,
-    /// Armed band: reversal position and the direction before the reversal.
-    band: Option<(f64, i8)>,
-}
-
-impl Path {
-    /// Starts at the motion's start: direction from the start velocity, no band.
-    pub fn reset(&mut self, motion: &AxisMotion) {
-        let v = motion.start.v;
-        self.dir = if v > 0.0 {
-            1
-        } else if v < 0.0 {
-            -1
-        } else {
-            0
-        };
-        self.band = None;
-    }
-
-    /// Walks the motion of one cycle with hysteresis `h`, reporting the effective path.
-    pub fn walk(&mut self, motion: &AxisMotion, h: f64, mut f: impl FnMut(PathEvent<'_>)) {
-        motion.for_each_run(|run| {
-            let s = run.dir();
-            if s == 0 {
-                return;
-            }
-            if self.band.is_none() {
-                if self.dir == s {
-                    f(PathEvent::Move {
-                        run,
-                        from: run.xa,
-                        to: run.xb,
-                    });
-                    return;
-                }
-                if self.dir == 0 || h <= 0.0 {
-                    self.dir = s;
-                    f(PathEvent::Turn {
-                        dt: run.ta(),
-                        dir: s,
-                        at: run.xa,
-                    });
-                    f(PathEvent::Move {
-                        run,
-                        from: run.xa,
-                        to: run.xb,
-                    });
-                    return;
-                }
-                // A reversal with hysteresis: arm the band at the reversal point.
-                self.band = Some((run.xa, self.dir));
-            }
-            let Some((p_rev, d_old)) = self.band else {
-                return;
-            };
-            let d = f64::from(d_old);
-            if s == d_old {
-                // Back in the old direction: past the reversal point the band is left.
-                if (run.xb - p_rev) * d > 0.0 {
-                    self.band = None;
-                    f(PathEvent::Move {
-                        run,
-                        from: p_rev,
-                        to: run.xb,
-                    });
-                }
-            } else {
-                let far = p_rev - d * h;
-                if (run.xb - far) * d < 0.0 {
-                    let dt = run.time_of(far);
-                    self.band = None;
-                    self.dir = s;
-                    f(PathEvent::Sweep {
-                        dt,
-                        dir: s,
-                        from: p_rev,
-                        to: far,
-                    });
-                    f(PathEvent::Move {
-                        run,
-                        from: far,
-                        to: run.xb,
-                    });
-                }
-            }
-        });
-    }
-}
-
-/// Calls `f(c)` for every point `p + k * period` (every `k`; only `p` without a period) crossed
-/// by a monotone motion from `from` to `to` (`(from, to]` or `[to, from)`), in motion order.
-pub(crate) fn point_crossings(
-    p: f64,
-    period: Option<f64>,
-    from: f64,
-    to: f64,
-    mut f: impl FnMut(f64) -> bool,
-) {
-    if from == to || !from.is_finite() || !to.is_finite() {
-        return;
-    }
-    let up = to > from;
-    let inside = |c: f64| {
-        if up {
-            c > from && c <= to
-        } else {
-            c >= to && c < from
-        }
-    };
-    match period {
-        None => {
-            if inside(p) {
-                f(p);
-            }
-        }
-        Some(l) => {
-            let (min, max) = if up { (from, to) } else { (to, from) };
-            let k0 = ((min - p) / l).floor() as i64;
-            let k1 = ((max - p) / l).ceil() as i64;
-            let (k0, k1) = crate::measuring::limit_periods(k0, k1, up);
-            if up {
-                for k in k0..=k1 {
-                    let c = p + k as f64 * l;
-                    if inside(c) && !f(c) {
-                        return;
-                    }
-                }
-            } else {
-                for k in (k0..=k1).rev() {
-                    let c = p + k as f64 * l;
-                    if inside(c) && !f(c) {
-                        return;
-                    }
-                }
-            }
-        }
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -430,15 +272,15 @@ impl OutputCamParameters {
         hysteresis: 0.0,
     };
 
-    pub(crate) fn check(&self) -> Result<(), &'static str> {
+    pub(crate) fn check(&self) -> Result<(), MeasuringConfigError> {
         if !(self.on_compensation >= 0.0 && self.on_compensation <= 1e9) {
-            return Err("on_compensation");
+            return Err(MeasuringConfigError::OnCompensation);
         }
         if !(self.off_compensation >= 0.0 && self.off_compensation <= 1e9) {
-            return Err("off_compensation");
+            return Err(MeasuringConfigError::OffCompensation);
         }
         if !(self.hysteresis >= 0.0 && self.hysteresis <= 1e12) {
-            return Err("hysteresis");
+            return Err(MeasuringConfigError::Hysteresis);
         }
         Ok(())
     }
@@ -458,8 +300,9 @@ impl OutputCamConfig {
     }
 }
 
-/// Maximum hysteresis (seed 003 §3.7): a quarter of the modulo length on a modulo axis, a quarter
-/// of the working range otherwise; `None` without either.
+/// Maximum hysteresis (S7-1500T Measuring input and cam functions V5.0 function manual,
+/// 3.2.4 'Hysteresis'): a quarter of the modulo length on a modulo axis, a quarter of the working
+/// range otherwise; `None` without either.
 pub fn max_hysteresis(
     modulo_length: Option<f64>,
     working_range: Option<(f64, f64)>,
@@ -592,11 +435,8 @@ fn check_position(x: f64) -> bool {
 
 impl OutputCam {
     /// An output cam with the given configuration.
-    pub fn new(config: OutputCamConfig) -> Result<Self, crate::measuring::ConfigError> {
-        config
-            .parameters
-            .check()
-            .map_err(crate::measuring::ConfigError)?;
+    pub fn new(config: OutputCamConfig) -> Result<Self, MeasuringConfigError> {
+        config.parameters.check()?;
         Ok(Self {
             config,
             owner: None,
@@ -627,11 +467,8 @@ impl OutputCam {
     }
 
     /// Writes the DIR parameters (compensations, hysteresis); effective at the next step.
-    pub fn set_parameters(
-        &mut self,
-        p: OutputCamParameters,
-    ) -> Result<(), crate::measuring::ConfigError> {
-        p.check().map_err(crate::measuring::ConfigError)?;
+    pub fn set_parameters(&mut self, p: OutputCamParameters) -> Result<(), MeasuringConfigError> {
+        p.check()?;
         self.config.parameters = p;
         Ok(())
     }
@@ -754,38 +591,9 @@ impl OutputCam {
         let t0 = motion.t0_ns;
         let enabled = self.owner.is_some();
         let changed = core::mem::take(&mut self.changed);
-
-        // Hysteresis cap.
-        let cap = max_hysteresis(motion.modulo.map(|m| m.length), self.config.working_range);
-        let h_cfg = self.config.parameters.hysteresis;
-        let h = cap.map_or(h_cfg, |c| h_cfg.min(c));
-        self.status.hysteresis = h;
-        self.status.hysteresis_limited = h < h_cfg;
-
-        // Alarm 704: the time cam's pulse would be empty.
-        if enabled && self.config.cam_type == OutputCamType::Time && self.alarm.is_none() {
-            let p = &self.config.parameters;
-            let d = self.input.duration;
-            let bad = d <= p.off_compensation - p.on_compensation
-                || (self.input.mode == OutputCamMode::Inverted
-                    && d <= p.on_compensation - p.off_compensation);
-            if bad {
-                self.alarm = Some(AlarmInstance::new(
-                    AlarmId::OutputCamDataFaulty,
-                    supplement::NONE,
-                ));
-            }
-        }
-        // Invalid position.
-        if enabled
-            && !motion.valid
-            && self.alarm.is_none()
-            && self.config.position_type == PositionType::Actual
-        {
-            self.alarm = Some(AlarmInstance::new(
-                AlarmId::PositionValueInvalid,
-                supplement::NONE,
-            ));
+        let h = self.cap_hysteresis(motion);
+        if enabled {
+            self.check_inputs(motion);
         }
 
         if !enabled || self.alarm.is_some() || !motion.valid {
@@ -825,55 +633,114 @@ impl OutputCam {
         self.arming = self.arming.saturating_sub(1);
         let mut path = self.path;
         match self.config.cam_type {
-            OutputCamType::Distance => {
-                let set = self.range(motion);
-                let dir_cfg = self.input.direction;
-                path.walk(motion, h, |ev| match ev {
-                    PathEvent::Move { run, from, to } => {
-                        let dir = run.dir();
-                        set.crossings(from, to, |c, entering| {
-                            let logic = entering && dir_cfg.enables(dir);
-                            if logic != self.logic {
-                                self.logic = logic;
-                                self.switch_at(edges, motion, run.time_of(c), logic);
-                            }
-                            true
-                        });
-                    }
-                    PathEvent::Turn { dt, dir, at }
-                    | PathEvent::Sweep {
-                        dt, dir, to: at, ..
-                    } => {
-                        let logic = set.contains_moving(at, dir) && dir_cfg.enables(dir);
-                        if logic != self.logic {
-                            self.logic = logic;
-                            self.switch_at(edges, motion, dt, logic);
-                        }
-                    }
-                });
-            }
-            OutputCamType::Time => {
-                let (p, period) = self.start_point(motion);
-                let dir_cfg = self.input.direction;
-                path.walk(motion, h, |ev| {
-                    let (dt_of, sweep_dt, dir, from, to) = match ev {
-                        PathEvent::Move { run, from, to } => (Some(run), 0.0, run.dir(), from, to),
-                        PathEvent::Sweep { dt, dir, from, to } => (None, dt, dir, from, to),
-                        PathEvent::Turn { .. } => return,
-                    };
-                    if !armed || !dir_cfg.enables(dir) {
-                        return;
-                    }
-                    point_crossings(p, period, from, to, |c| {
-                        let dt = dt_of.map_or(sweep_dt, |r| r.time_of(c));
-                        self.trigger(edges, motion, dt);
-                        true
-                    });
-                });
-            }
+            OutputCamType::Distance => self.walk_distance_cam(&mut path, motion, h, edges),
+            OutputCamType::Time => self.walk_time_cam(&mut path, motion, (h, armed), edges),
         }
         self.path = path;
         self.finish(edges, motion);
+    }
+
+    /// The hysteresis, capped at a quarter of the modulo length or working range.
+    fn cap_hysteresis(&mut self, motion: &AxisMotion) -> f64 {
+        let cap = max_hysteresis(motion.modulo.map(|m| m.length), self.config.working_range);
+        let h_cfg = self.config.parameters.hysteresis;
+        let h = cap.map_or(h_cfg, |c| h_cfg.min(c));
+        self.status.hysteresis = h;
+        self.status.hysteresis_limited = h < h_cfg;
+        h
+    }
+
+    /// The alarms of an enabled cam's inputs: 704 when the time cam's pulse would be empty,
+    /// 702 when the position it follows (the actual value) is not valid.
+    fn check_inputs(&mut self, motion: &AxisMotion) {
+        // Alarm 704: the time cam's pulse would be empty.
+        if self.config.cam_type == OutputCamType::Time && self.alarm.is_none() {
+            let p = &self.config.parameters;
+            let d = self.input.duration;
+            let bad = d <= p.off_compensation - p.on_compensation
+                || (self.input.mode == OutputCamMode::Inverted
+                    && d <= p.on_compensation - p.off_compensation);
+            if bad {
+                self.alarm = Some(AlarmInstance::new(
+                    AlarmId::OutputCamDataFaulty,
+                    supplement::NONE,
+                ));
+            }
+        }
+        // Invalid position.
+        if !motion.valid
+            && self.alarm.is_none()
+            && self.config.position_type == PositionType::Actual
+        {
+            self.alarm = Some(AlarmInstance::new(
+                AlarmId::PositionValueInvalid,
+                supplement::NONE,
+            ));
+        }
+    }
+
+    /// A distance cam: switches where the effective path enters and leaves the cam's range
+    /// (with the configured direction).
+    fn walk_distance_cam(
+        &mut self,
+        path: &mut Path,
+        motion: &AxisMotion,
+        h: f64,
+        edges: &mut CamEdges,
+    ) {
+        let set = self.range(motion);
+        let dir_cfg = self.input.direction;
+        path.walk(motion, h, |ev| match ev {
+            PathEvent::Move { run, from, to } => {
+                let dir = run.dir();
+                set.crossings(from, to, |c, entering| {
+                    let logic = entering && dir_cfg.enables(dir);
+                    if logic != self.logic {
+                        self.logic = logic;
+                        self.switch_at(edges, motion, run.time_of(c), logic);
+                    }
+                    true
+                });
+            }
+            PathEvent::Turn { dt, dir, at }
+            | PathEvent::Sweep {
+                dt, dir, to: at, ..
+            } => {
+                let logic = set.contains_moving(at, dir) && dir_cfg.enables(dir);
+                if logic != self.logic {
+                    self.logic = logic;
+                    self.switch_at(edges, motion, dt, logic);
+                }
+            }
+        });
+    }
+
+    /// A time cam: triggers where the effective path crosses the start point (once armed, in
+    /// the configured direction).
+    fn walk_time_cam(
+        &mut self,
+        path: &mut Path,
+        motion: &AxisMotion,
+        (h, armed): (f64, bool),
+        edges: &mut CamEdges,
+    ) {
+        let (p, period) = self.start_point(motion);
+        let dir_cfg = self.input.direction;
+        path.walk(motion, h, |ev| {
+            let (dt_of, sweep_dt, dir, from, to) = match ev {
+                PathEvent::Move { run, from, to } => (Some(run), 0.0, run.dir(), from, to),
+                PathEvent::Sweep { dt, dir, from, to } => (None, dt, dir, from, to),
+                PathEvent::Turn { .. } => return,
+            };
+            if !armed || !dir_cfg.enables(dir) {
+                return;
+            }
+            point_crossings(p, period, from, to, |c| {
+                let dt = dt_of.map_or(sweep_dt, |r| r.time_of(c));
+                self.trigger(edges, motion, dt);
+                true
+            });
+        });
     }
 
     /// A time cam's start crossed at `t0 + dt`.

@@ -1,7 +1,8 @@
-//! The instructions an axis accepts, with their inputs as in the references (seed 001 §3.2).
+//! The instructions an axis accepts, with their inputs as in the references (S7-1500T Motion
+//! Control V4.0 function manual, chapter 10 'Instructions').
 
-use crate::dynamics::Dynamics;
-use crate::leading::LeaderId;
+use crate::kinematics::dynamics::Dynamics;
+use crate::objects::leading::LeaderId;
 
 /// `MC_Power.StartMode`.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -91,7 +92,7 @@ pub enum ApplicationMode {
     CyclicAppending,
 }
 
-/// Identifies a cam for the runtime that provides it ([`crate::axis::Axis::provide_cam`]).
+/// Identifies a cam for the runtime that provides it ([`crate::objects::axis::Axis::provide_cam`]).
 pub type CamId = u32;
 
 /// `SyncDirection` of a modulo follower (MC_GearInPos, MC_CamIn).
@@ -126,7 +127,8 @@ pub enum Command {
         /// `Restart`: re-initialize the TO (needs it disabled).
         restart: bool,
     },
-    /// `MC_Home` (modes 0..10 of seed 001 §6.2).
+    /// `MC_Home` (modes 0..10 of S7-1500T Motion Control V4.0 function manual, 3.2.9.3 'Homing
+    /// mode').
     #[doc(alias = "MC_Home")]
     Home {
         /// `Mode`.
@@ -276,7 +278,7 @@ pub enum Command {
     CamIn {
         /// The leader.
         master: LeaderId,
-        /// The cam (provided with [`crate::axis::Axis::provide_cam`] just before).
+        /// The cam (provided with [`crate::objects::axis::Axis::provide_cam`] just before).
         cam: CamId,
         /// `MasterOffset`.
         master_offset: f64,

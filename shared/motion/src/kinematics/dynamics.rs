@@ -1,10 +1,11 @@
-//! Dynamic limits, defaults and the parameter conventions of the references (seed 001 §3.1,
-//! §4.2): a negative value means "use the default", zero is rejected (except jerk 0 =
-//! trapezoidal and velocity 0 for velocity and jog jobs), a value above the limit is clamped
-//! and reported as a warning (alarms 501, 502, 503).
+//! Dynamic limits, defaults and the parameter conventions of the references (S7-1500T Motion
+//! Control V4.0 function manual, 6.3 'Motion Control instructions', 3.2.8 'Motion control and
+//! limits for dynamics'): a negative value means "use the default", zero is rejected (except jerk 0
+//! = trapezoidal and velocity 0 for velocity and jog jobs), a value above the limit is clamped and
+//! reported as a warning (alarms 501, 502, 503).
 
-use crate::error_id::ErrorId;
-use crate::profile::Limits;
+use crate::catalog::error_id::ErrorId;
+use crate::kinematics::profile::Limits;
 
 /// `<TO>.DynamicLimits` (all > 0).
 #[derive(Copy, Clone, Debug, PartialEq)]

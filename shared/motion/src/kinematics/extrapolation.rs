@@ -1,5 +1,8 @@
 //! Actual-value coupling: the leader's actual position filtered, extrapolated and passed through
-//! a hysteresis before followers use it (seed 001 §1.6, seed 002 §5.2).
+//! a hysteresis before followers use it (S7-1500T Motion Control V4.0 function manual,
+//! 3.5.3.4 'Extrapolation of the leading values for actual value coupling'; S7-1500T Axis
+//! functions V5.0 function manual, 4.2.4.8 'Configuration - Actual value extrapolation
+//! (S7-1500T)').
 //!
 //! Pipeline, once per cycle of the leader:
 //! 1. position filter: PT2 (`T1`, `T2`, two first-order stages) of the actual position;

@@ -1,12 +1,14 @@
 //! Simulated drive and plant, so that actual values and the following error are real.
 //!
-//! Two models, both from the references (seed 001 §2.5, §2.6):
+//! Two models, both from the references (S7-1500T Motion Control V4.0 function manual, 3.2.11
+//! 'Closed-loop control' and 3.2.5.3 'Actual values'):
 //! - [`DriveModel::Delay`]: the S7 simulation model of a simulated or virtual axis, where the
 //!   actual value is the setpoint delayed by `T_t` (interpolated between cycle samples).
 //! - [`DriveModel::PositionLoop`]: a position controller (gain `Kv`, velocity precontrol `Kpc`)
 //!   over a first-order velocity loop (`T_vtc`) with one servo cycle of transport delay; the
 //!   following error is formed against the balanced setpoint (the setpoint passed through the
-//!   same dead time and first-order model, the "dynamic axis model" of §2.5).
+//!   same dead time and first-order model, the "dynamic axis model" of 3.2.11 'Closed-loop
+//!   control').
 //!
 //! The plant has a physical position (the drive's own coordinate); the axis adds its homing
 //! offset. Reference cam, zero marks and hardware limit switches live in physical coordinates.

@@ -1,23 +1,23 @@
-//! Camming of a synchronous axis (seed 001 §1.6 "Camming, MC_CamIn", §3.2): the cam mapping
+//! Camming of a synchronous axis (S7-1500T Motion Control V4.0 function manual, 3.5.7 'Camming' and
+//! 10.12.5 'MC_CamIn V4'): the cam mapping
 //! with offsets, scalings and application modes, the synchronization (shared with MC_GearInPos,
-//! whose law it uses until the sync point), MC_CamOut, and the seamless change to a pending cam
-//! at the end of a cam cycle.
+//! whose law it uses until the sync point), MC_CamOut, and the seamless change to a pending cam at
+//! the end of a cam cycle.
 
 use std::sync::Arc;
 
-use super::sync::{SyncJob, SyncLaw, SyncPhase};
-use super::{ApplicationMode, Axis, CamId, Goal, SyncDirection, SyncProfileReference};
+use super::job::{AbsoluteSync, SyncJob, SyncPhase};
+use super::law::SyncLaw;
 use crate::cam::Cam;
-use crate::dynamics::Dynamics;
-use crate::error_id::ErrorId;
-use crate::job::{Instruction, JobEventKind, JobId};
-use crate::leading::LeaderId;
-use crate::override_table::NewJob;
-use crate::profile::{Limits, State};
+use crate::catalog::error_id::ErrorId;
+use crate::catalog::override_table::NewJob;
+use crate::kinematics::profile::{Limits, State};
+use crate::objects::axis::{ApplicationMode, Axis, CamId, Goal, SyncProfileReference};
+use crate::objects::job::{Instruction, JobEventKind, JobId};
 
 /// How the leading value maps onto a cam and the cam onto the following value.
 #[derive(Copy, Clone, Debug, PartialEq)]
-pub(super) struct CamMap {
+pub(in crate::objects::axis) struct CamMap {
     /// `MasterScaling` (> 0) and `SlaveScaling`, `SlaveOffset`.
     ms: f64,
     ss: f64,
@@ -42,7 +42,7 @@ pub(super) struct CamMap {
 }
 
 /// What one synchronous cam evaluation did.
-pub(super) enum CamStep {
+pub(in crate::objects::axis) enum CamStep {
     /// Synchronous; `true` if a cam end was passed (EndOfProfile).
     Running(bool),
     /// The once-through cam ended.
@@ -59,19 +59,23 @@ impl Axis {
         self.provided_cam = Some((id, cam));
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn cmd_cam_in(
+    /// MC_CamIn with the cam `cam_id` (provided just before), its offsets and scalings
+    /// `(MasterOffset, SlaveOffset, MasterScaling, SlaveScaling)` and application mode.
+    pub(in crate::objects::axis) fn cmd_cam_in(
         &mut self,
-        master: LeaderId,
+        sync: &AbsoluteSync,
         cam_id: CamId,
         (mo, so, ms, ss): (f64, f64, f64, f64),
-        msp: f64,
-        reference: SyncProfileReference,
-        msd: f64,
-        dynamics: &Dynamics,
         mode: ApplicationMode,
-        direction: SyncDirection,
     ) -> Result<JobId, ErrorId> {
+        let AbsoluteSync {
+            master,
+            master_sync_position: msp,
+            reference,
+            master_start_distance: msd,
+            ref dynamics,
+            direction,
+        } = *sync;
         self.require_new_sync()?;
         self.check_motion_allowed()?;
         // The job takes the provided reference once accepted (the runtime's table keeps its own).
@@ -156,7 +160,7 @@ impl Axis {
         Ok(id)
     }
 
-    pub(super) fn cmd_cam_out(&mut self) -> Result<JobId, ErrorId> {
+    pub(in crate::objects::axis) fn cmd_cam_out(&mut self) -> Result<JobId, ErrorId> {
         self.require_synchronous()?;
         if !self
             .sync
@@ -172,7 +176,7 @@ impl Axis {
     }
 
     /// Ends the active synchronous operation; the follower continues with its velocity.
-    pub(super) fn end_sync_keep_velocity(&mut self, how: JobEventKind) {
+    pub(in crate::objects::axis) fn end_sync_keep_velocity(&mut self, how: JobEventKind) {
         let v = self.basic.v;
         if let Some(s) = self.sync.take() {
             self.emit(s.id, s.instr, how);
@@ -189,7 +193,7 @@ impl Axis {
 
     /// A pending CamIn became the active job: its cam and map follow, the map anchored so that
     /// the cam's sync point is at `x_sync` and the follower continuous at `y_sync`.
-    pub(super) fn activate_cam(&mut self, x_sync: f64, y_sync: f64) {
+    pub(in crate::objects::axis) fn activate_cam(&mut self, x_sync: f64, y_sync: f64) {
         self.cams[0] = self.cams[1].take();
         self.cam_maps[0] = self.cam_maps[1].take();
         let (Some(cam), Some(map)) = (self.cams[0].as_ref(), self.cam_maps[0].as_mut()) else {
@@ -204,7 +208,7 @@ impl Axis {
     }
 
     /// Whether the pending job is a CamIn waiting for the end of the active cam's cycle.
-    pub(super) fn pending_at_cycle_end(&self) -> bool {
+    pub(in crate::objects::axis) fn pending_at_cycle_end(&self) -> bool {
         self.sync_pending
             .is_some_and(|p| p.instr == Instruction::CamIn)
             && self.cam_maps[1].is_some_and(|m| m.at_cycle_end)
@@ -212,7 +216,7 @@ impl Axis {
 
     /// One synchronous evaluation of the active cam at the leading value `x` (position,
     /// velocity, acceleration), writing the basic setpoint.
-    pub(super) fn cam_synchronous(&mut self, x: State) -> CamStep {
+    pub(in crate::objects::axis) fn cam_synchronous(&mut self, x: State) -> CamStep {
         let (Some(cam), Some(map)) = (self.cams[0].as_ref(), self.cam_maps[0].as_mut()) else {
             return CamStep::Failed;
         };
@@ -274,7 +278,7 @@ impl Axis {
 
     /// At the end of a cycle of the active cam: a pending CamIn waiting for it takes over, the
     /// new cam starting where the leader is and the follower continuing from where it is.
-    pub(super) fn cam_change_at_cycle_end(&mut self) {
+    pub(in crate::objects::axis) fn cam_change_at_cycle_end(&mut self) {
         if !self.pending_at_cycle_end() {
             return;
         }

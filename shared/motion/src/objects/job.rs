@@ -1,11 +1,12 @@
-//! Jobs: identifiers, the instructions they run, and the events they report (seed 001 §3.1).
+//! Jobs: identifiers, the instructions they run, and the events they report (S7-1500T Motion
+//! Control V4.0 function manual, 6.5 'Tracking active jobs').
 //!
 //! An Execute-type instruction starts a job and is answered at once with a [`JobId`] or a
-//! rejection ([`crate::error_id::ErrorId`]); the job then reports its progress as [`JobEvent`]s
-//! (Busy at start, then InVelocity / Done / CommandAborted / Error). Enable-type instructions
-//! (MC_Power, MC_MoveJog, MC_MotionIn*) keep one job while their enable is held.
+//! rejection ([`crate::catalog::error_id::ErrorId`]); the job then reports its progress as
+//! [`JobEvent`]s (Busy at start, then InVelocity / Done / CommandAborted / Error). Enable-type
+//! instructions (MC_Power, MC_MoveJog, MC_MotionIn*) keep one job while their enable is held.
 
-use crate::error_id::ErrorId;
+use crate::catalog::error_id::ErrorId;
 
 /// Identifier of a job, unique per technology object (never 0).
 pub type JobId = u32;

@@ -2,11 +2,12 @@
 //! completion, monitoring, drive, status. Allocation-free.
 
 use super::{
-    sign, Axis, AxisKind, AxisState, Goal, HomePhase, HomingMark, PassiveDirection, PosMon, Sense,
+    sign, sync_function, Axis, AxisKind, AxisState, Goal, HomePhase, HomingMark, PassiveDirection,
+    PosMon, Sense,
 };
-use crate::alarm::{error_bit, status_bit, supplement, AlarmId, ErrorDetail, Reaction};
-use crate::job::{Instruction, JobEventKind};
-use crate::profile::{plan_position, Limits, State};
+use crate::catalog::alarm::{status_bit, supplement, AlarmId, ErrorDetail, Reaction};
+use crate::kinematics::profile::{plan_position, Limits, State};
+use crate::objects::job::{Instruction, JobEventKind};
 
 impl Axis {
     /// Runs one cycle for time `now_ns` (cell clock, ns): the setpoint computed here is the
@@ -492,7 +493,7 @@ impl Axis {
         }
     }
 
-    fn finish_main(&mut self, id: crate::job::JobId, instr: Instruction) {
+    fn finish_main(&mut self, id: crate::objects::job::JobId, instr: Instruction) {
         self.main = None;
         self.emit(id, instr, JobEventKind::Done);
         self.set_goal(Goal::Hold);
@@ -502,8 +503,9 @@ impl Axis {
         (self.actual_p - target).abs() <= self.cfg.positioning.window
     }
 
-    /// Positioning monitoring (seed 001 §4.6): `Some(true)` done, `Some(false)` failed (alarm
-    /// 541 raised), `None` still waiting.
+    /// Positioning monitoring (S7-1500T Motion Control V4.0 function manual, 3.2.10.2 'Positioning
+    /// monitoring'): `Some(true)` done, `Some(false)` failed (alarm 541 raised), `None` still
+    /// waiting.
     fn positioning_monitor(&mut self, pm: PosMon) -> Option<bool> {
         if !self.pos_ctrl {
             return Some(true);
@@ -575,153 +577,13 @@ impl Axis {
 
     pub(super) fn refresh_status(&mut self) {
         let tot = self.total();
-        let mut sw = 0u32;
-        let mut ew = 0u32;
-        let mut ww = 0u32;
-        let detail = if self.alarms.iter().any(Option::is_some) {
-            for a in self.alarms() {
-                let spec = a.spec();
-                ew |= spec.error_mask();
-                ww |= spec.warning_mask();
-            }
-            ErrorDetail::from_pending(self.alarms())
-        } else {
-            ErrorDetail::NONE
-        };
+        let (ew, ww, detail) = self.alarm_words();
         let main = self.main.as_ref().map(|m| m.instr);
-        let set = |sw: &mut u32, bit: u32, on: bool| {
-            if on {
-                *sw |= bit;
-            }
-        };
-        set(&mut sw, status_bit::ENABLE, self.enabled);
-        set(&mut sw, status_bit::ERROR, detail.number != 0);
-        set(&mut sw, status_bit::HOMING_DONE, self.homed);
-        set(
-            &mut sw,
-            status_bit::DONE,
-            self.main.is_none() && self.sup_job.is_none() && self.sync.is_none(),
-        );
-        let standstill = self
-            .standstill_since
-            .map(|t| self.now - t >= (self.cfg.standstill.min_dwell_time * 1e9).round() as i64)
-            .unwrap_or(false);
-        set(
-            &mut sw,
-            status_bit::STANDSTILL,
-            standstill && self.cfg.kind != AxisKind::Speed,
-        );
-        set(
-            &mut sw,
-            status_bit::POSITIONING_COMMAND,
-            matches!(
-                main,
-                Some(Instruction::MoveAbsolute | Instruction::MoveRelative)
-            ),
-        );
-        set(
-            &mut sw,
-            status_bit::JOG_COMMAND,
-            main == Some(Instruction::MoveJog),
-        );
-        set(
-            &mut sw,
-            status_bit::VELOCITY_COMMAND,
-            main == Some(Instruction::MoveVelocity),
-        );
-        set(
-            &mut sw,
-            status_bit::HOMING_COMMAND,
-            main == Some(Instruction::Home) || self.passive.is_some(),
-        );
-        set(&mut sw, status_bit::CONSTANT_VELOCITY, tot.a == 0.0);
-        set(
-            &mut sw,
-            status_bit::ACCELERATING,
-            tot.a != 0.0 && tot.a * tot.v >= 0.0,
-        );
-        set(&mut sw, status_bit::DECELERATING, tot.a * tot.v < 0.0);
-        set(
-            &mut sw,
-            status_bit::SW_LIMIT_MIN_ACTIVE,
-            self.sw_active == Some(Sense::Negative),
-        );
-        set(
-            &mut sw,
-            status_bit::SW_LIMIT_MAX_ACTIVE,
-            self.sw_active == Some(Sense::Positive),
-        );
-        let hw = self.hw_trigger.map(|(s, _)| s);
-        set(
-            &mut sw,
-            status_bit::HW_LIMIT_MIN_ACTIVE,
-            hw == Some(Sense::Negative),
-        );
-        set(
-            &mut sw,
-            status_bit::HW_LIMIT_MAX_ACTIVE,
-            hw == Some(Sense::Positive),
-        );
-        set(
-            &mut sw,
-            status_bit::SUPERIMPOSED_MOTION_COMMAND,
-            self.sup_job.is_some(),
-        );
-        set(&mut sw, status_bit::AXIS_SIMULATION, self.cfg.virtual_axis);
-        set(
-            &mut sw,
-            status_bit::NON_POSITION_CONTROLLED,
-            self.enabled && !self.pos_ctrl,
-        );
-        set(
-            &mut sw,
-            status_bit::MOTION_IN_COMMAND,
-            matches!(
-                main,
-                Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
-            ),
-        );
-        let sync_phase = self.sync.as_ref().map(|j| j.phase);
-        set(
-            &mut sw,
-            status_bit::SYNCHRONIZING,
-            sync_phase == Some(super::sync::SyncPhase::Synchronizing),
-        );
-        set(
-            &mut sw,
-            status_bit::SYNCHRONOUS,
-            sync_phase == Some(super::sync::SyncPhase::Synchronous),
-        );
-        set(&mut sw, status_bit::PHASING_COMMAND, self.phasing.is_some());
+        let mut sw = self.job_status_bits(main, &detail) | self.motion_status_bits(tot);
         if self.cfg.kind == AxisKind::Speed {
             sw &= status_bit::SPEED_AXIS_MASK;
         }
-        let _ = error_bit::SW_LIMIT;
-        let state = if detail.reaction != Reaction::None {
-            AxisState::ErrorStop
-        } else if !self.enabled {
-            AxisState::Disabled
-        } else if self.stop_lock || main == Some(Instruction::Stop) || self.power.disabling {
-            AxisState::Stopping
-        } else {
-            match main {
-                Some(Instruction::Home) => AxisState::Homing,
-                Some(
-                    Instruction::MoveVelocity
-                    | Instruction::MoveJog
-                    | Instruction::MotionInPosition
-                    | Instruction::MotionInVelocity,
-                ) => AxisState::ContinuousMotion,
-                Some(_) => AxisState::DiscreteMotion,
-                None if self.sync.is_some() => AxisState::SynchronizedMotion,
-                None if self.sup_job.is_some() => AxisState::DiscreteMotion,
-                // After MC_GearOut the axis keeps moving with no job (PLCopen).
-                None if matches!(self.goal, Goal::Velocity { .. }) && tot.v != 0.0 => {
-                    AxisState::ContinuousMotion
-                }
-                None => AxisState::Standstill,
-            }
-        };
+        let state = self.plc_state(&detail, main, tot);
         self.status = super::AxisStatus {
             time_ns: self.now,
             state,
@@ -745,10 +607,10 @@ impl Axis {
                 .map(|s| (s.id, Instruction::MoveSuperimposed)),
             sync_job: self.sync.as_ref().map(|s| (s.id, s.instr)),
             sync_function: match self.sync.as_ref().map(|s| s.instr) {
-                Some(Instruction::GearIn) => 1,
-                Some(Instruction::GearInPos) => 2,
-                Some(Instruction::CamIn) => 3,
-                _ => 0,
+                Some(Instruction::GearIn) => sync_function::GEAR_IN,
+                Some(Instruction::GearInPos) => sync_function::GEAR_IN_POS,
+                Some(Instruction::CamIn) => sync_function::CAM_IN,
+                _ => sync_function::NONE,
             },
             sync_status_word: if self.sync.is_some() {
                 self.sync_flags
@@ -757,5 +619,142 @@ impl Axis {
             },
             phase_shift: self.phase.p,
         };
+    }
+
+    /// ErrorWord, WarningWord and ErrorDetail from the pending alarms.
+    fn alarm_words(&self) -> (u32, u32, ErrorDetail) {
+        let mut ew = 0u32;
+        let mut ww = 0u32;
+        let detail = if self.alarms.iter().any(Option::is_some) {
+            for a in self.alarms() {
+                let spec = a.spec();
+                ew |= spec.error_mask();
+                ww |= spec.warning_mask();
+            }
+            ErrorDetail::from_pending(self.alarms())
+        } else {
+            ErrorDetail::NONE
+        };
+        (ew, ww, detail)
+    }
+
+    /// The StatusWord bits of the enable, the alarms and the running jobs.
+    fn job_status_bits(&self, main: Option<Instruction>, detail: &ErrorDetail) -> u32 {
+        let sync_phase = self.sync.as_ref().map(|j| j.phase);
+        bit(status_bit::ENABLE, self.enabled)
+            | bit(status_bit::ERROR, detail.number != 0)
+            | bit(status_bit::HOMING_DONE, self.homed)
+            | bit(
+                status_bit::DONE,
+                self.main.is_none() && self.sup_job.is_none() && self.sync.is_none(),
+            )
+            | bit(
+                status_bit::POSITIONING_COMMAND,
+                matches!(
+                    main,
+                    Some(Instruction::MoveAbsolute | Instruction::MoveRelative)
+                ),
+            )
+            | bit(status_bit::JOG_COMMAND, main == Some(Instruction::MoveJog))
+            | bit(
+                status_bit::VELOCITY_COMMAND,
+                main == Some(Instruction::MoveVelocity),
+            )
+            | bit(
+                status_bit::HOMING_COMMAND,
+                main == Some(Instruction::Home) || self.passive.is_some(),
+            )
+            | bit(
+                status_bit::SUPERIMPOSED_MOTION_COMMAND,
+                self.sup_job.is_some(),
+            )
+            | bit(
+                status_bit::MOTION_IN_COMMAND,
+                matches!(
+                    main,
+                    Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
+                ),
+            )
+            | bit(
+                status_bit::SYNCHRONIZING,
+                sync_phase == Some(super::sync::SyncPhase::Synchronizing),
+            )
+            | bit(
+                status_bit::SYNCHRONOUS,
+                sync_phase == Some(super::sync::SyncPhase::Synchronous),
+            )
+            | bit(status_bit::PHASING_COMMAND, self.phasing.is_some())
+    }
+
+    /// The StatusWord bits of the motion (`tot`: the total setpoint), the limit switches and
+    /// the control mode.
+    fn motion_status_bits(&self, tot: State) -> u32 {
+        let standstill = self
+            .standstill_since
+            .map(|t| self.now - t >= (self.cfg.standstill.min_dwell_time * 1e9).round() as i64)
+            .unwrap_or(false);
+        let hw = self.hw_trigger.map(|(s, _)| s);
+        bit(
+            status_bit::STANDSTILL,
+            standstill && self.cfg.kind != AxisKind::Speed,
+        ) | bit(status_bit::CONSTANT_VELOCITY, tot.a == 0.0)
+            | bit(
+                status_bit::ACCELERATING,
+                tot.a != 0.0 && tot.a * tot.v >= 0.0,
+            )
+            | bit(status_bit::DECELERATING, tot.a * tot.v < 0.0)
+            | bit(
+                status_bit::SW_LIMIT_MIN_ACTIVE,
+                self.sw_active == Some(Sense::Negative),
+            )
+            | bit(
+                status_bit::SW_LIMIT_MAX_ACTIVE,
+                self.sw_active == Some(Sense::Positive),
+            )
+            | bit(status_bit::HW_LIMIT_MIN_ACTIVE, hw == Some(Sense::Negative))
+            | bit(status_bit::HW_LIMIT_MAX_ACTIVE, hw == Some(Sense::Positive))
+            | bit(status_bit::AXIS_SIMULATION, self.cfg.virtual_axis)
+            | bit(
+                status_bit::NON_POSITION_CONTROLLED,
+                self.enabled && !self.pos_ctrl,
+            )
+    }
+
+    /// The PLCopen state from the alarm reaction, the enable and the running jobs.
+    fn plc_state(&self, detail: &ErrorDetail, main: Option<Instruction>, tot: State) -> AxisState {
+        if detail.reaction != Reaction::None {
+            AxisState::ErrorStop
+        } else if !self.enabled {
+            AxisState::Disabled
+        } else if self.stop_lock || main == Some(Instruction::Stop) || self.power.disabling {
+            AxisState::Stopping
+        } else {
+            match main {
+                Some(Instruction::Home) => AxisState::Homing,
+                Some(
+                    Instruction::MoveVelocity
+                    | Instruction::MoveJog
+                    | Instruction::MotionInPosition
+                    | Instruction::MotionInVelocity,
+                ) => AxisState::ContinuousMotion,
+                Some(_) => AxisState::DiscreteMotion,
+                None if self.sync.is_some() => AxisState::SynchronizedMotion,
+                None if self.sup_job.is_some() => AxisState::DiscreteMotion,
+                // After MC_GearOut the axis keeps moving with no job (PLCopen).
+                None if matches!(self.goal, Goal::Velocity { .. }) && tot.v != 0.0 => {
+                    AxisState::ContinuousMotion
+                }
+                None => AxisState::Standstill,
+            }
+        }
+    }
+}
+
+/// `bit` if `on`, else 0.
+fn bit(bit: u32, on: bool) -> u32 {
+    if on {
+        bit
+    } else {
+        0
     }
 }

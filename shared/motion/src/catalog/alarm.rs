@@ -1,22 +1,23 @@
 //! Technology alarms, alarm reactions and the StatusWord / ErrorWord / WarningWord bit layout.
 //!
-//! Data from seed 001 (S7-1500/S7-1500T Motion Control V4.0):
-//! - §5.1: alarm classes and reactions (src ~L11392–11514, L15830);
-//! - §5.2: technology alarm list (overview table src ~L16922–16996, alarm details ~L16998–17712);
-//! - §1.12: StatusWord, ErrorWord and WarningWord of positioning/synchronous axes (src ~L15739–15900).
+//! Data from the S7-1500T Motion Control V4.0 function manual:
+//! - 9.3 'Technology alarms': alarm classes and reactions;
+//! - A.8.1 'List of the technology alarms': the overview table and the alarm detail pages;
+//! - A.2.35 'StatusWord tag', A.2.36 'ErrorWord tag' and A.2.38 'WarningWord tag' (positioning
+//!   axis/synchronous axis).
 //!
 //! The table is static data: [`ALARMS`] holds one [`AlarmSpec`] per [`AlarmId`] with its reaction,
 //! ErrorWord/WarningWord bit, restart flag and text. [`AlarmId::spec`] is a `match`, so it is
 //! total and cannot fail.
 //!
 //! # Where the manual contradicts itself
-//! Seed 001 §8 item 34 says to prefer the appendix *tables* and to record the choice. Tandem
-//! follows the **overview table** (A.8.1, "List of the technology alarms", src ~L16960–16996)
+//! Where they disagree, tandem prefers the appendix *tables* and records the choice here: it
+//! follows the **overview table** (A.8.1, "List of the technology alarms")
 //! wherever it disagrees with the per-alarm detail pages:
 //! - **603** (leader not position-controlled): the table says *remove enable*, the detail page
-//!   (src ~L17571) says *no reaction*. Tandem: [`Reaction::RemoveEnable`], error bit 14.
+//!   says *no reaction*. Tandem: [`Reaction::RemoveEnable`], error bit 14.
 //! - **752** (measuring range not recognized): the table says *remove enable*, the detail page
-//!   (src ~L17667) says *no reaction*. Tandem: [`Reaction::RemoveEnable`], error bit 2.
+//!   says *no reaction*. Tandem: [`Reaction::RemoveEnable`], error bit 2.
 //! - **702**: the table prints the text "Position value valid."; the detail page shows it means
 //!   the position value is *not* valid (restart running or encoder values invalid). Tandem
 //!   uses the corrected text.
@@ -24,10 +25,11 @@
 //!   faulty" (it describes the output cams of a cam track). Tandem uses the table text.
 //!
 //! # Scope
-//! The list covers every alarm number of §5.2, including those raised on the measuring input,
+//! The list covers every alarm number of the list, including those raised on the measuring input,
 //! output cam and cam track TOs (700–758). The reaction stored for them is the table value.
 //! On those TOs the effective reaction is "terminate processing" (ErrorDetail.Reaction 6–10,
-//! seed 001 §5.1), which [`Reaction`] does not model because it holds the axis reactions 0–5.
+//! S7-1500T Motion Control V4.0 function manual, 9.3 'Technology alarms'), which [`Reaction`] does
+//! not model because it holds the axis reactions 0–5.
 //!
 //! 601 ([`AlarmId::LeaderMissing`], "leading axis is not assigned or defective") also covers
 //! a *missing leading value*, for example a network leader that stopped publishing, so tandem
@@ -35,7 +37,8 @@
 
 use core::fmt;
 
-/// Alarm reaction of an axis (`ErrorDetail.Reaction`, seed 001 §5.1, src ~L15830).
+/// Alarm reaction of an axis (`ErrorDetail.Reaction`, S7-1500T Motion Control V4.0 function manual,
+/// 9.3 'Technology alarms').
 ///
 /// The discriminant is the S7 code. The derived order is the **severity** order, least severe
 /// first. The codes are already in that order: each reaction stops at least as hard as the one
@@ -108,20 +111,23 @@ impl Reaction {
         }
     }
 
-    /// `true` for reactions 1..=5: running jobs on the axis are aborted (seed 001 §3.3, last
-    /// paragraph: "any alarm with a stopping reaction" aborts everything).
+    /// `true` for reactions 1..=5: running jobs on the axis are aborted (S7-1500T Motion Control
+    /// V4.0 function manual, 10.16 'Override response of Motion Control jobs V4', last paragraph:
+    /// "any alarm with a stopping reaction" aborts everything).
     pub const fn aborts_jobs(self) -> bool {
         !matches!(self, Reaction::None)
     }
 
     /// `true` for reactions 4 and 5. The axis is disabled, and it re-enables automatically on
-    /// acknowledgement if `MC_Power.Enable` is still TRUE (seed 001 §5.1).
+    /// acknowledgement if `MC_Power.Enable` is still TRUE (S7-1500T Motion Control V4.0 function
+    /// manual, 9.3 'Technology alarms').
     pub const fn removes_enable(self) -> bool {
         matches!(self, Reaction::RemoveEnable | Reaction::TrackSetpoints)
     }
 }
 
-/// Static description of one technology alarm (one row of seed 001 §5.2).
+/// Static description of one technology alarm (one row of S7-1500T Motion Control V4.0 function
+/// manual, A.8.1 'List of the technology alarms').
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct AlarmSpec {
     /// The alarm.
@@ -165,8 +171,9 @@ impl AlarmSpec {
 
     /// Priority for `ErrorDetail`: `true` if `self` outranks `other`.
     ///
-    /// The manual says only that ErrorDetail shows the "highest-priority" pending alarm (seed 001
-    /// §5.1). Tandem ranks pending alarms by these keys, in order:
+    /// The manual says only that ErrorDetail shows the "highest-priority" pending alarm (S7-1500T
+    /// Motion Control V4.0 function manual, 9.3 'Technology alarms'). Tandem ranks pending alarms
+    /// by these keys, in order:
     /// 1. the more severe [`Reaction`] wins ([`Reaction::severity`]);
     /// 2. at equal reaction, an alarm with an ErrorWord bit beats a pure warning (e.g. 758 beats
     ///    501);
@@ -209,8 +216,9 @@ macro_rules! alarms {
             )*
         }
 
-        /// Every technology alarm of seed 001 §5.2 with its reaction, ErrorWord/WarningWord bit,
-        /// restart flag and text, sorted by number.
+        /// Every technology alarm of S7-1500T Motion Control V4.0 function manual, A.8.1 'List of
+        /// the technology alarms' with its reaction, ErrorWord/WarningWord bit, restart flag and
+        /// text, sorted by number.
         pub const ALARMS: &[AlarmSpec] = &[$(*AlarmId::$name.spec(),)*];
 
         impl AlarmId {
@@ -234,7 +242,8 @@ macro_rules! alarms {
                 }
             }
 
-            /// The alarm with this number, or `None` if the number is not in seed 001 §5.2.
+            /// The alarm with this number, or `None` if the number is not in S7-1500T Motion
+            /// Control V4.0 function manual, A.8.1 'List of the technology alarms'.
             pub const fn from_number(n: u16) -> Option<AlarmId> {
                 match n {
                     $($num => Some(AlarmId::$name),)*
@@ -253,7 +262,8 @@ macro_rules! alarms {
 }
 
 alarms! {
-    /// Technology alarm number (`ErrorDetail.Number`, seed 001 §5.2, src ~L16922–16996).
+    /// Technology alarm number (`ErrorDetail.Number`, S7-1500T Motion Control V4.0 function manual,
+    /// A.8.1 'List of the technology alarms').
     ///
     /// The discriminant is the alarm number. The variants are declared in number order.
     #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -358,8 +368,9 @@ alarms! {
             RemoveEnable, error: Some(2), warning: None, restart: false,
             "Numerical value range of the position exceeded.",
         },
-        /// Raised by an absolute positioning job on an axis that is not homed (seed 001 §3.2
-        /// MC_MoveAbsolute). See also [`crate::error_id::ErrorId::NotHomed`].
+        /// Raised by an absolute positioning job on an axis that is not homed (S7-1500T Motion
+        /// Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4').
+        /// See also [`crate::catalog::error_id::ErrorId::NotHomed`].
         AxisNotHomed = 321 => {
             EmergencyStop, error: Some(3), warning: None, restart: false,
             "Axis not homed.",
@@ -692,7 +703,9 @@ where
     best
 }
 
-/// `<TO>.ErrorDetail` (seed 001 §1.12): number and reaction of the highest-priority pending alarm.
+/// `<TO>.ErrorDetail` (S7-1500T Motion Control V4.0 function manual, A.2.37 'ErrorDetail tags
+/// (positioning axis/synchronous axis)'): number and reaction of the highest-priority pending
+/// alarm.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct ErrorDetail {
     /// Alarm number, 0 if none is pending.
@@ -729,8 +742,8 @@ impl Default for ErrorDetail {
     }
 }
 
-/// Bit masks of `<TO>.StatusWord` of positioning and synchronous axes (seed 001 §1.12,
-/// src ~L15739–15792).
+/// Bit masks of `<TO>.StatusWord` of positioning and synchronous axes (S7-1500T Motion Control V4.0
+/// function manual, A.2.35 'StatusWord tag (positioning axis/synchronous axis)').
 pub mod status_bit {
     /// 0 "Enable": the TO is enabled.
     pub const ENABLE: u32 = 1 << 0;
@@ -800,7 +813,8 @@ pub mod status_bit {
     /// Bits that only a synchronous axis uses (21, 22, 24); reserved on a positioning axis.
     pub const SYNCHRONOUS_AXIS_ONLY: u32 = SYNCHRONIZING | SYNCHRONOUS | PHASING_COMMAND;
 
-    /// Bits a **speed axis** uses: 0–4, 6, 9, 10, 12–14, 25–27 (seed 001 §1.12, src ~L14902).
+    /// Bits a **speed axis** uses: 0–4, 6, 9, 10, 12–14, 25–27 (S7-1500T Motion Control V4.0
+    /// function manual, A.1.15 'StatusWord tag (speed axis)').
     pub const SPEED_AXIS_MASK: u32 = ENABLE
         | ERROR
         | RESTART_ACTIVE
@@ -817,8 +831,9 @@ pub mod status_bit {
         | IN_LIMITATION;
 }
 
-/// Bit masks of `<TO>.ErrorWord` of positioning and synchronous axes (seed 001 §1.12,
-/// src ~L15794). Bits 16–31 are reserved. [`AlarmSpec::error_bit`] holds the bit *index*.
+/// Bit masks of `<TO>.ErrorWord` of positioning and synchronous axes (S7-1500T Motion Control V4.0
+/// function manual, A.2.36 'ErrorWord tag (positioning axis/synchronous axis)'). Bits
+/// 16–31 are reserved. [`AlarmSpec::error_bit`] holds the bit *index*.
 pub mod error_bit {
     /// 0 "SystemFault": system-internal error.
     pub const SYSTEM_FAULT: u32 = 1 << 0;
@@ -854,9 +869,10 @@ pub mod error_bit {
     pub const ADAPTION_ERROR: u32 = 1 << 15;
 }
 
-/// Bit masks of `<TO>.WarningWord` of positioning and synchronous axes (seed 001 §1.12,
-/// src ~L15851). Same layout as [`error_bit`] with "…Warning" names, except that bits 8 and 9
-/// are split into SW limit min / max. Bits 16–31 are reserved.
+/// Bit masks of `<TO>.WarningWord` of positioning and synchronous axes (S7-1500T Motion Control
+/// V4.0 function manual, A.2.38 'WarningWord tag (positioning axis/synchronous axis)').
+/// Same layout as [`error_bit`] with "…Warning" names, except that bits 8 and 9 are split into SW
+/// limit min / max. Bits 16–31 are reserved.
 pub mod warning_bit {
     /// 0 "SystemWarning".
     pub const SYSTEM_WARNING: u32 = 1 << 0;
@@ -948,7 +964,8 @@ mod tests {
 
     #[test]
     fn reference_number_list() {
-        // The alarm numbers of seed 001 §5.2, written out separately from the table.
+        // The alarm numbers of S7-1500T Motion Control V4.0 function manual, A.8.1 'List of the
+        // technology alarms', written out separately from the table.
         let expected: &[u16] = &[
             101, 102, 103, 104, 105, 106, 107, 108, 109, 110, 111, 112, 113, 201, 202, 203, 204,
             304, 305, 306, 307, 308, 321, 322, 323, 341, 342, 343, 401, 411, 412, 421, 431, 501,

@@ -1,7 +1,9 @@
-//! Modulo axes: a position range `[start, start + length)` that repeats (seed 001 §1.1).
+//! Modulo axes: a position range `[start, start + length)` that repeats (S7-1500T Motion Control
+//! V4.0 function manual, 3.2.3 'Modulo setting').
 //!
 //! Axes keep a continuous (unwrapped) position internally, so a wrap is never a jump; every
-//! absolute input is reduced into the range (seed 000 §2.1: 400 -> 40, -20 -> 340 on 0..360).
+//! absolute input is reduced into the range (S7-Technology V4.1 function manual, 6.9.4 'Absolute
+//! positions of modulo axes': 400 -> 40, -20 -> 340 on 0..360).
 
 /// Modulo settings of an axis or encoder.
 #[derive(Copy, Clone, Debug, PartialEq)]

@@ -1,12 +1,13 @@
 //! Override (abort) response of motion-control jobs: which running job a new job aborts.
 //!
-//! Seed 001 §3.3 (S7-1500/S7-1500T Motion Control V4.0, chapter 10.16, src ~L14603–14668). The
-//! three tables are stored as **data** ([`TABLE1`], [`TABLE2`], [`TABLE3`]) and read through
-//! [`table1`], [`table2`] and [`table3`]. `A` in the manual is [`Effect::Abort`]: the running
-//! job ends with `CommandAborted = TRUE`. `–` is [`Effect::Continue`].
+//! S7-1500T Motion Control V4.0 function manual, chapter 10.16 'Override response of Motion Control
+//! jobs V4'. The three tables are stored as **data** ([`TABLE1`], [`TABLE2`], [`TABLE3`]) and read
+//! through [`table1`], [`table2`] and [`table3`]. `A` in the manual is [`Effect::Abort`]: the
+//! running job ends with `CommandAborted = TRUE`. `–` is [`Effect::Continue`].
 //!
-//! V4.0 has no BufferMode (seed 001 §3.4): every job acts as PLCopen `mcAborting` within these
-//! tables.
+//! V4.0 has no BufferMode (S7-1500T Motion Control V4.0 function manual, chapter 10
+//! 'Instructions': no instruction has a BufferMode input): every job acts as PLCopen
+//! `mcAborting` within these tables.
 //!
 //! # One row type for tables 1 and 2
 //! [`NewJob`] is the union of the rows of both tables. Table 1 has a single row for "Halt,
@@ -24,13 +25,14 @@
 //! other pending sync jobs, and no motion job in table 1. When it starts synchronizing
 //! (`StartSync` rises), evaluate it again as `…Active`: that is when it aborts the running
 //! single-axis motion and the previously active synchronous operation. This gives seamless cam
-//! and gear changes (seed 001 §3.3, notes under table 2; §8 item 8).
+//! and gear changes (S7-1500T Motion Control V4.0 function manual, 10.16 'Override response of
+//! Motion Control jobs V4', notes under table 2).
 //!
 //! # Table versus note
 //! The note under table 2 says a pending sync job "can only be overridden by a further
 //! synchronous operation job on the same following axis" or cancelled by MC_Power. The table
 //! itself also marks MC_MotionInVelocity / MC_MotionInPosition as aborting a pending
-//! MC_GearInPos and MC_CamIn (`A`, checked against the original, src ~L14638). Tandem follows
+//! MC_GearInPos and MC_CamIn (`A`, checked against the original). Tandem follows
 //! the table as printed: MotionIn takes over the axis setpoints, which a pending sync job would
 //! later have to abort anyway.
 //!
@@ -39,10 +41,11 @@
 //!   MC_TorqueAdditive, MC_TorqueRange, MC_SynchronizedMotionSimulation, MC_InterpolateCam,
 //!   MC_GetCam*. MC_OutputCam and MC_CamTrack end only through their own `Enable = FALSE`.
 //! - Everything on the TO is aborted by MC_Power `Enable = FALSE`, by a technology alarm with a
-//!   stopping reaction (see [`crate::alarm::Reaction::aborts_jobs`]), and by RUN→STOP.
+//!   stopping reaction (see [`crate::catalog::alarm::Reaction::aborts_jobs`]), and by RUN→STOP.
 //! - MC_Home modes 0/1/6/7 (direct homing, absolute adjustment) abort no motion or sync job
-//!   (seed 001 §6.5). Modes 2/8/10 (passive homing) abort no motion or sync job either
-//!   (§6.4). The manual does not say what a new passive homing job does to a running one;
+//!   (S7-1500T Motion Control V4.0 function manual, 3.2.9.11 'Direct homing'). Modes 2/8/10
+//!   (passive homing) abort no motion or sync job either (3.2.9.7 to 3.2.9.9, passive homing). The
+//!   manual does not say what a new passive homing job does to a running one;
 //!   [`NewJob::from_home_mode`] returns `None` for these modes and leaves that to the caller.
 
 /// Effect of a new job on a running job.
@@ -61,7 +64,8 @@ impl Effect {
     }
 }
 
-/// Row of tables 1 and 2: the new job (seed 001 §3.3).
+/// Row of tables 1 and 2: the new job (S7-1500T Motion Control V4.0 function manual, 10.16
+/// 'Override response of Motion Control jobs V4').
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum NewJob {
@@ -137,7 +141,8 @@ impl NewJob {
     }
 }
 
-/// Column of table 1: the running homing or motion job (seed 001 §3.3).
+/// Column of table 1: the running homing or motion job (S7-1500T Motion Control V4.0 function
+/// manual, 10.16 'Override response of Motion Control jobs V4').
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum RunningMotion {
@@ -186,7 +191,8 @@ impl RunningMotion {
     }
 }
 
-/// Column of table 2: the running synchronous-operation job (seed 001 §3.3).
+/// Column of table 2: the running synchronous-operation job (S7-1500T Motion Control V4.0 function
+/// manual, 10.16 'Override response of Motion Control jobs V4').
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum RunningSync {
@@ -232,7 +238,8 @@ impl RunningSync {
     }
 }
 
-/// Row of table 3: a new job that may abort a running measuring job (seed 001 §3.3).
+/// Row of table 3: a new job that may abort a running measuring job (S7-1500T Motion Control V4.0
+/// function manual, 10.16 'Override response of Motion Control jobs V4').
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum NewMeasuringJob {
@@ -304,7 +311,8 @@ const A: Effect = Effect::Abort;
 const C: Effect = Effect::Continue;
 
 /// Table 1: effect of a new job ([`NewJob`], rows) on running homing and motion jobs
-/// ([`RunningMotion`], columns). Seed 001 §3.3, src ~L14605–14627.
+/// ([`RunningMotion`], columns). S7-1500T Motion Control V4.0 function manual, 10.16 'Override
+/// response of Motion Control jobs V4'.
 pub const TABLE1: [[Effect; RunningMotion::COUNT]; NewJob::COUNT] = [
     //   H-pas H-act Mot Sup MIn
     [A, A, A, A, A], // HomeActive (MC_Home 3/5)
@@ -322,7 +330,8 @@ pub const TABLE1: [[Effect; RunningMotion::COUNT]; NewJob::COUNT] = [
 ];
 
 /// Table 2: effect of a new job ([`NewJob`], rows) on running synchronous-operation jobs
-/// ([`RunningSync`], columns). Seed 001 §3.3, src ~L14629–14653.
+/// ([`RunningSync`], columns). S7-1500T Motion Control V4.0 function manual, 10.16 'Override
+/// response of Motion Control jobs V4'.
 pub const TABLE2: [[Effect; RunningSync::COUNT]; NewJob::COUNT] = [
     //   GearIn GIPpend GIPact Phasing CamPend CamAct
     [A, C, C, C, C, C], // HomeActive (MC_Home 3/5)
@@ -340,7 +349,8 @@ pub const TABLE2: [[Effect; RunningSync::COUNT]; NewJob::COUNT] = [
 ];
 
 /// Table 3: effect of a new job ([`NewMeasuringJob`], rows) on running measuring jobs
-/// ([`RunningMeasuring`], columns). Seed 001 §3.3, src ~L14655–14668.
+/// ([`RunningMeasuring`], columns). S7-1500T Motion Control V4.0 function manual, 10.16 'Override
+/// response of Motion Control jobs V4'.
 pub const TABLE3: [[Effect; RunningMeasuring::COUNT]; NewMeasuringJob::COUNT] = [
     //   MeasIn MeasInCyclic
     [A, A], // HomeAborting (MC_Home 2/3/5/8/9/10)
@@ -407,8 +417,9 @@ mod tests {
             .collect()
     }
 
-    // Literal copy of seed 001 §3.3 table 1 (columns: H-pas, H-act, Mot, Sup, MIn).
-    const DIGEST_TABLE1: &str = "
+    // Literal copy of S7-1500T Motion Control V4.0 function manual, 10.16 'Override response of
+    // Motion Control jobs V4' table 1 (columns: H-pas, H-act, Mot, Sup, MIn).
+    const MANUAL_TABLE1: &str = "
         MC_Home 3/5                                              | A A A A A
         MC_Home 9                                                | A – – – –
         Halt, MoveAbs, MoveRel, MoveVel, Jog, MotionInVel/Pos    | – A A A A
@@ -418,9 +429,10 @@ mod tests {
         GearInPos / CamIn active                                 | – A A A –
     ";
 
-    // Literal copy of seed 001 §3.3 table 2
-    // (columns: GearIn, GearInPos pend., GearInPos act., Phasing, CamIn pend., CamIn act.).
-    const DIGEST_TABLE2: &str = "
+    // Literal copy of S7-1500T Motion Control V4.0 function manual, 10.16 'Override response of
+    // Motion Control jobs V4' table 2 (columns: GearIn, GearInPos pend., GearInPos act., Phasing,
+    // CamIn pend., CamIn act.).
+    const MANUAL_TABLE2: &str = "
         MC_Home 3/5                       | A – – – – –
         MC_Halt                           | A – A A – A
         MoveAbs, MoveRel, MoveVel, Jog    | A – A A – A
@@ -434,8 +446,9 @@ mod tests {
         CamIn active                      | A A A A A A
     ";
 
-    // Literal copy of seed 001 §3.3 table 3 (columns: MeasuringInput, MeasuringInputCyclic).
-    const DIGEST_TABLE3: &str = "
+    // Literal copy of S7-1500T Motion Control V4.0 function manual, 10.16 'Override response of
+    // Motion Control jobs V4' table 3 (columns: MeasuringInput, MeasuringInputCyclic).
+    const MANUAL_TABLE3: &str = "
         MC_Home 2/3/5/8/9/10                                     | A A
         MC_Home 0/1/6/7                                          | – –
         MeasuringInput, MeasuringInputCyclic, AbortMeasuringInput | A A
@@ -462,8 +475,8 @@ mod tests {
 
     #[test]
     fn table1_every_cell() {
-        let grid = rows(DIGEST_TABLE1);
-        // Digest row → NewJob rows it covers.
+        let grid = rows(MANUAL_TABLE1);
+        // Manual row → NewJob rows it covers.
         let map: [&[NewJob]; 7] = [
             &[NewJob::HomeActive],
             &[NewJob::HomeAbortPassive],
@@ -497,7 +510,7 @@ mod tests {
 
     #[test]
     fn table2_every_cell() {
-        let grid = rows(DIGEST_TABLE2);
+        let grid = rows(MANUAL_TABLE2);
         let map: [&[NewJob]; 11] = [
             &[NewJob::HomeActive],
             &[NewJob::Halt],
@@ -534,7 +547,7 @@ mod tests {
 
     #[test]
     fn table3_every_cell() {
-        let grid = rows(DIGEST_TABLE3);
+        let grid = rows(MANUAL_TABLE3);
         let map: [&[NewMeasuringJob]; 3] = [
             &[NewMeasuringJob::HomeAborting],
             &[NewMeasuringJob::HomeDirect],
@@ -592,7 +605,7 @@ mod tests {
     }
 
     #[test]
-    fn consequences_stated_in_the_digest() {
+    fn consequences_stated_in_the_manual() {
         // Passive homing survives all motion jobs.
         for new in [
             NewJob::Halt,

@@ -1,23 +1,26 @@
 //! ErrorIDs returned by motion-control jobs (the `ErrorID` output of an S7 / PLCopen FB).
 //!
-//! One variant per ErrorID of seed 001 §5.3 (S7-1500/S7-1500T Motion Control V4.0, appendix A.9,
-//! src ~L17714–17825), plus a small block of **tandem extensions** at `16#80F0`–`16#80F3`, a range
-//! that the reference does not use (seed 001 §5.3 uses `16#8001`–`16#8076`, `16#80A1`–`16#80AE`
-//! and `16#8FFF`).
+//! One variant per ErrorID of the S7-1500T Motion Control V4.0 function manual, appendix A.9
+//! A.9 'Error ID for Motion Control instructions', plus a small block of **tandem extensions** at
+//! `16#80F0`–`16#80F3`, a range that the reference does not use (S7-1500T Motion Control V4.0
+//! function manual, A.9 'Error ID for Motion Control instructions' uses `16#8001`–`16#8076`,
+//! `16#80A1`–`16#80AE` and `16#8FFF`).
 //!
-//! Semantics (seed 001 §3.1, §5.3): every ErrorID other than [`ErrorId::None`] means the FB shows
-//! `Error = TRUE` and the job was **rejected**: running jobs are not affected and nothing has to
-//! be acknowledged. The exception is [`ErrorId::TechnologyAlarm`] (`16#8001`): a technology alarm
-//! occurred while the job ran, see `ErrorDetail.Number` and [`crate::alarm`].
+//! Semantics (S7-1500T Motion Control V4.0 function manual, 6.3 'Motion Control instructions', A.9
+//! 'Error ID for Motion Control instructions'): every ErrorID other than [`ErrorId::None`] means
+//! the FB shows `Error = TRUE` and the job was **rejected**: running jobs are not affected and
+//! nothing has to be acknowledged. The exception is [`ErrorId::TechnologyAlarm`] (`16#8001`): a
+//! technology alarm occurred while the job ran, see `ErrorDetail.Number` and
+//! [`crate::catalog::alarm`].
 //!
 //! # Tandem extensions
 //!
 //! | Code | Variant | Why |
 //! |---|---|---|
-//! | `16#80F0` | [`ErrorId::AxisLocked`] | S7-Technology MC_Stop locks the axis and rejects motion jobs with `8045` (seed 000 §2.3); in S7-1500 `16#8045` already means "fixed-stop travel active", so tandem uses a free code. |
-//! | `16#80F1` | [`ErrorId::IllegalOverride`] | S7-1500 clamps `Override.Velocity` (a DIR tag, seed 001 §1.12); tandem's job interface can also reject an override outside 0..200 %. |
-//! | `16#80F2` | [`ErrorId::NotHomed`] | S7-1500 reacts to MC_MoveAbsolute on an axis that is not homed with technology alarm 321 (E-stop, ErrorID `16#8001`, seed 001 §3.2); the reference has no plain ErrorID for it. This code is for a rejection without an alarm. |
-//! | `16#80F3` | [`ErrorId::JobRejectedInErrorStop`] | PLCopen ErrorStop: a motion job while a stopping technology alarm is pending and not acknowledged. S7-1500 has no own code for it; its manual only tells the user to check `ErrorDetail` before starting a job (seed 001 §3.1). |
+//! | `16#80F0` | [`ErrorId::AxisLocked`] | S7-Technology MC_Stop locks the axis and rejects motion jobs with `8045` (S7-Technology V4.1 function manual, 6.2.3 'FB404 MC_Stop - Stopping an axis and preventing new motion commands'); in S7-1500 `16#8045` already means "fixed-stop travel active", so tandem uses a free code. |
+//! | `16#80F1` | [`ErrorId::IllegalOverride`] | S7-1500 clamps `Override.Velocity` (a DIR tag, S7-1500T Motion Control V4.0 function manual, A.2.20 'Override tags (positioning axis/synchronous axis)'); tandem's job interface can also reject an override outside 0..200 %. |
+//! | `16#80F2` | [`ErrorId::NotHomed`] | S7-1500 reacts to MC_MoveAbsolute on an axis that is not homed with technology alarm 321 (E-stop, ErrorID `16#8001`, S7-1500T Motion Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4'); the reference has no plain ErrorID for it. This code is for a rejection without an alarm. |
+//! | `16#80F3` | [`ErrorId::JobRejectedInErrorStop`] | PLCopen ErrorStop: a motion job while a stopping technology alarm is pending and not acknowledged. S7-1500 has no own code for it; its manual only tells the user to check `ErrorDetail` before starting a job (S7-1500T Motion Control V4.0 function manual, 6.3 'Motion Control instructions'). |
 //!
 //! Whether the axis reports a missing homing as alarm 321 (S7-compatible) or as
 //! [`ErrorId::NotHomed`] is the axis's choice. This module only defines the codes.
@@ -54,7 +57,8 @@ macro_rules! error_ids {
                 }
             }
 
-            /// One-line description (the meaning column of seed 001 §5.3, or the tandem extension).
+            /// One-line description (the meaning column of S7-1500T Motion Control V4.0 function
+            /// manual, A.9 'Error ID for Motion Control instructions', or the tandem extension).
             pub const fn description(self) -> &'static str {
                 match self {
                     $(ErrorId::$name => $desc,)*
@@ -73,7 +77,8 @@ macro_rules! error_ids {
 }
 
 error_ids! {
-    /// ErrorID of a motion-control job (seed 001 §5.3, src ~L17714–17825).
+    /// ErrorID of a motion-control job (S7-1500T Motion Control V4.0 function manual,
+    /// A.9 'Error ID for Motion Control instructions').
     ///
     /// The discriminant is the code (`16#8003` is `0x8003`). The variants are declared in code
     /// order and [`ErrorId::ALL`] lists them in that order.
@@ -90,7 +95,8 @@ error_ids! {
         IllegalDeceleration = 0x8005 => "Illegal deceleration.",
         IllegalJerk = 0x8006 => "Illegal jerk.",
         /// Also JogForward and JogBackward both TRUE: the axis brakes with the last valid
-        /// deceleration (seed 001 §3.1).
+        /// deceleration (S7-1500T Motion Control V4.0 function manual, 6.3 'Motion Control
+        /// instructions').
         IllegalDirection = 0x8007 => "Illegal Direction or SyncDirection, or JogForward and JogBackward both TRUE.",
         IllegalDistance = 0x8008 => "Illegal distance.",
         IllegalPosition = 0x8009 => "Illegal position.",
@@ -124,7 +130,8 @@ error_ids! {
         IllegalDuration = 0x8042 => "Illegal Duration of the time-based output cam.",
         IllegalTorqueLimit = 0x8043 => "Illegal force/torque limit.",
         TorqueReductionNotConfigured = 0x8044 => "Axis not configured for torque reduction (needs telegram 102, 103, 105 or 106).",
-        /// Not to be confused with the S7-Technology `8045` of MC_Stop: see [`ErrorId::AxisLocked`].
+        /// Not to be confused with the S7-Technology `8045` of MC_Stop: see
+        /// [`ErrorId::AxisLocked`].
         FixedStopActive = 0x8045 => "Job not possible: travel to fixed stop active (no switch to non-position-controlled).",
         InClamping = 0x8046 => "MC_TorqueLimiting cannot be disabled while InClamping.",
         MotionIntoFixedStop = 0x8047 => "The motion goes into the fixed stop; only motions away from it are allowed.",
@@ -157,16 +164,19 @@ error_ids! {
         CamInvalidPoints = 0x80AC => "The cam contains invalid points or segments.",
         SyncPositionOutsideCam = 0x80AD => "MasterSyncPosition outside the definition range of the cam.",
         KinematicsMotionActive = 0x80AE => "Job not possible: a kinematics motion is active.",
-        /// **Tandem extension.** Counterpart of the S7-Technology MC_Stop lock (seed 000 §2.3,
-        /// error `8045` there): while an MC_Stop job holds the axis (its Execute still TRUE),
-        /// every new motion job is rejected, even across disable/re-enable.
+        /// **Tandem extension.** Counterpart of the S7-Technology MC_Stop lock (S7-Technology V4.1
+        /// function manual, 6.2.3 'FB404 MC_Stop - Stopping an axis and preventing new motion
+        /// commands', error `8045` there): while an MC_Stop job holds the axis (its Execute still
+        /// TRUE), every new motion job is rejected, even across disable/re-enable.
         AxisLocked = 0x80F0 => "Tandem extension: job rejected, the axis is locked by an active MC_Stop.",
-        /// **Tandem extension.** Velocity override outside 0.0..=200.0 % (seed 001 §1.12 range
-        /// of `Override.Velocity`) or not finite.
+        /// **Tandem extension.** Velocity override outside 0.0..=200.0 % (S7-1500T Motion Control
+        /// V4.0 function manual, A.2.20 'Override tags (positioning axis/synchronous
+        /// axis)', range of `Override.Velocity`) or not finite.
         IllegalOverride = 0x80F1 => "Tandem extension: override outside 0..200 %.",
         /// **Tandem extension.** Absolute positioning requested on an axis that is not homed.
         /// S7-1500 raises technology alarm 321 instead (E-stop reaction, job ErrorID `16#8001`,
-        /// seed 001 §3.2 MC_MoveAbsolute).
+        /// S7-1500T Motion Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis
+        /// absolutely V4').
         NotHomed = 0x80F2 => "Tandem extension: absolute move rejected, the axis is not homed (S7-1500: alarm 321).",
         /// **Tandem extension.** PLCopen ErrorStop: a technology alarm with a stopping reaction
         /// (1..=5) is pending and not yet acknowledged with MC_Reset.
@@ -186,7 +196,8 @@ impl ErrorId {
         !matches!(self, ErrorId::None)
     }
 
-    /// `true` for the codes tandem adds beyond seed 001 §5.3 (see the module documentation).
+    /// `true` for the codes tandem adds beyond S7-1500T Motion Control V4.0 function manual, A.9
+    /// 'Error ID for Motion Control instructions' (see the module documentation).
     pub const fn is_tandem_extension(self) -> bool {
         matches!(
             self,
@@ -204,6 +215,8 @@ impl fmt::Display for ErrorId {
         write!(f, "16#{:04X} {}", self.code(), self.name())
     }
 }
+
+impl std::error::Error for ErrorId {}
 
 #[cfg(test)]
 mod tests {
@@ -253,7 +266,8 @@ mod tests {
 
     #[test]
     fn reference_codes() {
-        // Spot checks against seed 001 §5.3.
+        // Spot checks against S7-1500T Motion Control V4.0 function manual, A.9 'Error ID for
+        // Motion Control instructions'.
         assert_eq!(ErrorId::None.code(), 0x0000);
         assert_eq!(ErrorId::TechnologyAlarm.code(), 0x8001);
         assert_eq!(ErrorId::IllegalVelocity.code(), 0x8003);
@@ -271,7 +285,8 @@ mod tests {
         for code in [0x8020, 0x8025, 0x8048, 0x8049, 0x8072, 0x80A4, 0x80AF] {
             assert_eq!(ErrorId::from_code(code), None);
         }
-        // 73 codes in seed 001 §5.3, plus 4 tandem extensions.
+        // 73 codes in S7-1500T Motion Control V4.0 function manual, A.9 'Error ID for Motion
+        // Control instructions', plus 4 tandem extensions.
         let reference = ErrorId::ALL
             .iter()
             .filter(|e| !e.is_tandem_extension())

@@ -1,6 +1,6 @@
 //! The instruction for one technology object, as the runtime applies it.
 
-use crate::axis::{CamId, Command};
+use crate::objects::axis::{CamId, Command};
 
 /// What an instruction does to a technology object: an axis or encoder command, or one of the
 /// instructions of the cam, output cam, cam track and measuring input objects. Script files,

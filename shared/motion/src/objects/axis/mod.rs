@@ -1,11 +1,11 @@
 //! The axis technology object: speed axis and positioning axis with the PLCopen state machine,
-//! the jobs of seed 001 §3.2, monitoring (§4) and technology alarms (§5), over a simulated
-//! drive. One call of [`Axis::step`] is one servo/interpolator cycle; commands are applied
-//! between cycles with [`Axis::command`]. Nothing here allocates after [`Axis::new`].
+//! the jobs of the S7-1500T Motion Control V4.0 function manual (chapter 10 'Instructions'), its
+//! monitoring functions and technology alarms, over a simulated drive. One call of [`Axis::step`]
+//! is one servo/interpolator cycle; commands are applied between cycles with [`Axis::command`].
+//! Nothing here allocates after [`Axis::new`].
 //!
 //! Positions are kept continuous (unwrapped) inside; modulo positions are what the status shows.
 
-mod camming;
 mod command;
 mod config;
 mod step;
@@ -16,22 +16,24 @@ pub use command::{
     SyncProfileReference, VelocityDirection,
 };
 pub use config::{
-    AxisConfig, AxisKind, ConfigError, EncoderType, FollowingErrorMonitoring, HomingConfig,
-    HomingMark, MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits,
-    StandstillSignal,
+    AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
+    FollowingErrorMonitoring, HomingConfig, HomingMark, MotionType, PassiveDirection,
+    PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
 };
 
-use crate::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
-use crate::drive::SimDrive;
-use crate::dynamics::{Clamped, Dynamics};
-use crate::error_id::ErrorId;
-use crate::extrapolation::{Extrapolated, Extrapolator};
-use crate::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
-use crate::leading::LeadingValue;
-use crate::override_table::{table1, NewJob, RunningMotion};
-use crate::profile::{plan_position, plan_velocity, Limits, Profile, State};
+use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
+use crate::catalog::error_id::ErrorId;
+use crate::catalog::override_table::{table1, NewJob, RunningMotion};
+use crate::kinematics::dynamics::{Clamped, Dynamics};
+use crate::kinematics::extrapolation::{Extrapolated, Extrapolator};
+use crate::kinematics::modulo::Modulo;
+use crate::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, State};
+use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
+use crate::objects::leading::LeadingValue;
+use crate::plant::drive::SimDrive;
 
-/// PLCopen axis states (seed 001 §3.5, seed 000 §2.5).
+/// PLCopen axis states (S7-1500T Motion Control V4.0 function manual, A.2.35 'StatusWord tag' (the
+/// manual draws no state diagram), PLCopen Motion Control part 1, axis state diagram).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum AxisState {
     /// Not enabled.
@@ -107,13 +109,40 @@ pub struct AxisStatus {
     pub superimposed_job: Option<(JobId, Instruction)>,
     /// The active synchronous operation job.
     pub sync_job: Option<(JobId, Instruction)>,
-    /// `StatusSynchronizedMotion.FunctionState`: 0 none, 1 GearIn, 2 GearInPos, 3 CamIn.
+    /// `StatusSynchronizedMotion.FunctionState`: one of [`sync_function`] (0 none, 1 GearIn,
+    /// 2 GearInPos, 3 CamIn).
     pub sync_function: u8,
-    /// `StatusSynchronizedMotion.StatusWord`: bit 0 MaxVelocityExceeded, 1
-    /// MaxAccelerationExceeded, 2 MaxDecelerationExceeded.
+    /// `StatusSynchronizedMotion.StatusWord`: the bits of [`sync_status`] (bit 0
+    /// MaxVelocityExceeded, 1 MaxAccelerationExceeded, 2 MaxDecelerationExceeded, 3 simulated).
     pub sync_status_word: u8,
     /// `StatusSynchronizedMotion.PhaseShift`.
     pub phase_shift: f64,
+}
+
+/// The values of [`AxisStatus::sync_function`] (`StatusSynchronizedMotion.FunctionState`), as
+/// they appear in traces and on the wire.
+pub mod sync_function {
+    /// 0: no synchronous operation.
+    pub const NONE: u8 = 0;
+    /// 1: relative gearing (MC_GearIn).
+    pub const GEAR_IN: u8 = 1;
+    /// 2: absolute gearing (MC_GearInPos).
+    pub const GEAR_IN_POS: u8 = 2;
+    /// 3: camming (MC_CamIn).
+    pub const CAM_IN: u8 = 3;
+}
+
+/// The bits of [`AxisStatus::sync_status_word`] (`StatusSynchronizedMotion.StatusWord`).
+pub mod sync_status {
+    /// Bit 0 "MaxVelocityExceeded": the coupled setpoint exceeds the axis' maximum velocity.
+    pub const MAX_VELOCITY_EXCEEDED: u8 = 1 << 0;
+    /// Bit 1 "MaxAccelerationExceeded": it exceeds the maximum acceleration.
+    pub const MAX_ACCELERATION_EXCEEDED: u8 = 1 << 1;
+    /// Bit 2 "MaxDecelerationExceeded": it exceeds the maximum deceleration.
+    pub const MAX_DECELERATION_EXCEEDED: u8 = 1 << 2;
+    /// Bit 3: the synchronous operation runs simulated (MC_SynchronizedMotionSimulation); the
+    /// coupling goes on logically while the follower stands.
+    pub const SIMULATION: u8 = 1 << 3;
 }
 
 impl AxisStatus {
@@ -251,13 +280,13 @@ pub struct Axis {
     sync_sim: Option<JobId>,
     /// Cams of the active and the pending CamIn, with their mappings.
     cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
-    cam_maps: [Option<camming::CamMap>; 2],
+    cam_maps: [Option<sync::CamMap>; 2],
     /// The cam handed over for the next MC_CamIn.
     provided_cam: Option<(CamId, std::sync::Arc<crate::cam::Cam>)>,
     /// Offset of the following value (MC_OffsetAbsolute/Relative), follower units.
     shift_out: State,
     /// Leading values for this cycle: of the active and of the pending job's leader.
-    lead: [Option<crate::leading::LeadingValue>; 2],
+    lead: [Option<crate::objects::leading::LeadingValue>; 2],
     sync_flags: u8,
     /// The actual value prepared for actual-value coupling (run only while a follower may use
     /// it: [`Axis::set_actual_value_output`]).
@@ -289,7 +318,7 @@ fn sign(x: f64) -> f64 {
 
 impl Axis {
     /// Builds an axis from a validated configuration, disabled, at rest.
-    pub fn new(cfg: AxisConfig) -> Result<Self, ConfigError> {
+    pub fn new(cfg: AxisConfig) -> Result<Self, AxisConfigError> {
         cfg.validate()?;
         let drive = SimDrive::new(
             cfg.drive,
@@ -367,7 +396,7 @@ impl Axis {
                 motion_job: None,
                 superimposed_job: None,
                 sync_job: None,
-                sync_function: 0,
+                sync_function: sync_function::NONE,
                 sync_status_word: 0,
                 phase_shift: 0.0,
             },
@@ -423,8 +452,8 @@ impl Axis {
     }
 
     /// This axis as a leader with actual-value coupling: its actual value filtered and
-    /// extrapolated (`StatusExtrapolation`, see [`crate::extrapolation`]); the plain actual
-    /// value while [`Axis::set_actual_value_output`] is off.
+    /// extrapolated (`StatusExtrapolation`, see [`crate::kinematics::extrapolation`]); the plain
+    /// actual value while [`Axis::set_actual_value_output`] is off.
     pub fn actual_leading_value(&self) -> LeadingValue {
         if !self.actual_output {
             return LeadingValue {
@@ -618,7 +647,8 @@ impl Axis {
         ]
     }
 
-    /// Aborts the running jobs that `new` overrides (seed 001 §3.3 tables 1 and 2).
+    /// Aborts the running jobs that `new` overrides (S7-1500T Motion Control V4.0 function manual,
+    /// 10.16 'Override response of Motion Control jobs V4' tables 1 and 2).
     fn apply_override_table(&mut self, new: NewJob) {
         self.apply_table2(new);
         let [main, sup, passive] = self.running_classes();
@@ -635,8 +665,9 @@ impl Axis {
 
     fn abort_main(&mut self, how: JobEventKind) {
         if let Some(m) = self.main.take() {
-            // An aborted MC_Stop keeps its lock while its Execute is held (seed 000 §2.3: "even
-            // across disable/re-enable"); only releasing it unlocks the axis.
+            // An aborted MC_Stop keeps its lock while its Execute is held (S7-Technology V4.1
+            // function manual, 6.2.3 'FB404 MC_Stop - Stopping an axis and preventing new motion
+            // commands': "even across disable/re-enable"); only releasing it unlocks the axis.
             self.emit(m.id, m.instr, how);
         }
     }
@@ -655,7 +686,8 @@ impl Axis {
     }
 
     fn abort_all(&mut self, how: JobEventKind) {
-        // A simulated synchronous operation survives disables and alarms (seed 001 §1.6).
+        // A simulated synchronous operation survives disables and alarms (S7-1500T Motion Control
+        // V4.0 function manual, 3.5.10 'Simulate synchronous operation').
         if self.sync_sim.is_none() {
             self.abort_sync(how);
             self.abort_pending(how);
@@ -666,7 +698,8 @@ impl Axis {
         self.replan();
     }
 
-    /// Raises a technology alarm and applies its reaction (seed 001 §5.1).
+    /// Raises a technology alarm and applies its reaction (S7-1500T Motion Control V4.0 function
+    /// manual, 9.3 'Technology alarms').
     pub fn raise(&mut self, id: AlarmId, supp: u16) {
         if self.alarms().any(|a| a.id == id && a.supplement == supp) {
             return;
@@ -810,14 +843,7 @@ impl Axis {
                 deceleration,
                 jerk,
                 abort_acceleration,
-            } => {
-                self.check_motion_allowed()?;
-                let lim = self.stop_limits(deceleration, jerk)?;
-                if abort_acceleration {
-                    self.basic.a = 0.0;
-                }
-                Ok(self.start_main(Instruction::Halt, lim, Goal::Stop { lim }))
-            }
+            } => self.cmd_halt(deceleration, jerk, abort_acceleration),
             Command::Stop {
                 execute,
                 deceleration,
@@ -840,35 +866,7 @@ impl Axis {
                 direction,
                 current,
                 position_controlled,
-            } => {
-                self.check_motion_allowed()?;
-                // MoveVelocity: the sign of Velocity is a direction (Direction 0), not the
-                // "default" sentinel; 0 is allowed (stop and stay busy).
-                let d = Dynamics {
-                    velocity: dynamics.velocity.abs(),
-                    ..dynamics
-                };
-                let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
-                let speed = r.limits.vel;
-                let v = if current {
-                    self.total().v
-                } else {
-                    match direction {
-                        VelocityDirection::BySign => speed.copysign(dynamics.velocity),
-                        VelocityDirection::Positive => speed,
-                        VelocityDirection::Negative => -speed,
-                    }
-                };
-                self.warn_clamped(r.clamped);
-                self.apply_override_table(NewJob::Positioning);
-                self.fold_superimposed();
-                self.set_position_control(position_controlled);
-                let lim = Limits {
-                    vel: self.cfg.limits.max_velocity,
-                    ..r.limits
-                };
-                Ok(self.start_main(Instruction::MoveVelocity, lim, Goal::Velocity { v, lim }))
-            }
+            } => self.cmd_move_velocity(&dynamics, direction, current, position_controlled),
             Command::MoveJog {
                 forward,
                 backward,
@@ -876,137 +874,18 @@ impl Axis {
                 position_controlled,
             } => self.cmd_jog(forward, backward, dynamics, position_controlled),
             Command::MoveSuperimposed { distance, dynamics } => {
-                self.require_positioning()?;
-                self.check_motion_allowed()?;
-                if !distance.is_finite() {
-                    return Err(ErrorId::IllegalDistance);
-                }
-                let r = self
-                    .cfg
-                    .limits
-                    .resolve(&self.cfg.defaults, &dynamics, false)?;
-                self.warn_clamped(r.clamped);
-                // A running superimposed job is aborted (table 1) without folding its motion
-                // into the basic motion: the new one continues from its state.
-                if let Some(old) = self.sup_job.take() {
-                    self.emit(
-                        old.id,
-                        Instruction::MoveSuperimposed,
-                        JobEventKind::CommandAborted,
-                    );
-                }
-                self.apply_override_table(NewJob::Superimposed);
-                self.force_position_control();
-                // A new superimposed job continues from the current superimposed state; its
-                // distance counts from the current superimposed position.
-                let s = self.sup;
-                let prof = plan_position(s, s.p + distance, &r.limits)
-                    .map_err(|_| ErrorId::IllegalDistance)?;
-                let id = self.new_id();
-                self.sup_job = Some(SupJob {
-                    id,
-                    prof,
-                    t0: self.now,
-                });
-                self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Busy);
-                Ok(id)
+                self.cmd_superimposed(distance, &dynamics)
             }
-            Command::GearIn {
-                master,
-                ratio_numerator,
-                ratio_denominator,
-                dynamics,
-            } => self.cmd_gear_in(master, ratio_numerator, ratio_denominator, &dynamics, false),
-            Command::GearInPos {
-                master,
-                ratio_numerator,
-                ratio_denominator,
-                master_sync_position,
-                slave_sync_position,
-                sync_profile_reference,
-                master_start_distance,
-                dynamics,
-                sync_direction,
-            } => self.cmd_gear_in_pos(
-                master,
-                ratio_numerator,
-                ratio_denominator,
-                master_sync_position,
-                slave_sync_position,
-                sync_profile_reference,
-                master_start_distance,
-                &dynamics,
-                sync_direction,
-            ),
-            Command::GearOut => self.cmd_gear_out(),
-            Command::CamIn {
-                master,
-                cam,
-                master_offset,
-                slave_offset,
-                master_scaling,
-                slave_scaling,
-                master_sync_position,
-                sync_profile_reference,
-                master_start_distance,
-                dynamics,
-                application_mode,
-                sync_direction,
-            } => self.cmd_cam_in(
-                master,
-                cam,
-                (master_offset, slave_offset, master_scaling, slave_scaling),
-                master_sync_position,
-                sync_profile_reference,
-                master_start_distance,
-                &dynamics,
-                application_mode,
-                sync_direction,
-            ),
-            Command::CamOut => self.cmd_cam_out(),
-            Command::SynchronizedMotionSimulation { enable } => self.cmd_sync_simulation(enable),
-            Command::GearInVelocity {
-                master,
-                ratio_numerator,
-                ratio_denominator,
-                dynamics,
-            } => self.cmd_gear_in(master, ratio_numerator, ratio_denominator, &dynamics, true),
-            Command::Offset {
-                offset,
-                absolute,
-                dynamics,
-            } => self.cmd_offset(offset, absolute, &dynamics),
-            Command::Phasing {
-                phase_shift,
-                absolute,
-                dynamics,
-            } => self.cmd_phasing(phase_shift, absolute, &dynamics),
-            Command::SetOverride { velocity } => {
-                if !(velocity.is_finite() && (0.0..=200.0).contains(&velocity)) {
-                    return Err(ErrorId::IllegalOverride);
-                }
-                let id = self.new_id();
-                if velocity != self.override_pct {
-                    self.override_pct = velocity;
-                    if matches!(self.goal, Goal::Position { .. } | Goal::Velocity { .. }) {
-                        self.replan();
-                        let mut left = None;
-                        if let Some(m) = self.main.as_mut() {
-                            if m.in_velocity {
-                                m.in_velocity = false;
-                                left = Some((m.id, m.instr));
-                            }
-                            // A positioning job that had stopped at override 0 moves again.
-                            m.monitoring = None;
-                        }
-                        if let Some((mid, instr)) = left {
-                            self.emit(mid, instr, JobEventKind::LeftVelocity);
-                        }
-                    }
-                }
-                self.emit(id, Instruction::SetOverride, JobEventKind::Done);
-                Ok(id)
-            }
+            Command::GearIn { .. }
+            | Command::GearInPos { .. }
+            | Command::GearOut
+            | Command::CamIn { .. }
+            | Command::CamOut
+            | Command::SynchronizedMotionSimulation { .. }
+            | Command::GearInVelocity { .. }
+            | Command::Offset { .. }
+            | Command::Phasing { .. } => self.apply_sync(cmd),
+            Command::SetOverride { velocity } => self.cmd_set_override(velocity),
             Command::MotionInPosition {
                 enable,
                 position,
@@ -1037,6 +916,126 @@ impl Axis {
                 position_controlled,
             ),
         }
+    }
+
+    /// MC_Halt: stop with the given deceleration and jerk (the job stays until standstill).
+    fn cmd_halt(
+        &mut self,
+        deceleration: f64,
+        jerk: f64,
+        abort_acceleration: bool,
+    ) -> Result<JobId, ErrorId> {
+        self.check_motion_allowed()?;
+        let lim = self.stop_limits(deceleration, jerk)?;
+        if abort_acceleration {
+            self.basic.a = 0.0;
+        }
+        Ok(self.start_main(Instruction::Halt, lim, Goal::Stop { lim }))
+    }
+
+    /// MC_MoveVelocity: a velocity goal from the dynamics, the direction or the current
+    /// velocity.
+    fn cmd_move_velocity(
+        &mut self,
+        dynamics: &Dynamics,
+        direction: VelocityDirection,
+        current: bool,
+        position_controlled: bool,
+    ) -> Result<JobId, ErrorId> {
+        self.check_motion_allowed()?;
+        // MoveVelocity: the sign of Velocity is a direction (Direction 0), not the
+        // "default" sentinel; 0 is allowed (stop and stay busy).
+        let d = Dynamics {
+            velocity: dynamics.velocity.abs(),
+            ..*dynamics
+        };
+        let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+        let speed = r.limits.vel;
+        let v = if current {
+            self.total().v
+        } else {
+            match direction {
+                VelocityDirection::BySign => speed.copysign(dynamics.velocity),
+                VelocityDirection::Positive => speed,
+                VelocityDirection::Negative => -speed,
+            }
+        };
+        self.warn_clamped(r.clamped);
+        self.apply_override_table(NewJob::Positioning);
+        self.fold_superimposed();
+        self.set_position_control(position_controlled);
+        let lim = Limits {
+            vel: self.cfg.limits.max_velocity,
+            ..r.limits
+        };
+        Ok(self.start_main(Instruction::MoveVelocity, lim, Goal::Velocity { v, lim }))
+    }
+
+    /// MC_MoveSuperimposed: a relative motion added to the basic motion.
+    fn cmd_superimposed(&mut self, distance: f64, dynamics: &Dynamics) -> Result<JobId, ErrorId> {
+        self.require_positioning()?;
+        self.check_motion_allowed()?;
+        if !distance.is_finite() {
+            return Err(ErrorId::IllegalDistance);
+        }
+        let r = self
+            .cfg
+            .limits
+            .resolve(&self.cfg.defaults, dynamics, false)?;
+        self.warn_clamped(r.clamped);
+        // A running superimposed job is aborted (table 1) without folding its motion
+        // into the basic motion: the new one continues from its state.
+        if let Some(old) = self.sup_job.take() {
+            self.emit(
+                old.id,
+                Instruction::MoveSuperimposed,
+                JobEventKind::CommandAborted,
+            );
+        }
+        self.apply_override_table(NewJob::Superimposed);
+        self.force_position_control();
+        // A new superimposed job continues from the current superimposed state; its
+        // distance counts from the current superimposed position.
+        let s = self.sup;
+        let prof =
+            plan_position(s, s.p + distance, &r.limits).map_err(|_| ErrorId::IllegalDistance)?;
+        let id = self.new_id();
+        self.sup_job = Some(SupJob {
+            id,
+            prof,
+            t0: self.now,
+        });
+        self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Busy);
+        Ok(id)
+    }
+
+    /// MC_SetOverride: the velocity override in percent (0..=200); a running positioning or
+    /// velocity job is replanned with it.
+    fn cmd_set_override(&mut self, velocity: f64) -> Result<JobId, ErrorId> {
+        if !(velocity.is_finite() && (0.0..=200.0).contains(&velocity)) {
+            return Err(ErrorId::IllegalOverride);
+        }
+        let id = self.new_id();
+        if velocity != self.override_pct {
+            self.override_pct = velocity;
+            if matches!(self.goal, Goal::Position { .. } | Goal::Velocity { .. }) {
+                self.replan();
+                let mut left = None;
+                if let Some(m) = self.main.as_mut() {
+                    if m.in_velocity {
+                        m.in_velocity = false;
+                        left = Some((m.id, m.instr));
+                    }
+                    // A positioning job that had stopped at override 0 moves again.
+                    m.monitoring = None;
+                }
+                if let Some((mid, instr)) = left {
+                    self.emit(mid, instr, JobEventKind::LeftVelocity);
+                }
+            }
+        }
+        self.emit(id, Instruction::SetOverride, JobEventKind::Done);
+        Ok(id)
     }
 
     /// MC_MoveAbsolute (`value` = Position) and MC_MoveRelative (`value` = Distance): checks,
@@ -1088,7 +1087,8 @@ impl Axis {
         self.pos_ctrl = on;
     }
 
-    /// Continuous target of MoveAbsolute: modulo reduction and Direction (seed 001 §3.2).
+    /// Continuous target of MoveAbsolute: modulo reduction and Direction (S7-1500T Motion Control
+    /// V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4').
     fn absolute_target(&self, position: f64, direction: Direction, lim: &Limits) -> f64 {
         let Some(m) = self.cfg.modulo else {
             return position;
@@ -1255,7 +1255,8 @@ impl Axis {
             return Ok(0);
         }
         self.check_motion_allowed()?;
-        // Jog uses the absolute value of a negative Velocity (seed 001 §8 item 2).
+        // Jog uses the absolute value of a negative Velocity (S7-1500T Motion Control V4.0
+        // function manual, 10.8.1 'MC_MoveJog: Move axis in jog mode V4').
         let d = Dynamics {
             velocity: dynamics.velocity.abs(),
             ..dynamics
@@ -1365,7 +1366,61 @@ impl Axis {
         Ok(id)
     }
 
+    /// MC_Home: checks the mode against the encoder, the enable and the plant, then homes
+    /// directly (modes 0, 1, 6, 7), arms passive homing (2, 8, 10; 9 aborts it) or starts active
+    /// homing (3, 5).
     fn cmd_home(&mut self, mode: u8, position: f64) -> Result<JobId, ErrorId> {
+        self.check_home(mode, position)?;
+        let id = self.new_id();
+        self.emit(id, Instruction::Home, JobEventKind::Busy);
+        let modulo = self.cfg.modulo;
+        match mode {
+            0 | 7 => {
+                // Direct / absolute-encoder adjustment, absolute: actual := Position.
+                let delta = reduce(modulo, position) - self.actual_p;
+                self.home_directly(id, delta, mode == 7);
+            }
+            1 | 6 => {
+                // Relative: actual := actual + Position (reduced on modulo axes).
+                let delta = reduce(modulo, self.actual_p + position) - self.actual_p;
+                self.home_directly(id, delta, mode == 6);
+            }
+            9 => {
+                self.abort_passive(JobEventKind::CommandAborted);
+                self.emit(id, Instruction::Home, JobEventKind::Done);
+            }
+            2 | 8 | 10 => {
+                self.abort_passive(JobEventKind::CommandAborted);
+                if mode != 2 {
+                    self.homed = false;
+                }
+                let home = reduce(
+                    modulo,
+                    if mode == 10 {
+                        self.cfg.homing.home_position
+                    } else {
+                        position
+                    },
+                );
+                let phase = match self.cfg.homing.passive_mark {
+                    HomingMark::ZeroMark => HomePhase::Armed,
+                    _ => HomePhase::Search,
+                };
+                self.passive = Some(PassiveHoming {
+                    job: id,
+                    home,
+                    phase,
+                    armed_dir: 0.0,
+                });
+            }
+            _ => self.start_active_homing(id, mode, position),
+        }
+        Ok(id)
+    }
+
+    /// The checks of MC_Home: no absolute synchronous operation, a finite position, a mode the
+    /// encoder type, the enable and the plant's sensors allow.
+    fn check_home(&mut self, mode: u8, position: f64) -> Result<(), ErrorId> {
         self.require_positioning()?;
         let absolute_sync = |s: Option<sync::SyncJob>| {
             s.map(|j| matches!(j.instr, Instruction::GearInPos | Instruction::CamIn))
@@ -1416,120 +1471,82 @@ impl Axis {
                 return Err(ErrorId::IllegalMode);
             }
         }
-        let id = self.new_id();
-        self.emit(id, Instruction::Home, JobEventKind::Busy);
-        let modulo = self.cfg.modulo;
-        let reduce = |p: f64| match modulo {
-            Some(m) => m.wrap(p),
-            None => p,
-        };
-        match mode {
-            0 | 7 => {
-                // Direct / absolute-encoder adjustment, absolute: actual := Position.
-                let delta = reduce(position) - self.actual_p;
-                self.shift(delta);
-                if mode == 7 {
-                    self.abs_encoder_offset = self.offset;
-                }
-                self.homed = true;
-                self.emit(id, Instruction::Home, JobEventKind::Done);
-            }
-            1 | 6 => {
-                // Relative: actual := actual + Position (reduced on modulo axes).
-                let delta = reduce(self.actual_p + position) - self.actual_p;
-                self.shift(delta);
-                if mode == 6 {
-                    self.abs_encoder_offset = self.offset;
-                }
-                self.homed = true;
-                self.emit(id, Instruction::Home, JobEventKind::Done);
-            }
-            9 => {
-                self.abort_passive(JobEventKind::CommandAborted);
-                self.emit(id, Instruction::Home, JobEventKind::Done);
-            }
-            2 | 8 | 10 => {
-                self.abort_passive(JobEventKind::CommandAborted);
-                if mode != 2 {
-                    self.homed = false;
-                }
-                let home = reduce(if mode == 10 {
-                    self.cfg.homing.home_position
-                } else {
-                    position
-                });
-                let phase = match self.cfg.homing.passive_mark {
-                    HomingMark::ZeroMark => HomePhase::Armed,
-                    _ => HomePhase::Search,
-                };
-                self.passive = Some(PassiveHoming {
-                    job: id,
-                    home,
-                    phase,
-                    armed_dir: 0.0,
-                });
-            }
-            _ => {
-                // 3 / 5: active homing. Aborts all motion and re-enables position control.
-                self.apply_override_table(NewJob::HomeActive);
-                self.fold_superimposed();
-                self.force_position_control();
-                self.homed = false;
-                let h = &self.cfg.homing;
-                let end = reduce(if mode == 5 { h.home_position } else { position });
-                let lim = self.default_limits();
-                if self.cfg.virtual_axis {
-                    // Simulation: homing completes at once without motion (seed 001 §7).
-                    let delta = end - self.actual_p;
-                    self.shift(delta);
-                    self.homed = true;
-                    self.emit(id, Instruction::Home, JobEventKind::Done);
-                    return Ok(id);
-                }
-                let home = end - h.home_position_offset;
-                let search_dir = h.approach_direction.sign();
-                let on_cam = self.on_cam(self.drive.actual().p);
-                let (phase, v) = match (h.active_mark, on_cam) {
-                    (HomingMark::ZeroMark, _) => (
-                        HomePhase::Armed,
-                        h.homing_direction.sign() * h.referencing_velocity,
-                    ),
-                    (_, true) => (
-                        HomePhase::OnCam,
-                        h.homing_direction.sign() * h.referencing_velocity,
-                    ),
-                    (_, false) => (HomePhase::Search, search_dir * h.approach_velocity),
-                };
-                self.main = Some(MotionJob {
-                    id,
-                    instr: Instruction::Home,
-                    in_velocity: false,
-                    monitoring: None,
-                    homing: Some(ActiveHoming {
-                        home,
-                        end,
-                        phase,
-                        search_dir,
-                        reversals: 0,
-                    }),
-                    jog: (false, false),
-                    lim,
-                });
-                let vlim = Limits {
-                    vel: self.cfg.limits.max_velocity,
-                    ..lim
-                };
-                self.set_goal(Goal::Velocity { v, lim: vlim });
-                // Homing velocities are not scaled by the override: undo the scaling.
-                if self.override_pct != 100.0 {
-                    let ovr = self.override_pct;
-                    self.override_pct = 100.0;
-                    self.replan();
-                    self.override_pct = ovr;
-                }
-            }
+        Ok(())
+    }
+
+    /// Direct homing (modes 0, 1, 6, 7): the coordinates move by `delta`; with an absolute
+    /// encoder (`absolute`, modes 6, 7) its offset is kept.
+    fn home_directly(&mut self, id: JobId, delta: f64, absolute: bool) {
+        self.shift(delta);
+        if absolute {
+            self.abs_encoder_offset = self.offset;
         }
-        Ok(id)
+        self.homed = true;
+        self.emit(id, Instruction::Home, JobEventKind::Done);
+    }
+
+    /// Active homing (modes 3, 5): aborts all motion, re-enables position control and starts
+    /// the search for the homing mark (on a virtual axis it completes at once).
+    fn start_active_homing(&mut self, id: JobId, mode: u8, position: f64) {
+        let modulo = self.cfg.modulo;
+        // 3 / 5: active homing. Aborts all motion and re-enables position control.
+        self.apply_override_table(NewJob::HomeActive);
+        self.fold_superimposed();
+        self.force_position_control();
+        self.homed = false;
+        let h = &self.cfg.homing;
+        let end = reduce(modulo, if mode == 5 { h.home_position } else { position });
+        let lim = self.default_limits();
+        if self.cfg.virtual_axis {
+            // Simulation: homing completes at once without motion (S7-1500T Motion Control V4.0
+            // function manual, 3.2.5.7 'Axis in simulation').
+            let delta = end - self.actual_p;
+            self.shift(delta);
+            self.homed = true;
+            self.emit(id, Instruction::Home, JobEventKind::Done);
+            return;
+        }
+        let home = end - h.home_position_offset;
+        let search_dir = h.approach_direction.sign();
+        let on_cam = self.on_cam(self.drive.actual().p);
+        let (phase, v) = match (h.active_mark, on_cam) {
+            (HomingMark::ZeroMark, _) => (
+                HomePhase::Armed,
+                h.homing_direction.sign() * h.referencing_velocity,
+            ),
+            (_, true) => (
+                HomePhase::OnCam,
+                h.homing_direction.sign() * h.referencing_velocity,
+            ),
+            (_, false) => (HomePhase::Search, search_dir * h.approach_velocity),
+        };
+        self.main = Some(MotionJob {
+            id,
+            instr: Instruction::Home,
+            in_velocity: false,
+            monitoring: None,
+            homing: Some(ActiveHoming {
+                home,
+                end,
+                phase,
+                search_dir,
+                reversals: 0,
+            }),
+            jog: (false, false),
+            lim,
+        });
+        let vlim = Limits {
+            vel: self.cfg.limits.max_velocity,
+            ..lim
+        };
+        self.set_goal(Goal::Velocity { v, lim: vlim });
+        // Homing velocities are not scaled by the override: undo the scaling.
+        if self.override_pct != 100.0 {
+            let ovr = self.override_pct;
+            self.override_pct = 100.0;
+            self.replan();
+            self.override_pct = ovr;
+        }
     }
 
     /// Shifts the axis coordinate system by `delta` (homing): actual, setpoint and the running
@@ -1567,5 +1584,13 @@ impl Axis {
             Some((lo, hi)) => phys >= lo && phys <= hi,
             None => false,
         }
+    }
+}
+
+/// `p` reduced into the modulo range (unchanged on a linear axis).
+fn reduce(modulo: Option<Modulo>, p: f64) -> f64 {
+    match modulo {
+        Some(m) => m.wrap(p),
+        None => p,
     }
 }

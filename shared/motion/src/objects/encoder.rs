@@ -1,18 +1,19 @@
-//! The external encoder technology object (`TO_ExternalEncoder`, seed 001 §1.7): an actual
-//! position from outside (a measuring wheel on the material, a line shaft), enabled with
-//! MC_Power, homed directly or by absolute-encoder adjustment, and offered to followers as an
-//! actual-value leading value through the extrapolation of [`crate::extrapolation`].
+//! The external encoder technology object (`TO_ExternalEncoder`, S7-1500T Motion Control V4.0
+//! function manual, 3.6 'Technology object external encoder'): an actual position from outside (a
+//! measuring wheel on the material, a line shaft), enabled with MC_Power, homed directly or by
+//! absolute-encoder adjustment, and offered to followers as an actual-value leading value through
+//! the extrapolation of [`crate::kinematics::extrapolation`].
 //!
 //! The raw position and velocity are an input of each cycle (the runtime's simulated source or,
 //! later, a real encoder). Nothing here allocates after [`ExternalEncoder::new`].
 
-use crate::alarm::status_bit;
-use crate::axis::{Command, EncoderType};
-use crate::error_id::ErrorId;
-use crate::extrapolation::{Extrapolated, ExtrapolationConfig, Extrapolator};
-use crate::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
-use crate::leading::LeadingValue;
-use crate::modulo::Modulo;
+use crate::catalog::alarm::status_bit;
+use crate::catalog::error_id::ErrorId;
+use crate::kinematics::extrapolation::{Extrapolated, ExtrapolationConfig, Extrapolator};
+use crate::kinematics::modulo::Modulo;
+use crate::objects::axis::{Command, EncoderType};
+use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
+use crate::objects::leading::LeadingValue;
 
 /// Configuration of an external encoder.
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -259,8 +260,8 @@ mod tests {
         assert_eq!(e.leading_value(), None, "no leading value while disabled");
         e.command(&Command::Power {
             enable: true,
-            start_mode: crate::axis::StartMode::PositionControlled,
-            stop_mode: crate::axis::StopMode::Emergency,
+            start_mode: crate::objects::axis::StartMode::PositionControlled,
+            stop_mode: crate::objects::axis::StopMode::Emergency,
         })
         .unwrap();
         e.step(1_000_000, 100.01, 10.0);

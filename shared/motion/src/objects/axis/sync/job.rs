@@ -1,0 +1,68 @@
+//! The synchronous operation jobs an axis keeps: the coupling job (its law and phase) and the
+//! phasing / offset jobs that shift it.
+
+use super::law::SyncLaw;
+use crate::kinematics::dynamics::Dynamics;
+use crate::kinematics::profile::{Limits, Profile};
+use crate::objects::axis::{SyncDirection, SyncProfileReference};
+use crate::objects::job::{Instruction, JobId};
+use crate::objects::leading::LeaderId;
+
+/// Phase of a synchronous operation job.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(in crate::objects::axis) enum SyncPhase {
+    /// Waiting for the start condition (Busy, neither StartSync nor InSync).
+    Pending,
+    /// Synchronizing (`StartSync`, StatusWord.X21).
+    Synchronizing,
+    /// Synchronous (`InGear` / `InSync`, StatusWord.X22).
+    Synchronous,
+}
+
+/// A synchronous operation job.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(in crate::objects::axis) struct SyncJob {
+    pub id: JobId,
+    pub instr: Instruction,
+    pub master: LeaderId,
+    pub ratio: f64,
+    pub lim: Limits,
+    pub phase: SyncPhase,
+    pub law: SyncLaw,
+    /// The law has been set up from the first leading value.
+    pub ready: bool,
+}
+
+impl SyncJob {
+    /// The follower's coordinates moved by `delta` (homing): the coupling moves with them.
+    pub(in crate::objects::axis) fn shift_follower(&mut self, delta: f64) {
+        self.law.shift_follower(delta);
+    }
+}
+
+/// A phasing job: a profile of the phase shift (leading value units).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(in crate::objects::axis) struct PhasingJob {
+    pub id: JobId,
+    pub instr: Instruction,
+    pub prof: Profile,
+    pub t0: i64,
+}
+
+/// The inputs shared by the absolute synchronizations (MC_GearInPos, MC_CamIn): the leader, where
+/// and how the follower synchronizes, with which dynamics.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(in crate::objects::axis) struct AbsoluteSync {
+    /// The leading value.
+    pub master: LeaderId,
+    /// `MasterSyncPosition`.
+    pub master_sync_position: f64,
+    /// `SyncProfileReference`.
+    pub reference: SyncProfileReference,
+    /// `MasterStartDistance`.
+    pub master_start_distance: f64,
+    /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` of the synchronization.
+    pub dynamics: Dynamics,
+    /// `SyncDirection`.
+    pub direction: SyncDirection,
+}
