@@ -31,7 +31,7 @@ pub struct Fail(pub u8, pub String);
 
 impl From<ipc::IpcError> for Fail {
     fn from(e: ipc::IpcError) -> Self {
-        Fail(4, e.message)
+        Fail(4, e.to_string())
     }
 }
 

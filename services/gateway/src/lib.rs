@@ -453,7 +453,7 @@ fn commands(x: &Ctx) -> Result<(), String> {
                     Ok(t) if t.trim_start().starts_with('{') => {
                         serde_json::from_str::<json::CommandJson>(&t)
                             .map_err(|e| format!("the JSON command is malformed: {e}"))
-                            .and_then(|c| c.to_line())
+                            .and_then(|c| c.to_line().map_err(|e| e.to_string()))
                     }
                     Ok(t) => Ok(t),
                 };
