@@ -81,13 +81,13 @@ const JOB_EVENTS: usize = 256;
 
 /// What the cycle works on.
 pub(crate) struct NodeCycle<'c> {
-    cell: &'c Cell,
-    node: usize,
     exec: Executive<'c>,
     ports: Ports,
     owned: Vec<usize>,
     names: Vec<&'c str>,
     script: &'c [ScriptEntry],
+    /// Per script entry: whether this node hosts its object (looked up once, not per cycle).
+    mine: Vec<bool>,
     /// The next script entry.
     next: usize,
     log: LogRing,
@@ -132,14 +132,18 @@ impl<'c> NodeCycle<'c> {
         let next = p
             .script
             .partition_point(|e| e.t_ns < clock.first * clock.cycle);
+        let mine = p
+            .script
+            .iter()
+            .map(|e| owns(p.cell, p.node, &e.axis, &e.action))
+            .collect();
         Self {
-            cell: p.cell,
-            node: p.node,
             exec: p.exec,
             ports: p.ports,
             owned: p.owned,
             names: p.cell.object_names(),
             script: p.script,
+            mine,
             next,
             log: LogRing::new(),
             links: p.links,
@@ -151,10 +155,7 @@ impl<'c> NodeCycle<'c> {
 
     /// Script entries for this node's objects before the first cycle (they are skipped).
     pub(crate) fn skipped(&self) -> usize {
-        self.script[..self.next]
-            .iter()
-            .filter(|e| owns(self.cell, self.node, &e.axis, &e.action))
-            .count()
+        self.mine[..self.next].iter().filter(|m| **m).count()
     }
 
     /// Leaders published and remote leaders followed.
@@ -196,6 +197,10 @@ impl<'c> NodeCycle<'c> {
             self.record(t, start, &marks, clock.cycle);
             k += 1;
         }
+        if self.health.cycles > 0 {
+            // The end state for observers, whatever the telemetry rate.
+            self.telemetry();
+        }
         self.report.wall_ns = rt::now_ns() - started;
         if let Some((process, thread)) = cpu0 {
             self.report.cpu_ns = cpu_time_ns() - process;
@@ -234,8 +239,9 @@ impl<'c> NodeCycle<'c> {
             }
         }
         while let Some(e) = self.script.get(self.next).filter(|e| e.t_ns <= t) {
+            let mine = self.mine.get(self.next).copied().unwrap_or(false);
             self.next += 1;
-            if owns(self.cell, self.node, &e.axis, &e.action) {
+            if mine {
                 let r =
                     self.exec
                         .apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut self.log);
