@@ -1,11 +1,14 @@
 //! `tandem-node`: thin main over [`tandem_node::run`].
 //!
 //! Exit codes: 0 stopped cleanly (signal or end of duration); 2 the cell, node or script is
-//! wrong; 1 the node could not run (iceoryx2 resources, threads).
+//! wrong; 1 the node could not run (iceoryx2 resources, threads). Diagnostics go to stderr
+//! through `tracing` (`--log-format text|json`, filtered by `TANDEM_LOG` or `RUST_LOG`,
+//! default `info`).
 
 use clap::{Arg, Command};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tandem_rt::diag::{self, LogFormat};
 
 fn main() -> ExitCode {
     let m = Command::new("tandem-node")
@@ -27,7 +30,19 @@ fn main() -> ExitCode {
         )
         .arg(Arg::new("trace").long("trace").value_parser(clap::value_parser!(PathBuf)))
         .arg(Arg::new("log").long("log").value_parser(clap::value_parser!(PathBuf)))
+        .arg(
+            Arg::new("log-format")
+                .long("log-format")
+                .value_parser(["text", "json"])
+                .default_value("text")
+                .help("Diagnostics on stderr: text lines or one JSON object per line (filter: TANDEM_LOG or RUST_LOG)"),
+        )
         .get_matches();
+    let format = m
+        .get_one::<String>("log-format")
+        .and_then(|f| LogFormat::parse(f))
+        .unwrap_or_default();
+    diag::init("info", format);
     let o = tandem_node::Options {
         cell: m.get_one::<PathBuf>("cell").cloned().unwrap_or_default(),
         node: m.get_one::<String>("node").cloned().unwrap_or_default(),
@@ -40,8 +55,9 @@ fn main() -> ExitCode {
     match tandem_node::run(&o) {
         Ok(_) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("tandem-node {}: error: {e}", o.node);
-            ExitCode::from(tandem_node::exit_code(&e))
+            let code = e.exit_code();
+            tracing::error!(node = %o.node, exit_code = code, "{e}");
+            ExitCode::from(code)
         }
     }
 }

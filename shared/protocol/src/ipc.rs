@@ -2,7 +2,7 @@
 //! the same function, so their settings always agree.
 //!
 //! Every publish-subscribe service overflows safely (the oldest sample is dropped, so a slow
-//! reader never blocks a writer, design §5).
+//! reader never blocks a writer; docs/processes.md, "Services").
 
 use crate::names;
 use crate::wire::{
@@ -31,25 +31,56 @@ pub type CommandService =
 /// A node's "leading values published" event service.
 pub type PublishedEvent = iceoryx2::service::port_factory::event::PortFactory<ipc::Service>;
 
-/// An iceoryx2 call that failed, with what was being done.
+/// What tandem was doing with iceoryx2 when a call failed.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum IpcOp {
+    /// Naming the iceoryx2 domain of a host.
+    Domain,
+    /// Naming an iceoryx2 node.
+    NodeName,
+    /// Creating an iceoryx2 node.
+    CreateNode,
+    /// Naming a service.
+    ServiceName,
+    /// Opening (or creating) a service.
+    OpenService,
+    /// Creating a port (publisher, subscriber, notifier, server) of a service.
+    CreatePort,
+}
+
+/// An iceoryx2 call that failed: what was being done, to what, and iceoryx2's reason.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct IpcError {
-    /// What failed and why.
-    pub message: String,
+    /// What was being done.
+    pub op: IpcOp,
+    /// The domain, node, service or port it concerned.
+    pub name: String,
+    /// iceoryx2's reason, in its words.
+    pub cause: String,
 }
 
 impl fmt::Display for IpcError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
+        let (name, cause) = (&self.name, &self.cause);
+        match self.op {
+            IpcOp::Domain => write!(f, "iceoryx2 domain `{name}`: {cause}"),
+            IpcOp::NodeName => write!(f, "node name `{name}`: {cause}"),
+            IpcOp::CreateNode => write!(f, "creating iceoryx2 node `{name}`: {cause}"),
+            IpcOp::ServiceName => write!(f, "service name `{name}`: {cause}"),
+            IpcOp::OpenService => write!(f, "opening {name}: {cause}"),
+            IpcOp::CreatePort => write!(f, "{name}: {cause}"),
+        }
     }
 }
 
 impl std::error::Error for IpcError {}
 
-/// Wraps an iceoryx2 error with what was being done.
-pub fn ctx<T, E: fmt::Display>(r: Result<T, E>, what: impl fmt::Display) -> Result<T, IpcError> {
+/// Wraps the error of an iceoryx2 call with what was being done (`op`) to what (`name`).
+pub fn ctx<T, E: fmt::Display>(r: Result<T, E>, op: IpcOp, name: &str) -> Result<T, IpcError> {
     r.map_err(|e| IpcError {
-        message: format!("{what}: {e}"),
+        op,
+        name: name.to_owned(),
+        cause: e.to_string(),
     })
 }
 
@@ -59,10 +90,7 @@ pub fn config(host: &str) -> Result<Config, IpcError> {
     set_log_level(LogLevel::Error);
     let mut c = Config::global_config().clone();
     let domain = names::domain(host);
-    c.global.prefix = ctx(
-        FileName::new(domain.as_bytes()),
-        format_args!("iceoryx2 domain `{domain}`"),
-    )?;
+    c.global.prefix = ctx(FileName::new(domain.as_bytes()), IpcOp::Domain, &domain)?;
     Ok(c)
 }
 
@@ -70,14 +98,15 @@ pub fn config(host: &str) -> Result<Config, IpcError> {
 /// process (tandem handles SIGINT/SIGTERM itself).
 pub fn node(name: &str, host: &str) -> Result<IpcNode, IpcError> {
     let config = config(host)?;
-    let node_name = ctx(NodeName::new(name), format_args!("node name `{name}`"))?;
+    let node_name = ctx(NodeName::new(name), IpcOp::NodeName, name)?;
     ctx(
         NodeBuilder::new()
             .config(&config)
             .name(&node_name)
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>(),
-        format_args!("creating iceoryx2 node `{name}`"),
+        IpcOp::CreateNode,
+        name,
     )
 }
 
@@ -88,6 +117,7 @@ pub fn cleanup_dead_nodes(host: &str) -> usize {
         return 0;
     };
     let mut cleaned = 0;
+    // Best effort: a domain that cannot be listed has nothing this process could clean.
     let _ = Node::<ipc::Service>::list(&config, |state| {
         if let NodeState::Dead(view) = state {
             if view.try_remove_stale_resources().is_ok() {
@@ -100,7 +130,7 @@ pub fn cleanup_dead_nodes(host: &str) -> usize {
 }
 
 fn service_name(s: &str) -> Result<ServiceName, IpcError> {
-    ctx(ServiceName::new(s), format_args!("service name `{s}`"))
+    ctx(ServiceName::new(s), IpcOp::ServiceName, s)
 }
 
 /// A publish-subscribe service of `T` named `name`: `history` samples for late joiners,
@@ -121,7 +151,8 @@ fn pubsub<T: core::fmt::Debug + ZeroCopySend>(
             .max_subscribers(32)
             .max_nodes(32)
             .open_or_create(),
-        format_args!("opening {name}"),
+        IpcOp::OpenService,
+        name,
     )
 }
 
@@ -161,7 +192,8 @@ pub fn telemetry(
             .max_subscribers(8)
             .max_nodes(32)
             .open_or_create(),
-        format_args!("opening {name}"),
+        IpcOp::OpenService,
+        &name,
     )
 }
 
@@ -185,7 +217,8 @@ pub fn commands(node: &IpcNode, cell: &str, node_name: &str) -> Result<CommandSe
             .max_servers(2)
             .max_nodes(32)
             .open_or_create(),
-        format_args!("opening {name}"),
+        IpcOp::OpenService,
+        &name,
     )
 }
 
@@ -199,6 +232,7 @@ pub fn published(node: &IpcNode, cell: &str, node_name: &str) -> Result<Publishe
             .max_listeners(8)
             .max_nodes(32)
             .open_or_create(),
-        format_args!("opening {name}"),
+        IpcOp::OpenService,
+        &name,
     )
 }

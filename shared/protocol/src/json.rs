@@ -43,19 +43,49 @@ pub fn encode_leading_value(s: &LeadingValueSample) -> Vec<u8> {
     bincode::serde::encode_to_vec(w, codec()).unwrap_or_default()
 }
 
-/// Decodes a leading value from Zenoh; a payload of the wrong size, with trailing bytes or with
-/// non-finite values is refused, saying why.
-pub fn decode_leading_value(bytes: &[u8]) -> Result<LeadingValueSample, String> {
-    let (w, used): (LeadingValueWire, usize) =
-        bincode::serde::decode_from_slice(bytes, codec()).map_err(|e| e.to_string())?;
-    if used != bytes.len() {
-        return Err(format!("{} bytes, a leading value has {used}", bytes.len()));
+/// Bytes of an encoded leading value.
+pub const LEADING_VALUE_BYTES: usize = 64;
+
+/// Why a leading value from Zenoh was refused.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum DecodeError {
+    /// The payload has `bytes` bytes; a leading value has [`LEADING_VALUE_BYTES`].
+    Size {
+        /// The payload's length.
+        bytes: usize,
+    },
+    /// A position, velocity, acceleration or modulo value is NaN or infinite.
+    NotFinite,
+}
+
+impl core::fmt::Display for DecodeError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Size { bytes } => write!(
+                f,
+                "{bytes} bytes, a leading value has {LEADING_VALUE_BYTES}"
+            ),
+            Self::NotFinite => f.write_str("a value is not finite"),
+        }
     }
+}
+
+impl std::error::Error for DecodeError {}
+
+/// Decodes a leading value from Zenoh; a payload of the wrong size or with non-finite values
+/// is refused, saying why.
+pub fn decode_leading_value(bytes: &[u8]) -> Result<LeadingValueSample, DecodeError> {
+    let size = DecodeError::Size { bytes: bytes.len() };
+    if bytes.len() != LEADING_VALUE_BYTES {
+        return Err(size);
+    }
+    let (w, _): (LeadingValueWire, usize) =
+        bincode::serde::decode_from_slice(bytes, codec()).map_err(|_| size)?;
     if ![w.p, w.v, w.a, w.modulo_start, w.modulo_length]
         .iter()
         .all(|x| x.is_finite())
     {
-        return Err("a value is not finite".into());
+        return Err(DecodeError::NotFinite);
     }
     Ok(LeadingValueSample {
         t_ns: w.t_ns,
@@ -169,6 +199,27 @@ pub struct Health {
     pub samples_rejected: u64,
     /// Process id.
     pub pid: u32,
+    /// Log lines and notes dropped (more than fit in one cycle).
+    #[serde(default)]
+    pub log_dropped: u64,
+    /// iceoryx2 sends of the cycle that failed.
+    #[serde(default)]
+    pub sends_failed: u64,
+    /// Command replies the command thread could not take.
+    #[serde(default)]
+    pub commands_unanswered: u64,
+    /// Script entries the node's objects refused or could not apply.
+    #[serde(default)]
+    pub script_rejected: u64,
+    /// Cycles whose step reported an error.
+    #[serde(default)]
+    pub step_errors: u64,
+    /// Diagnostic records the node's recorder thread could not take.
+    #[serde(default)]
+    pub diag_dropped: u64,
+    /// Trace rows dropped because the recorder was behind.
+    #[serde(default)]
+    pub trace_dropped: u64,
 }
 
 impl Health {
@@ -188,6 +239,13 @@ impl Health {
             extrapolated: h.extrapolated,
             samples_rejected: h.samples_rejected,
             pid: h.pid,
+            log_dropped: h.log_dropped,
+            sends_failed: h.sends_failed,
+            commands_unanswered: h.commands_unanswered,
+            script_rejected: h.script_rejected,
+            step_errors: h.step_errors,
+            diag_dropped: h.diag_dropped,
+            trace_dropped: h.trace_dropped,
         }
     }
 }
@@ -254,9 +312,30 @@ pub struct CommandJson {
     pub params: serde_json::Map<String, serde_json::Value>,
 }
 
+/// A parameter of a [`CommandJson`] the command line cannot carry.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParamError {
+    /// The parameter's name.
+    pub key: String,
+    /// Its JSON value.
+    pub value: String,
+}
+
+impl core::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "parameter `{}`: {} is not a number, a boolean or a name",
+            self.key, self.value
+        )
+    }
+}
+
+impl std::error::Error for ParamError {}
+
 impl CommandJson {
     /// The command line the node parses: `<instruction> --k v ...`.
-    pub fn to_line(&self) -> Result<String, String> {
+    pub fn to_line(&self) -> Result<String, ParamError> {
         let mut line = self.instruction.clone();
         for (k, v) in &self.params {
             let v = match v {
@@ -264,9 +343,10 @@ impl CommandJson {
                 serde_json::Value::Bool(b) => b.to_string(),
                 serde_json::Value::String(s) if !s.contains(char::is_whitespace) => s.clone(),
                 other => {
-                    return Err(format!(
-                        "parameter `{k}`: {other} is not a number, a boolean or a name"
-                    ))
+                    return Err(ParamError {
+                        key: k.clone(),
+                        value: other.to_string(),
+                    })
                 }
             };
             line.push_str(&format!(" --{k} {v}"));
@@ -351,10 +431,19 @@ mod tests {
         longer.push(0);
         assert!(decode_leading_value(&longer)
             .unwrap_err()
+            .to_string()
             .contains("65 bytes"));
+        assert_eq!(
+            decode_leading_value(&longer),
+            Err(DecodeError::Size { bytes: 65 })
+        );
         assert!(decode_leading_value(b"").is_err());
         let nan = LeadingValueSample { p: f64::NAN, ..s };
         assert!(decode_leading_value(&encode_leading_value(&nan)).is_err());
+        assert_eq!(
+            decode_leading_value(&encode_leading_value(&nan)),
+            Err(DecodeError::NotFinite)
+        );
     }
 
     #[test]
@@ -370,5 +459,9 @@ mod tests {
         let bad: CommandJson =
             serde_json::from_str(r#"{"instruction": "MC_Halt", "params": {"x": [1]}}"#).unwrap();
         assert!(bad.to_line().is_err());
+        assert_eq!(
+            bad.to_line().unwrap_err().to_string(),
+            "parameter `x`: [1] is not a number, a boolean or a name"
+        );
     }
 }

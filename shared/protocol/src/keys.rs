@@ -1,4 +1,4 @@
-//! Every Zenoh key expression of a cell (design §5). Everything of cell `c` is under
+//! Every Zenoh key expression of a cell (docs/gateway.md, "Observation and commands (JSON)"). Everything of cell `c` is under
 //! `tandem/<c>/`, so `tandem/<c>/**` observes the whole cell.
 
 /// Leading values of `leader` between hosts (binary, RealTime, express, drop on congestion).

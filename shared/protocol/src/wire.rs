@@ -1,4 +1,4 @@
-//! The `#[repr(C)]` payloads of the iceoryx2 services (design §5). Each carries a type name with
+//! The `#[repr(C)]` payloads of the iceoryx2 services (docs/processes.md, "Services"). Each carries a type name with
 //! a version, so a process built from another version fails to open the service
 //! (`IncompatibleTypes`) instead of misreading it.
 
@@ -11,7 +11,7 @@ use tandem_motion::objects::leading::LeadingSample;
 /// [`LeadingValueSample::status`] bit: the value is valid.
 pub const LV_VALID: u32 = 1;
 
-/// One leading value of a leader (design §4): at `t_ns` on the cell clock the leader was at
+/// One leading value of a leader (docs/processes.md, "Leading values"): at `t_ns` on the cell clock the leader was at
 /// (`p`, `v`, `a`). Positions are continuous; a modulo leader sends its modulo range with them.
 #[derive(Copy, Clone, Debug, PartialEq, ZeroCopySend)]
 #[type_name("tandem.LeadingValueSample.v1")]
@@ -239,7 +239,7 @@ pub fn state_code(s: AxisState) -> u32 {
 
 /// A node's health, the header of each telemetry snapshot.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.NodeHealth.v1")]
+#[type_name("tandem.NodeHealth.v2")]
 #[repr(C)]
 pub struct NodeHealth {
     /// The cycle's engine time (ns); it runs on the cell clock at `epoch_ns + t_ns`.
@@ -270,6 +270,22 @@ pub struct NodeHealth {
     pub pid: u32,
     /// Axes in the snapshot.
     pub axes: u32,
+    /// iceoryx2 sends of the cycle (leading values, the published event, output edges and
+    /// measured values, events, telemetry) that failed.
+    pub sends_failed: u64,
+    /// Command replies the command thread could not take (it stopped or fell behind): the
+    /// command was applied, its client waits in vain.
+    pub commands_unanswered: u64,
+    /// Script entries the node's objects refused (an ErrorID) or could not apply.
+    pub script_rejected: u64,
+    /// Cycles whose step reported an error (writing its log lines failed).
+    pub step_errors: u64,
+    /// Diagnostic records (log lines, job events) the diagnostics thread could not take.
+    pub diag_dropped: u64,
+    /// Trace rows dropped because the recorder thread was behind.
+    pub trace_dropped: u64,
+    /// Cycles between two telemetry snapshots (1: every cycle).
+    pub telemetry_every: u64,
 }
 
 /// One axis in a telemetry snapshot.

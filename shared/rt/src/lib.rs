@@ -1,6 +1,23 @@
 //! The operating-system calls of the cyclic thread: the absolute-time sleep, real-time
 //! scheduling, CPU affinity, memory locking and the termination signals. Each is one libc call;
 //! this is the only module of tandem with `unsafe` code, and each block says why it is sound.
+//! [`diag`] sets up the services' diagnostics output (`tracing`).
+//!
+//! ```no_run
+//! use tandem_rt as rt;
+//! // A 1 ms cycle on the cell clock, with an absolute sleep (no drift).
+//! rt::install_termination_handler();
+//! rt::no_timer_slack();
+//! if let Err(e) = rt::set_fifo(80) {
+//!     eprintln!("warning: {e}"); // e.g. not permitted without CAP_SYS_NICE
+//! }
+//! let mut next = rt::now_ns();
+//! while !rt::termination_requested() {
+//!     next += 1_000_000;
+//!     rt::sleep_until(next);
+//!     // ... one cycle ...
+//! }
+//! ```
 #![allow(unsafe_code)]
 
 pub mod diag;
@@ -19,6 +36,29 @@ pub fn now_ns() -> i64 {
     }
     // time_t and c_long are i64 on the 64-bit Linux targets tandem runs on.
     ts.tv_sec * 1_000_000_000 + ts.tv_nsec
+}
+
+/// The CPU time of `clock` (a CPU-time clock) in ns.
+fn cpu_clock_ns(clock: libc::clockid_t) -> i64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the CPU-time clocks always exist on Linux.
+    unsafe {
+        libc::clock_gettime(clock, &mut ts);
+    }
+    ts.tv_sec * 1_000_000_000 + ts.tv_nsec
+}
+
+/// The CPU time (user + system) the whole process used so far, in ns.
+pub fn process_cpu_ns() -> i64 {
+    cpu_clock_ns(libc::CLOCK_PROCESS_CPUTIME_ID)
+}
+
+/// The CPU time (user + system) the calling thread used so far, in ns.
+pub fn thread_cpu_ns() -> i64 {
+    cpu_clock_ns(libc::CLOCK_THREAD_CPUTIME_ID)
 }
 
 /// Sleeps until the cell clock reads `t_ns` (absolute, so no drift accumulates). Returns early
@@ -40,9 +80,78 @@ pub fn sleep_until(t_ns: i64) {
     }
 }
 
-fn errno_text() -> String {
-    std::io::Error::last_os_error().to_string()
+/// The calling thread's `errno` after a failed call.
+fn errno() -> i32 {
+    std::io::Error::last_os_error().raw_os_error().unwrap_or(0)
 }
+
+/// An operating-system call that failed, with the OS error number (`errno`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum RtError {
+    /// SCHED_FIFO at `priority` was refused.
+    Fifo {
+        /// The priority asked for.
+        priority: u8,
+        /// The OS error.
+        errno: i32,
+    },
+    /// The CPU is beyond what a CPU set can name.
+    NoSuchCpu {
+        /// The CPU asked for.
+        cpu: usize,
+    },
+    /// Pinning to `cpu` was refused.
+    Pin {
+        /// The CPU asked for.
+        cpu: usize,
+        /// The OS error.
+        errno: i32,
+    },
+    /// Locking the process' memory was refused.
+    LockMemory {
+        /// The OS error.
+        errno: i32,
+    },
+    /// The process id does not fit the OS' type.
+    NoSuchProcess {
+        /// The process id.
+        pid: u32,
+    },
+    /// Sending a signal to `pid` failed.
+    Signal {
+        /// The process id.
+        pid: u32,
+        /// The OS error.
+        errno: i32,
+    },
+}
+
+impl std::fmt::Display for RtError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let os = |e: i32| std::io::Error::from_raw_os_error(e);
+        match *self {
+            Self::Fifo { priority, errno } => write!(
+                f,
+                "SCHED_FIFO priority {priority} not permitted ({}); the node runs with normal \
+                 scheduling (run as root, or grant CAP_SYS_NICE or an rtprio limit)",
+                os(errno)
+            ),
+            Self::NoSuchCpu { cpu } => write!(f, "CPU {cpu} does not exist"),
+            Self::Pin { cpu, errno } => write!(f, "cannot pin to CPU {cpu} ({})", os(errno)),
+            Self::LockMemory { errno } => write!(
+                f,
+                "cannot lock memory ({}); page faults may delay cycles (raise the memlock limit)",
+                os(errno)
+            ),
+            Self::NoSuchProcess { pid } => write!(f, "no process {pid}"),
+            Self::Signal { pid, errno } => {
+                write!(f, "cannot signal process {pid}: {}", os(errno))
+            }
+        }
+    }
+}
+
+impl std::error::Error for RtError {}
 
 /// Sets the calling thread's timer slack to 1 ns, so that an absolute sleep ends when asked
 /// (normal threads get 50 µs of slack by default; SCHED_FIFO threads have none).
@@ -54,7 +163,7 @@ pub fn no_timer_slack() {
 }
 
 /// Runs the calling thread under SCHED_FIFO at `priority` (1..=99).
-pub fn set_fifo(priority: u8) -> Result<(), String> {
+pub fn set_fifo(priority: u8) -> Result<(), RtError> {
     let param = libc::sched_param {
         sched_priority: i32::from(priority),
     };
@@ -63,42 +172,41 @@ pub fn set_fifo(priority: u8) -> Result<(), String> {
     if r == 0 {
         Ok(())
     } else {
-        Err(format!(
-            "SCHED_FIFO priority {priority} not permitted ({}); the node runs with normal \
-             scheduling (run as root, or grant CAP_SYS_NICE or an rtprio limit)",
-            errno_text()
-        ))
+        Err(RtError::Fifo {
+            priority,
+            errno: errno(),
+        })
     }
 }
 
 /// Pins the calling thread to `cpu`.
-pub fn pin_to_cpu(cpu: usize) -> Result<(), String> {
+pub fn pin_to_cpu(cpu: usize) -> Result<(), RtError> {
     // SAFETY: cpu_set_t is plain data; zeroed is the empty set, CPU_SET writes inside it (the
     // index is checked against its size first).
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
         if cpu >= 8 * std::mem::size_of::<libc::cpu_set_t>() {
-            return Err(format!("CPU {cpu} does not exist"));
+            return Err(RtError::NoSuchCpu { cpu });
         }
         libc::CPU_SET(cpu, &mut set);
         if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
-            return Err(format!("cannot pin to CPU {cpu} ({})", errno_text()));
+            return Err(RtError::Pin {
+                cpu,
+                errno: errno(),
+            });
         }
     }
     Ok(())
 }
 
 /// Locks the process' current and future memory (no page faults on the cyclic path).
-pub fn lock_memory() -> Result<(), String> {
+pub fn lock_memory() -> Result<(), RtError> {
     // SAFETY: plain flags.
     let r = unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) };
     if r == 0 {
         Ok(())
     } else {
-        Err(format!(
-            "cannot lock memory ({}); page faults may delay cycles (raise the memlock limit)",
-            errno_text()
-        ))
+        Err(RtError::LockMemory { errno: errno() })
     }
 }
 
@@ -133,13 +241,16 @@ pub fn resident_bytes() -> Option<u64> {
 }
 
 /// Sends `signal` (`libc::SIGTERM`, `libc::SIGKILL`...) to process `pid`.
-pub fn send_signal(pid: u32, signal: libc::c_int) -> Result<(), String> {
-    let pid = libc::pid_t::try_from(pid).map_err(|_| format!("no process {pid}"))?;
+pub fn send_signal(pid: u32, signal: libc::c_int) -> Result<(), RtError> {
+    let id = libc::pid_t::try_from(pid).map_err(|_| RtError::NoSuchProcess { pid })?;
     // SAFETY: kill has no memory preconditions; a wrong pid is an error return.
-    if unsafe { libc::kill(pid, signal) } == 0 {
+    if unsafe { libc::kill(id, signal) } == 0 {
         Ok(())
     } else {
-        Err(format!("cannot signal process {pid}: {}", errno_text()))
+        Err(RtError::Signal {
+            pid,
+            errno: errno(),
+        })
     }
 }
 

@@ -1,4 +1,4 @@
-//! `tandem-bench-axes`: one node with N axes at a 1 ms cycle, on the real clock, in-process.
+//! `cargo bench -p tandem-bench --bench axes`: one node with N axes at a 1 ms cycle, on the real clock, in-process.
 //!
 //! The cell (one node `bench`) has a virtual leader axis `master` moving at constant velocity
 //! and, in thirds of the other N - 1 axes: positioning axes doing jerk-limited MC_MoveAbsolute
@@ -19,10 +19,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tandem_bench::{cargo_bench_flag, mib, rss, thread_ticks, Steal};
 use tandem_node::{Options, Report};
 use tandem_protocol::ipc as tipc;
 use tandem_protocol::wire::STATE_NAMES;
 use tandem_rt as rt;
+use tandem_runtime::exec::Executive;
 
 /// The node's cycle (µs).
 const CYCLE_US: i64 = 1000;
@@ -237,44 +239,11 @@ struct Seen {
     threads: Vec<(u32, String, u64, u64)>,
 }
 
-/// The threads of this process: (tid, name, user + system CPU in clock ticks).
-fn thread_cpu() -> Vec<(u32, String, u64)> {
-    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
-        return Vec::new();
-    };
-    let mut out = Vec::new();
-    for entry in dir.flatten() {
-        let Some(tid) = entry
-            .file_name()
-            .to_str()
-            .and_then(|x| x.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        let Ok(stat) = std::fs::read_to_string(entry.path().join("stat")) else {
-            continue;
-        };
-        let (Some(open), Some(close)) = (stat.find('('), stat.rfind(')')) else {
-            continue;
-        };
-        let name = stat.get(open + 1..close).unwrap_or("?").to_string();
-        let f: Vec<&str> = stat
-            .get(close + 1..)
-            .unwrap_or("")
-            .split_whitespace()
-            .collect();
-        let ticks = f.get(11).and_then(|x| x.parse::<u64>().ok()).unwrap_or(0)
-            + f.get(12).and_then(|x| x.parse::<u64>().ok()).unwrap_or(0);
-        out.push((tid, name, ticks));
-    }
-    out
-}
-
 impl Seen {
     /// Notes the threads' CPU time; threads first seen after the first snapshot start at 0.
     fn look_at_threads(&mut self) {
         let first = self.threads.is_empty();
-        for (tid, name, ticks) in thread_cpu() {
+        for (tid, name, ticks) in thread_ticks() {
             match self.threads.iter_mut().find(|t| t.0 == tid) {
                 Some(t) => t.3 = ticks,
                 None => self
@@ -372,10 +341,67 @@ struct Outcome {
     threads: String,
     /// The hypervisor's steal over the run (% of the machine's CPU time).
     steal: f64,
+    /// The engine alone on the same cell and script.
+    engine: EngineOnly,
 }
 
-fn mib(bytes: u64) -> f64 {
-    bytes as f64 / (1024.0 * 1024.0)
+/// The engine alone on the same cell and script: `Executive::step` of the node's objects in a
+/// tight loop, with the script entries applied at their times, no IPC, telemetry, recording or
+/// sleeping.
+#[derive(Debug, Clone, Copy, Default)]
+struct EngineOnly {
+    /// Cycles stepped.
+    cycles: u64,
+    /// Mean step (commands and script entries included) per cycle (µs).
+    mean_us: f64,
+    /// Median step per cycle (µs).
+    p50_us: f64,
+    /// The thread's CPU time per cycle (µs).
+    cpu_us: f64,
+}
+
+impl EngineOnly {
+    /// `% of a core` at the bench's cycle.
+    fn percent(&self) -> f64 {
+        100.0 * self.cpu_us / CYCLE_US as f64
+    }
+}
+
+/// Runs [`EngineOnly`] for `seconds` of engine time.
+fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<EngineOnly, String> {
+    let cell = tandem_config::load(cell_path).map_err(|e| e.to_string())?;
+    let src = std::fs::read_to_string(script_path)
+        .map_err(|e| format!("{}: {e}", script_path.display()))?;
+    let script = tandem_config::script::parse_cell(&script_path.display().to_string(), &src, &cell)
+        .map_err(|e| e.to_string())?;
+    let mut exec = Executive::new(&cell, Some(0)).map_err(|e| e.to_string())?;
+    let mut log = std::io::sink();
+    let cycle_ns = CYCLE_US * 1000;
+    let cycles = (seconds * 1e9) as i64 / cycle_ns + 1;
+    let mut hist = tandem_node::Histogram::default();
+    let mut next = 0;
+    let (cpu0, wall0) = (rt::thread_cpu_ns(), rt::now_ns());
+    for k in 0..cycles {
+        let t = k * cycle_ns;
+        let t0 = rt::now_ns();
+        while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
+            next += 1;
+            // The bench checks the node's run for rejections; here only the time counts.
+            let _ = exec.apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log);
+        }
+        exec.step(t, &mut log).map_err(|e| e.to_string())?;
+        exec.drain_job_notes(|_| {});
+        exec.drain_io_notes(|_| {});
+        hist.record(rt::now_ns() - t0);
+    }
+    let (cpu, wall) = (rt::thread_cpu_ns() - cpu0, rt::now_ns() - wall0);
+    let n = cycles.max(1) as f64;
+    Ok(EngineOnly {
+        cycles: cycles as u64,
+        mean_us: wall as f64 / n / 1e3,
+        p50_us: hist.quantile_us(0.5),
+        cpu_us: cpu as f64 / n / 1e3,
+    })
 }
 
 fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome, String> {
@@ -421,6 +447,17 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         (validate - load).as_secs_f64() * 1e3
     );
 
+    let engine = engine_only(&cell_path, &script_path, seconds)?;
+    eprintln!(
+        "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
+         CPU {:.1} µs per cycle ({:.1} % of a core)",
+        engine.cycles,
+        engine.mean_us,
+        engine.p50_us,
+        engine.cpu_us,
+        engine.percent()
+    );
+
     let stop = Arc::new(AtomicBool::new(false));
     let (ready_tx, ready_rx) = mpsc::sync_channel(1);
     let watcher = {
@@ -434,7 +471,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         .recv_timeout(Duration::from_secs(10))
         .map_err(|e| format!("telemetry watcher: {e}"))??;
 
-    let rss_before = rt::resident_bytes().unwrap_or(0);
+    let rss_before = rss();
     // Cycle 0 on a ms boundary, after the node's own loading (which repeats our validation).
     // The wait until then counts in the report's wall time.
     let margin_ns = 300_000_000 + 3 * i64::try_from(validate.as_nanos()).unwrap_or(0) / 2;
@@ -448,14 +485,14 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         trace: None,
         log: with_log.then(|| log_path.clone()),
     };
-    let steal0 = rt::cpu_and_steal();
+    let steal0 = Steal::start();
     let result = tandem_node::run(&options);
-    let steal = rt::steal_percent(steal0, rt::cpu_and_steal());
+    let steal = steal0.percent();
     stop.store(true, Ordering::SeqCst);
     let seen = watcher
         .join()
         .map_err(|_| "the telemetry watcher panicked".to_string())?;
-    let report = result?;
+    let report = result.map_err(|e| e.to_string())?;
 
     let mut failures = Vec::new();
     let mut threads = String::new();
@@ -538,6 +575,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         failures,
         threads,
         steal,
+        engine,
     })
 }
 
@@ -547,6 +585,53 @@ fn verdict(ok: bool) -> &'static str {
     } else {
         "ABOVE"
     }
+}
+
+/// The node beside the engine alone on the same cell and script, per cycle.
+fn print_engine_table(outcomes: &[Outcome]) {
+    println!();
+    println!(
+        "{:>5} | {:>14} | {:>14} {:>14} | {:>36} | {:>11}",
+        "axes",
+        "engine CPU",
+        "cyclic CPU",
+        "process CPU",
+        "stages µs: recv/cmds/step/publ/rec",
+        "node/engine"
+    );
+    for o in outcomes {
+        let r = &o.report;
+        let c = r.cycles.max(1) as f64;
+        let per = |ns: i64| ns as f64 / c / 1e3;
+        let pct = |us: f64| 100.0 * us / CYCLE_US as f64;
+        let cyclic = per(r.cyclic_cpu_ns);
+        let process = per(r.cpu_ns);
+        let st = &r.stages;
+        println!(
+            "{:>5} | {:>6.1} µs {:>4.1}% | {:>6.1} µs {:>4.1}% {:>6.1} µs {:>4.1}% | {:>6.1}/{:>5.1}/{:>6.1}/{:>5.1}/{:>6.1} | {:>5.2} {:>5.2}",
+            o.n,
+            o.engine.cpu_us,
+            o.engine.percent(),
+            cyclic,
+            pct(cyclic),
+            process,
+            pct(process),
+            per(st.receive_ns),
+            per(st.commands_ns),
+            per(st.step_ns),
+            per(st.publish_ns),
+            per(st.record_ns),
+            tandem_bench::ratio(cyclic, o.engine.cpu_us),
+            tandem_bench::ratio(process, o.engine.cpu_us),
+        );
+    }
+    println!(
+        "engine CPU: the engine alone (Executive::step of the same cell and script in a tight \
+         loop, this thread's CPU time per cycle); cyclic CPU: the node's cyclic thread; process \
+         CPU: the whole process (every thread of the node and this bench's telemetry watcher), \
+         both per cycle run and in % of a core at 1 ms; stages: wall time per cycle of the \
+         node's stages; node/engine: cyclic / engine and process / engine."
+    );
 }
 
 fn print_table(outcomes: &[Outcome], seconds: f64, with_log: bool) {
@@ -601,6 +686,7 @@ fn print_table(outcomes: &[Outcome], seconds: f64, with_log: bool) {
         );
     }
     println!("(compute and lateness in µs, upper edges of 1 µs bins; max exact)");
+    print_engine_table(outcomes);
     for o in outcomes {
         println!(
             "{:>5} axes, CPU ms per thread (10 ms ticks, from the first to the last telemetry \
@@ -671,7 +757,7 @@ fn main() -> ExitCode {
                 .long("no-log")
                 .action(ArgAction::SetTrue)
                 .help(
-                    "Run the node without a log (its recorder thread then does not run); the \
+                    "Run the node without a log file (its recorder thread then only emits diagnostics); the \
                      errors are checked from the telemetry only",
                 ),
         )
@@ -681,7 +767,10 @@ fn main() -> ExitCode {
                 .action(ArgAction::SetTrue)
                 .help("Keep the generated cell, script and log"),
         )
+        .arg(cargo_bench_flag())
         .get_matches();
+    // The node's own diagnostics (its start and stop lines) on stderr.
+    rt::diag::init("info", rt::diag::LogFormat::Text);
     let sizes: Vec<usize> = match m.get_one::<u64>("axes") {
         Some(n) => vec![usize::try_from(*n).unwrap_or(64)],
         None => vec![64, 256, 1024],

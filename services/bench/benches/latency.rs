@@ -24,6 +24,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use std::process::{Child, ExitCode, Stdio};
 use std::time::{Duration, Instant};
+use tandem_bench::{cargo_bench_flag, fmt_us, median, Hist, Steal};
 use tandem_motion::objects::leading::{LeadingSample, LeadingValue, LeadingValueBuffer};
 use tandem_protocol::ipc as tipc;
 use tandem_protocol::wire::LeadingValueSample;
@@ -223,81 +224,9 @@ impl End for Tandem {
     }
 }
 
-/// RTTs in 1 ns bins.
-#[derive(Debug, Clone)]
-struct Hist {
-    bins: Vec<u32>,
-    slow: Vec<u64>,
-    n: u64,
-    sum_ns: u128,
-}
-
-impl Hist {
-    fn new() -> Self {
-        let mut bins = vec![0u32; BINS];
-        // Touch every page now rather than on the measured path.
-        bins.iter_mut().for_each(|b| *b = std::hint::black_box(0));
-        Self {
-            bins,
-            slow: Vec::with_capacity(1 << 16),
-            n: 0,
-            sum_ns: 0,
-        }
-    }
-
-    #[inline]
-    fn record(&mut self, rtt_ns: u64) {
-        match self.bins.get_mut(rtt_ns as usize) {
-            Some(b) => *b = b.saturating_add(1),
-            None => self.slow.push(rtt_ns),
-        }
-        self.n += 1;
-        self.sum_ns += u128::from(rtt_ns);
-    }
-
-    fn merge(&mut self, o: &Hist) {
-        for (a, b) in self.bins.iter_mut().zip(&o.bins) {
-            *a = a.saturating_add(*b);
-        }
-        self.slow.extend_from_slice(&o.slow);
-        self.n += o.n;
-        self.sum_ns += o.sum_ns;
-    }
-
-    /// The `q` quantile of the RTT (ns); the max for `q >= 1`.
-    fn quantile(&self, q: f64) -> u64 {
-        if self.n == 0 {
-            return 0;
-        }
-        let rank = ((q.min(1.0) * self.n as f64).ceil() as u64).clamp(1, self.n);
-        let mut seen = 0u64;
-        for (i, b) in self.bins.iter().enumerate() {
-            seen += u64::from(*b);
-            if seen >= rank {
-                return i as u64;
-            }
-        }
-        let mut slow = self.slow.clone();
-        slow.sort_unstable();
-        let i = usize::try_from(rank - seen).unwrap_or(usize::MAX);
-        slow.get(i.saturating_sub(1))
-            .or(slow.last())
-            .copied()
-            .unwrap_or(0)
-    }
-
-    /// One-way (RTT / 2) quantile in µs.
-    fn one_way_us(&self, q: f64) -> f64 {
-        self.quantile(q) as f64 / 2000.0
-    }
-
-    fn mean_one_way_us(&self) -> f64 {
-        if self.n == 0 {
-            0.0
-        } else {
-            self.sum_ns as f64 / self.n as f64 / 2000.0
-        }
-    }
+/// One-way (RTT / 2) quantile of `h` in µs.
+fn one_way_us(h: &Hist, q: f64) -> f64 {
+    h.quantile(q) as f64 / 2000.0
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -387,7 +316,7 @@ fn ping<E: End>(e: &mut E, mode: Mode, n: u64) -> Result<Measured, String> {
         await_answer(e, seq, t0)?;
         seq += 1;
     }
-    let mut hist = Hist::new();
+    let mut hist = Hist::new(BINS);
     let mut late_wakeups = 0;
     let start = Instant::now();
     match mode {
@@ -577,25 +506,6 @@ fn cache_line_floor(n: u64) -> f64 {
     took.as_secs_f64() * 1e6 / (2.0 * n as f64)
 }
 
-fn fmt_us(x: f64) -> String {
-    if x >= 100.0 {
-        format!("{x:.0}")
-    } else if x >= 10.0 {
-        format!("{x:.1}")
-    } else {
-        format!("{x:.2}")
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
 fn main() -> ExitCode {
     let m = Command::new("tandem-bench-latency")
         .about(
@@ -632,6 +542,7 @@ fn main() -> ExitCode {
         .arg(Arg::new("role").long("role").hide(true))
         .arg(Arg::new("path").long("path").hide(true))
         .arg(Arg::new("tag").long("tag").hide(true))
+        .arg(cargo_bench_flag())
         .get_matches();
 
     if m.get_one::<String>("role").map(String::as_str) == Some("pong") {
@@ -688,7 +599,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
     // Per round: p50 of each row (µs).
     let mut p50s: Vec<Vec<f64>> = rows.iter().map(|_| Vec::new()).collect();
     let started = Instant::now();
-    let steal0 = rt::cpu_and_steal();
+    let steal0 = Steal::start();
     let mut floors = Vec::new();
     for r in 0..rounds {
         floors.push(cache_line_floor(200_000));
@@ -700,10 +611,10 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
             };
             for path in order {
                 let n = if mode == Mode::Busy { busy_n } else { period_n };
-                let st = rt::cpu_and_steal();
+                let st = Steal::start();
                 let x = measure(path, mode, n, &tag)
                     .map_err(|e| format!("{} {}: {e}", path.name(), mode.name()))?;
-                let st = rt::steal_percent(st, rt::cpu_and_steal());
+                let st = st.percent();
                 let i = rows
                     .iter()
                     .position(|row| *row == (path, mode))
@@ -714,10 +625,10 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
                     path.name(),
                     mode.name(),
                     n,
-                    fmt_us(x.hist.one_way_us(0.5)),
-                    fmt_us(x.hist.one_way_us(0.99))
+                    fmt_us(one_way_us(&x.hist, 0.5)),
+                    fmt_us(one_way_us(&x.hist, 0.99))
                 );
-                p50s[i].push(x.hist.one_way_us(0.5));
+                p50s[i].push(one_way_us(&x.hist, 0.5));
                 match &mut merged[i] {
                     Some(all) => {
                         all.hist.merge(&x.hist);
@@ -730,7 +641,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
         }
     }
     let elapsed = started.elapsed();
-    let steal = rt::steal_percent(steal0, rt::cpu_and_steal());
+    let steal = steal0.percent();
 
     println!();
     println!(
@@ -746,8 +657,8 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
     for (i, (path, mode)) in rows.iter().enumerate() {
         let Some(x) = &merged[i] else { continue };
         let h = &x.hist;
-        let total = if *mode == Mode::Busy && h.n > 0 {
-            fmt_us(x.total_ns as f64 / h.n as f64 / 2000.0)
+        let total = if *mode == Mode::Busy && h.count() > 0 {
+            fmt_us(x.total_ns as f64 / h.count() as f64 / 2000.0)
         } else {
             "-".into()
         };
@@ -757,7 +668,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
                 .position(|row| *row == (Path::Raw, *mode))
                 .and_then(|j| merged[j].as_ref());
             raw.map_or("-".into(), |r| {
-                format!("{:.2}", h.one_way_us(0.5) / r.hist.one_way_us(0.5))
+                format!("{:.2}", one_way_us(h, 0.5) / one_way_us(&r.hist, 0.5))
             })
         } else {
             String::new()
@@ -766,12 +677,12 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
             "{:<7} {:<7} {:>8} {:>7} {:>7} {:>7} {:>8} {:>7} {:>9} {:>11}",
             path.name(),
             mode.name(),
-            h.n,
-            fmt_us(h.one_way_us(0.5)),
-            fmt_us(h.one_way_us(0.99)),
-            fmt_us(h.one_way_us(0.999)),
-            fmt_us(h.one_way_us(1.0)),
-            fmt_us(h.mean_one_way_us()),
+            h.count(),
+            fmt_us(one_way_us(h, 0.5)),
+            fmt_us(one_way_us(h, 0.99)),
+            fmt_us(one_way_us(h, 0.999)),
+            fmt_us(one_way_us(h, 1.0)),
+            fmt_us(h.mean() / 2000.0),
             total,
             ratio
         );

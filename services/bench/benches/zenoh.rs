@@ -39,6 +39,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
+use tandem_bench::{
+    cargo_bench_flag, fmt_us, machine_ticks, median, process_ticks, quantile, sibling_binary, Steal,
+};
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::json;
 use tandem_protocol::names;
@@ -888,38 +891,6 @@ fn measure(
     }
 }
 
-/// The machine's CPU time in clock ticks, all CPUs: (all, used), from /proc/stat; used is
-/// neither idle, iowait nor steal.
-fn machine_ticks() -> (u64, u64) {
-    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-    let f: Vec<u64> = stat
-        .lines()
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .skip(1)
-        .take(8)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    let all: u64 = f.iter().sum();
-    let unused: u64 = [3, 4, 7].iter().filter_map(|i| f.get(*i)).sum();
-    (all, all.saturating_sub(unused))
-}
-
-/// The CPU time (clock ticks) of a process from `/proc/<pid>/stat`: user + system, with its
-/// reaped children's when `children`.
-fn process_ticks(pid: &str, children: bool) -> u64 {
-    let s = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
-    let rest = s.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<u64> = rest
-        .split_whitespace()
-        .skip(11)
-        .take(4)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    f.iter().take(if children { 4 } else { 2 }).sum()
-}
-
 /// The CPU time of the bench's own processes: this one, its reaped children (pings and
 /// pongs), and the gateways.
 fn own_ticks(env: &Env, gateways: &[usize]) -> u64 {
@@ -944,38 +915,9 @@ fn others_percent(a: ((u64, u64), u64), b: ((u64, u64), u64)) -> f64 {
     }
 }
 
-/// The `q` quantile of sorted `v` (the max for `q >= 1`).
-fn quantile(v: &[u64], q: f64) -> u64 {
-    if v.is_empty() {
-        return 0;
-    }
-    let n = v.len();
-    let rank = ((q.min(1.0) * n as f64).ceil() as usize).clamp(1, n);
-    v[rank - 1]
-}
-
 /// One-way (RTT / 2) in µs.
 fn one_way_us(rtt_ns: u64) -> f64 {
     rtt_ns as f64 / 2000.0
-}
-
-fn fmt_us(x: f64) -> String {
-    if x >= 100.0 {
-        format!("{x:.0}")
-    } else if x >= 10.0 {
-        format!("{x:.1}")
-    } else {
-        format!("{x:.2}")
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
 }
 
 /// A row of the table: the merged rounds and the p50 of each.
@@ -1047,6 +989,7 @@ fn main() -> ExitCode {
         .arg(hidden("tag"))
         .arg(hidden("addr"))
         .arg(hidden("cell"))
+        .arg(cargo_bench_flag())
         .get_matches();
 
     PURE_SPIN.store(
@@ -1088,15 +1031,15 @@ fn main() -> ExitCode {
 
 fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
     let exe = std::env::current_exe().map_err(|e| format!("own executable: {e}"))?;
-    let gateway = exe.with_file_name("tandem-gateway");
-    if !gateway.exists() {
-        return Err(format!(
-            "{} is missing: build it first (cargo build --release -p tandem-gateway)",
-            gateway.display()
-        ));
-    }
+    let gateway = sibling_binary("tandem-gateway").ok_or_else(|| {
+        format!(
+            "tandem-gateway is missing beside {}: build it first (cargo build --release -p \
+             tandem-gateway)",
+            exe.display()
+        )
+    })?;
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    let steal0 = rt::cpu_and_steal();
+    let steal0 = Steal::start();
     let started = Instant::now();
     for h in ["hA", "hB"] {
         ipc::cleanup_dead_nodes(h);
@@ -1141,7 +1084,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
         };
         for path in order {
             eprintln!("round {}/{rounds}: {}", r + 1, path.name());
-            let st = rt::cpu_and_steal();
+            let st = Steal::start();
             let o0 = (machine_ticks(), own_ticks(&env, &gateways));
             let (busy, period) = measure(
                 &mut env,
@@ -1162,7 +1105,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
                     logs.join("")
                 )
             })?;
-            let st = rt::steal_percent(st, rt::cpu_and_steal());
+            let st = st.percent();
             let other = others_percent(o0, (machine_ticks(), own_ticks(&env, &gateways)));
             others.push(other);
             let p50 = |s: &Series| {
@@ -1194,7 +1137,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
     let gateway_logs: Vec<String> = gateways.iter().map(|g| env.log(*g)).collect();
     drop(env);
     let elapsed = started.elapsed();
-    let steal = rt::steal_percent(steal0, rt::cpu_and_steal());
+    let steal = steal0.percent();
     for row in &mut rows {
         row.all.rtt.sort_unstable();
     }

@@ -1,0 +1,458 @@
+//! The cyclic executive: one loop over the named stages of a cycle, in this order —
+//! [`NodeCycle::receive`] (leading values in), [`NodeCycle::commands`] (queued commands and due
+//! script entries), [`NodeCycle::step`] (the technology objects), [`NodeCycle::publish`]
+//! (leading values, the published event, output edges and measured values, job events, log
+//! lines) and [`NodeCycle::record`] (telemetry, trace row, timing). Nothing here allocates,
+//! locks, formats for `tracing` or blocks; a result the cycle cannot act on is counted in the
+//! node's health ([`NodeHealth`]), never dropped unseen.
+
+use crate::commands::{Done, Queued};
+use crate::logring::{DiagRecord, LogRing, TextWriter};
+use crate::owns;
+use crate::ports::Ports;
+use crate::report::{cpu_time_ns, Report};
+use std::sync::mpsc::{Receiver, SyncSender};
+use tandem_config::script::ScriptEntry;
+use tandem_config::Cell;
+use tandem_motion::catalog::error_id::ErrorId;
+use tandem_motion::objects::axis::AxisStatus;
+use tandem_protocol::wire::{
+    job_code, AxisTelemetry, CommandReply, Event, IoEvent, LeadingValueSample, NodeHealth, Text,
+    EVENT_JOB, EVENT_LOG, IO_MEASURED, IO_OUTPUT, OUTCOME_ACCEPTED, OUTCOME_REJECTED,
+};
+use tandem_rt as rt;
+use tandem_runtime::exec::{Applied, Describe, Executive, JobNote};
+
+/// A trace row: the cycle's time and the status of every owned axis.
+pub(crate) type Row = (i64, Vec<AxisStatus>);
+
+/// The rows the cyclic thread fills and the recorder thread writes, without allocating: a
+/// row comes from `free`, goes out on `full`, and comes back to `free` once written.
+#[derive(Debug)]
+pub(crate) struct RowPool {
+    /// Empty rows.
+    pub(crate) free: Receiver<Row>,
+    /// Filled rows, to the recorder.
+    pub(crate) full: SyncSender<Row>,
+}
+
+/// The cyclic thread's links to the node's other threads.
+#[derive(Debug)]
+pub(crate) struct Links {
+    /// Commands from the command thread.
+    pub(crate) commands: Receiver<Queued>,
+    /// Their results, back to the command thread.
+    pub(crate) done: SyncSender<Done>,
+    /// Log lines and job events, to the recorder thread (which emits them through `tracing`).
+    pub(crate) diag: SyncSender<DiagRecord>,
+    /// Trace rows, when a trace is written.
+    pub(crate) rows: Option<RowPool>,
+}
+
+/// Where the node's cycles lie on the cell clock.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Clock {
+    /// The cell clock's time of cycle 0 (ns).
+    pub(crate) epoch: i64,
+    /// The node's cycle (ns).
+    pub(crate) cycle: i64,
+    /// The first cycle to run.
+    pub(crate) first: i64,
+    /// The engine time after which the node stops, if any.
+    pub(crate) end_ns: Option<i64>,
+}
+
+impl Clock {
+    /// The clock of a node with cycle `cycle` on `epoch`, starting at the next cycle on the
+    /// grid at least 2 cycles from now.
+    pub(crate) fn starting_now(epoch: i64, cycle: i64, end_ns: Option<i64>) -> Self {
+        let first = ((rt::now_ns() - epoch + 2 * cycle).max(0) + cycle - 1) / cycle;
+        Self {
+            epoch,
+            cycle,
+            first,
+            end_ns,
+        }
+    }
+}
+
+/// Job events a cycle keeps for the recorder until their axes' alarms are read.
+const JOB_EVENTS: usize = 256;
+
+/// What the cycle works on.
+pub(crate) struct NodeCycle<'c> {
+    exec: Executive<'c>,
+    ports: Ports,
+    owned: Vec<usize>,
+    names: Vec<&'c str>,
+    script: &'c [ScriptEntry],
+    /// Per script entry: whether this node hosts its object (looked up once, not per cycle).
+    mine: Vec<bool>,
+    /// The next script entry.
+    next: usize,
+    log: LogRing,
+    links: Links,
+    /// This cycle's job events, for the recorder (capacity [`JOB_EVENTS`]).
+    jobs: Vec<Event>,
+    health: NodeHealth,
+    report: Report,
+}
+
+/// What [`NodeCycle::new`] takes.
+pub(crate) struct CycleParts<'c> {
+    /// The cell.
+    pub(crate) cell: &'c Cell,
+    /// The node's index.
+    pub(crate) node: usize,
+    /// Its technology objects.
+    pub(crate) exec: Executive<'c>,
+    /// Its ports.
+    pub(crate) ports: Ports,
+    /// The axes it owns.
+    pub(crate) owned: Vec<usize>,
+    /// The script's entries (all objects; the node applies its own).
+    pub(crate) script: &'c [ScriptEntry],
+    /// Its links to the other threads.
+    pub(crate) links: Links,
+    /// Cycles between two telemetry snapshots.
+    pub(crate) telemetry_every: u64,
+}
+
+impl<'c> NodeCycle<'c> {
+    /// The cycle of a node about to run on `clock`.
+    pub(crate) fn new(p: CycleParts<'c>, clock: &Clock) -> Self {
+        let health = NodeHealth {
+            epoch_ns: clock.epoch,
+            cycle_ns: clock.cycle,
+            pid: std::process::id(),
+            axes: p.owned.len() as u32,
+            telemetry_every: p.telemetry_every.max(1),
+            ..NodeHealth::default()
+        };
+        let next = p
+            .script
+            .partition_point(|e| e.t_ns < clock.first * clock.cycle);
+        let mine = p
+            .script
+            .iter()
+            .map(|e| owns(p.cell, p.node, &e.axis, &e.action))
+            .collect();
+        Self {
+            exec: p.exec,
+            ports: p.ports,
+            owned: p.owned,
+            names: p.cell.object_names(),
+            script: p.script,
+            mine,
+            next,
+            log: LogRing::new(),
+            links: p.links,
+            jobs: Vec::with_capacity(JOB_EVENTS),
+            health,
+            report: Report::default(),
+        }
+    }
+
+    /// Script entries for this node's objects before the first cycle (they are skipped).
+    pub(crate) fn skipped(&self) -> usize {
+        self.mine[..self.next].iter().filter(|m| **m).count()
+    }
+
+    /// Leaders published and remote leaders followed.
+    pub(crate) fn links_count(&self) -> (usize, usize) {
+        (self.ports.leaders_out.len(), self.ports.leaders_in.len())
+    }
+
+    /// Runs cycles on `clock` until SIGINT/SIGTERM or the end; returns what it measured and
+    /// the node's health at the end.
+    pub(crate) fn run(mut self, clock: &Clock) -> (Report, NodeHealth) {
+        let mut k = clock.first;
+        // The run is measured from the start of its first cycle.
+        let started = clock.epoch + k * clock.cycle;
+        let mut cpu0 = None;
+        loop {
+            let t = k * clock.cycle;
+            if clock.end_ns.is_some_and(|e| t > e) || rt::termination_requested() {
+                break;
+            }
+            let start = clock.epoch + t;
+            rt::sleep_until(start);
+            let wake = rt::now_ns();
+            if wake < start {
+                // A signal woke us early: look at the flag, then sleep again.
+                continue;
+            }
+            if cpu0.is_none() {
+                cpu0 = Some((cpu_time_ns(), rt::thread_cpu_ns()));
+            }
+            let mut marks = [wake; 5];
+            self.receive();
+            marks[1] = rt::now_ns();
+            self.commands(t);
+            marks[2] = rt::now_ns();
+            self.step(t);
+            marks[3] = rt::now_ns();
+            self.publish(t);
+            marks[4] = rt::now_ns();
+            self.record(t, start, &marks, clock.cycle);
+            k += 1;
+        }
+        if self.health.cycles > 0 {
+            // The end state for observers, whatever the telemetry rate.
+            self.telemetry();
+        }
+        self.report.wall_ns = rt::now_ns() - started;
+        if let Some((process, thread)) = cpu0 {
+            self.report.cpu_ns = cpu_time_ns() - process;
+            self.report.cyclic_cpu_ns = rt::thread_cpu_ns() - thread;
+        }
+        self.health.extrapolated = self.exec.extrapolated;
+        (self.report, self.health)
+    }
+
+    /// Receive: the samples other nodes published go into their leaders' buffers.
+    fn receive(&mut self) {
+        for x in &self.ports.leaders_in {
+            while let Ok(Some(sample)) = x.port.receive() {
+                if self
+                    .exec
+                    .feed(x.leader, x.coupling, sample.payload().to_sample())
+                    .is_err()
+                {
+                    self.health.samples_rejected += 1;
+                }
+            }
+        }
+    }
+
+    /// Commands: the queued commands, each answered, then the script entries due at `t`.
+    fn commands(&mut self, t: i64) {
+        while let Ok(q) = self.links.commands.try_recv() {
+            let e = &q.entry;
+            let applied = self
+                .exec
+                .apply(t, &e.axis, e.instruction, e.action, &mut self.log)
+                .unwrap_or(Err(ErrorId::IllegalObject));
+            let reply = reply(t, applied);
+            if self.links.done.try_send(Done { id: q.id, reply }).is_err() {
+                self.health.commands_unanswered += 1;
+            }
+        }
+        while let Some(e) = self.script.get(self.next).filter(|e| e.t_ns <= t) {
+            let mine = self.mine.get(self.next).copied().unwrap_or(false);
+            self.next += 1;
+            if mine {
+                let r =
+                    self.exec
+                        .apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut self.log);
+                if !matches!(r, Ok(Ok(_))) {
+                    self.health.script_rejected += 1;
+                }
+            }
+        }
+    }
+
+    /// Step: the technology objects, as `tandem sim` steps them.
+    fn step(&mut self, t: i64) {
+        if self.exec.step(t, &mut self.log).is_err() {
+            self.health.step_errors += 1;
+        }
+    }
+
+    /// Publish: leading values, the published event, output edges and measured values, job
+    /// events and log lines (these two also to the recorder).
+    fn publish(&mut self, t: i64) {
+        let mut failed = 0u64;
+        for x in &mut self.ports.leaders_out {
+            let s = self.exec.sample(x.leader, x.coupling, t, x.seq);
+            x.seq += 1;
+            let sample = LeadingValueSample::from_sample(x.id, &s);
+            failed += u64::from(x.port.send_copy(sample).is_err());
+        }
+        if let Some(n) = &self.ports.published {
+            failed += u64::from(n.notify().is_err());
+        }
+        let io = &self.ports.io;
+        self.exec.drain_io_notes(|x| {
+            if let Some(Some(p)) = io.get(x.object) {
+                let ev = IoEvent {
+                    t_ns: x.t_ns,
+                    kind: if x.measured { IO_MEASURED } else { IO_OUTPUT },
+                    counter: x.counter,
+                    value: x.value,
+                };
+                failed += u64::from(p.send_copy(ev).is_err());
+            }
+        });
+        let (events, names, jobs) = (&self.ports.events, &self.names, &mut self.jobs);
+        let mut dropped = 0u64;
+        self.exec.drain_job_notes(|j| {
+            let ev = job_event(j, names);
+            failed += u64::from(events.send_copy(ev).is_err());
+            // Within the capacity the buffer was made with: no allocation.
+            if jobs.len() < jobs.capacity() {
+                jobs.push(ev);
+            } else {
+                dropped += 1;
+            }
+        });
+        self.health.sends_failed += failed;
+        self.health.diag_dropped += dropped;
+        self.hand_over_jobs();
+        self.hand_over_log(t);
+    }
+
+    /// Hands this cycle's job events to the recorder, each with its axis' pending alarm.
+    fn hand_over_jobs(&mut self) {
+        let status = self.exec.status();
+        for event in self.jobs.drain(..) {
+            let alarm = status
+                .get(event.object as usize)
+                .map_or(0, |s| s.error_detail.number);
+            if self
+                .links
+                .diag
+                .try_send(DiagRecord { event, alarm })
+                .is_err()
+            {
+                self.health.diag_dropped += 1;
+            }
+        }
+    }
+
+    /// Publishes the log ring's lines and hands them to the recorder.
+    fn hand_over_log(&mut self, t: i64) {
+        while let Some(line) = self.log.lines.pop_front() {
+            let event = Event {
+                t_ns: t,
+                kind: EVENT_LOG,
+                object: u32::MAX,
+                job: 0,
+                code: 0,
+                error_id: 0,
+                message: line,
+            };
+            if self.ports.events.send_copy(event).is_err() {
+                self.health.sends_failed += 1;
+            }
+            if self
+                .links
+                .diag
+                .try_send(DiagRecord { event, alarm: 0 })
+                .is_err()
+            {
+                self.health.diag_dropped += 1;
+            }
+        }
+    }
+
+    /// Record: the health, the telemetry snapshot, the trace row and the cycle's timing.
+    fn record(&mut self, t: i64, start: i64, marks: &[i64; 5], cycle: i64) {
+        let wake = marks[0];
+        let lateness = wake - start;
+        let h = &mut self.health;
+        h.t_ns = t;
+        h.lateness_ns = lateness;
+        h.max_lateness_ns = h.max_lateness_ns.max(lateness);
+        h.cycles += 1;
+        h.extrapolated = self.exec.extrapolated;
+        h.log_dropped = self.log.dropped + self.exec.notes_dropped;
+        if (h.cycles - 1) % h.telemetry_every == 0 {
+            self.telemetry();
+        }
+        if let Some(pool) = &self.links.rows {
+            self.health.trace_dropped += u64::from(!row(pool, t, &self.owned, self.exec.status()));
+        }
+        let end = rt::now_ns();
+        let compute = end - wake;
+        let h = &mut self.health;
+        h.compute_ns = compute;
+        h.max_compute_ns = h.max_compute_ns.max(compute);
+        self.report.compute.record(compute);
+        self.report.stages.add(marks, end);
+        self.report.lateness.record(lateness);
+        self.report.cycles += 1;
+        if end > start + cycle {
+            h.overruns += 1;
+            self.report.overruns += 1;
+        }
+    }
+
+    /// Publishes a telemetry snapshot: every owned axis, the health as header.
+    fn telemetry(&mut self) {
+        let status = self.exec.status();
+        let owned = &self.owned;
+        let Ok(mut sample) = self.ports.telemetry.loan_slice_uninit(owned.len()) else {
+            self.health.sends_failed += 1;
+            return;
+        };
+        *sample.user_header_mut() = self.health;
+        let sample = sample.write_from_fn(|i| {
+            owned
+                .get(i)
+                .map(|a| AxisTelemetry::from_status(*a as u32, &status[*a]))
+                .unwrap_or_default()
+        });
+        if sample.send().is_err() {
+            self.health.sends_failed += 1;
+        }
+    }
+}
+
+/// Fills a trace row from the pool and hands it to the recorder; `false` when the recorder
+/// was behind (no free row, or its queue full) and the row is dropped.
+fn row(pool: &RowPool, t: i64, owned: &[usize], status: &[AxisStatus]) -> bool {
+    let Ok((_, mut row)) = pool.free.try_recv() else {
+        return false;
+    };
+    // Within the capacity the row was made with: no allocation.
+    row.clear();
+    row.extend(owned.iter().map(|a| status[*a]));
+    pool.full.try_send((t, row)).is_ok()
+}
+
+/// The reply to a command applied at `t`.
+fn reply(t: i64, applied: Applied) -> CommandReply {
+    let mut reply = CommandReply {
+        outcome: OUTCOME_ACCEPTED,
+        job: 0,
+        error_id: 0,
+        t_ns: t,
+        message: Text::default(),
+    };
+    match applied {
+        Ok(job) => reply.job = job.unwrap_or(0),
+        Err(id) => {
+            reply.outcome = OUTCOME_REJECTED;
+            reply.error_id = u32::from(id.code());
+            reply.message = Text::new(id.description());
+        }
+    }
+    reply
+}
+
+/// The event of a job note, its message formatted into the fixed text (no allocation).
+fn job_event(j: &JobNote, names: &[&str]) -> Event {
+    let (code, error_id) = job_code(j.kind);
+    let mut ev = Event {
+        t_ns: j.t_ns,
+        kind: EVENT_JOB,
+        object: j.object as u32,
+        job: j.job,
+        code,
+        error_id,
+        message: Text::default(),
+    };
+    // A TextWriter never fails: it cuts the text at its capacity.
+    let _ = core::fmt::Write::write_fmt(
+        &mut TextWriter(&mut ev.message),
+        format_args!(
+            "{} {} job {}: {}",
+            names.get(j.object).copied().unwrap_or("?"),
+            j.instruction.name(),
+            j.job,
+            Describe(j.kind)
+        ),
+    );
+    ev
+}
