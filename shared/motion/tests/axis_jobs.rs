@@ -15,8 +15,7 @@ use tandem_motion::objects::axis::{
 use tandem_motion::objects::job::{Instruction, JobEventKind};
 use tandem_motion::plant::drive::{DriveModel, ZeroMark};
 
-mod common;
-use common::{dyn_, Rig};
+use tandem_testkit::rig::{dynamics as dyn_, Rig};
 
 fn homed(cfg: AxisConfig) -> Rig {
     let mut r = Rig::enabled(cfg);

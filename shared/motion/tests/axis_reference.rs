@@ -14,8 +14,7 @@ use tandem_motion::objects::axis::{
 use tandem_motion::objects::job::JobEventKind;
 use tandem_motion::plant::drive::{DriveModel, ZeroMark};
 
-mod common;
-use common::{dyn_ as dynamics, Rig};
+use tandem_testkit::rig::{dynamics, Rig};
 
 #[test]
 fn ramp_and_smoothing_times_of_the_velocity_profile_example() {

@@ -883,11 +883,9 @@ fn csv_to_cam() {
 
 // --- No allocation on the query path ----------------------------------------------------------
 
-mod common;
-use common::counting::{arm, disarm, Counting};
+use tandem_testkit::counting::{arm, disarm};
 
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+tandem_testkit::counting_allocator!();
 
 #[test]
 fn queries_do_not_allocate() {

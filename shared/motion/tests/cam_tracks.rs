@@ -3,9 +3,6 @@
 //! and a property test of the track output against exact crossings.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-#[path = "common/machine_limits.rs"]
-mod machine_limits;
-use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tandem_motion::catalog::alarm::AlarmId;
@@ -18,6 +15,7 @@ use tandem_motion::objects::cam_track::{
     CamTrackState, CamTrackType, McCamTrack, TrackCam, TrackOutputInterface,
 };
 use tandem_motion::objects::output_cam::{CamEdges, Edge};
+use tandem_testkit::strategies::limits;
 
 const MS: i64 = 1_000_000;
 

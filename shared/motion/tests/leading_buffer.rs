@@ -4,18 +4,15 @@
 //! does not allocate.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-#[path = "common/counting.rs"]
-mod counting;
-use counting::{arm, disarm, Counting};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tandem_motion::kinematics::modulo::Modulo;
 use tandem_motion::objects::leading::{
     LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
+use tandem_testkit::counting::{arm, disarm};
 
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+tandem_testkit::counting_allocator!();
 
 const MS: i64 = 1_000_000;
 

@@ -3,9 +3,6 @@
 //! and property tests of the measured positions and the cyclic counters.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-#[path = "common/machine_limits.rs"]
-mod machine_limits;
-use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tandem_motion::catalog::alarm::AlarmId;
@@ -18,6 +15,7 @@ use tandem_motion::objects::measuring::{
     MeasuringState, MeasuringTiming, MeasuringWindow, OneTimeMode,
 };
 use tandem_motion::plant::sensor::{InputEdge, InputEdges, SensorDirection, SimulatedSensor};
+use tandem_testkit::strategies::limits;
 
 const MS: i64 = 1_000_000;
 

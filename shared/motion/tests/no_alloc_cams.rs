@@ -5,8 +5,6 @@
 //! 10,000 cycles of 1 ms on a modulo axis moving back and forth.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-mod common;
-use common::counting::{arm, disarm, Counting};
 use tandem_motion::kinematics::cycle_motion::AxisMotion;
 use tandem_motion::kinematics::modulo::Modulo;
 use tandem_motion::kinematics::profile::{plan_position, Limits, Profile, State};
@@ -21,9 +19,9 @@ use tandem_motion::objects::output_cam::{
     CamDirection, CamEdges, McOutputCam, OutputCam, OutputCamConfig, OutputCamType,
 };
 use tandem_motion::plant::sensor::{InputEdge, InputEdges, SensorDirection, SimulatedSensor};
+use tandem_testkit::counting::{arm, disarm};
 
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+tandem_testkit::counting_allocator!();
 
 const MS: i64 = 1_000_000;
 const CYCLES: i64 = 10_000;

@@ -30,11 +30,9 @@ use tandem_motion::objects::axis::{
 use tandem_motion::objects::job::{JobEvent, JobEventKind, JobId};
 use tandem_motion::objects::leading::LeaderId;
 
-mod common;
-use common::counting::{arm, disarm, Counting};
+use tandem_testkit::counting::{arm, disarm};
 
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+tandem_testkit::counting_allocator!();
 
 const MS: i64 = 1_000_000;
 const CYCLES: u32 = 10_000;

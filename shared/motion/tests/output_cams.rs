@@ -3,9 +3,6 @@
 //! and property tests of the edge times against exact crossings of the profile.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-#[path = "common/machine_limits.rs"]
-mod machine_limits;
-use machine_limits::limits;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use tandem_motion::catalog::alarm::AlarmId;
@@ -17,6 +14,7 @@ use tandem_motion::objects::output_cam::{
     combine, max_hysteresis, CamDirection, CamEdges, Edge, LogicOperation, McOutputCam, OutputCam,
     OutputCamConfig, OutputCamMode, OutputCamParameters, OutputCamType, PositionType,
 };
+use tandem_testkit::strategies::limits;
 
 const MS: i64 = 1_000_000;
 

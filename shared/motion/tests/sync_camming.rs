@@ -5,9 +5,6 @@
 //! leading value in every cycle.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-mod common;
-
-use common::{dynamics, Pair, LEADER};
 use proptest::prelude::*;
 use std::sync::Arc;
 use tandem_motion::cam::{Cam, CamDefinition, Interpolation, MotionLaw, SegmentDef};
@@ -18,6 +15,7 @@ use tandem_motion::objects::axis::{
     VelocityDirection,
 };
 use tandem_motion::objects::job::JobEventKind;
+use tandem_testkit::rig::{dynamics, Pair, LEADER};
 
 /// Rise 0 -> 100 over 0..180 and return over 180..360 (5th-degree polynomial laws): cyclic.
 fn rise_return() -> Arc<Cam> {

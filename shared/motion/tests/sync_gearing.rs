@@ -15,8 +15,7 @@ use tandem_motion::objects::axis::{
 };
 use tandem_motion::objects::job::JobEventKind;
 
-mod common;
-use common::{dynamics, power, Pair, LEADER};
+use tandem_testkit::rig::{dynamics, power, Pair, LEADER};
 
 fn gear_in(num: i32, den: i32) -> Command {
     Command::GearIn {
