@@ -101,17 +101,23 @@ struct Launch<'a> {
 }
 
 impl Launch<'_> {
+    /// Passes `up`'s `--log-format json` on to a node or the gateway (text is their default).
+    fn log_format(&self, c: &mut std::process::Command) {
+        if self.o.log_format == LogFormat::Json {
+            c.arg("--log-format").arg("json");
+        }
+    }
+
     /// The command line of `slot`'s program.
     fn command(&self, slot: &Slot) -> std::process::Command {
         let Some(node) = slot.node else {
             let mut c = std::process::Command::new(binary("tandem-gateway"));
             c.arg(self.cell_path).arg("--host").arg(self.host);
-            if self.o.log_format == LogFormat::Json {
-                c.arg("--log-format").arg("json");
-            }
+            self.log_format(&mut c);
             return c;
         };
         let mut c = std::process::Command::new(binary("tandem-node"));
+        self.log_format(&mut c);
         c.arg(self.cell_path)
             .arg("--node")
             .arg(&self.cell.nodes[node].name)
