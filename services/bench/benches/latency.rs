@@ -399,6 +399,7 @@ impl Drop for PongProcess {
                     std::thread::sleep(Duration::from_millis(5));
                 }
                 _ => {
+                    // Cleanup after the grace time: a child that is gone already is fine.
                     let _ = self.0.kill();
                     let _ = self.0.wait();
                     return;
@@ -486,6 +487,7 @@ fn cache_line_floor(n: u64) -> f64 {
     let flag = AtomicU64::new(0);
     let took = std::thread::scope(|s| {
         s.spawn(|| {
+            // Pinning is best effort; the report states the CPU the run had.
             let _ = rt::pin_to_cpu(1);
             for i in 0..n {
                 while flag.load(Ordering::Acquire) != 2 * i + 1 {

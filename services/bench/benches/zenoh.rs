@@ -649,6 +649,7 @@ impl Env {
         let out = child.stdout.take().map(|mut o| {
             std::thread::spawn(move || {
                 let mut s = String::new();
+                // Whatever output arrived is shown; a read error leaves it empty.
                 let _ = o.read_to_string(&mut s);
                 s
             })
@@ -692,6 +693,7 @@ impl Env {
                     std::thread::sleep(Duration::from_millis(10));
                 }
                 Ok(None) if !termed => {
+                    // A child that already exited cannot be signalled; the wait below handles both.
                     let _ = rt::send_signal(p.child.id(), SIGTERM);
                     termed = true;
                     std::thread::sleep(Duration::from_millis(10));
@@ -700,6 +702,7 @@ impl Env {
                     std::thread::sleep(Duration::from_millis(10));
                 }
                 Ok(None) => {
+                    // Last resort after the grace time: a child that is gone already is fine.
                     let _ = p.child.kill();
                     let _ = p.child.wait();
                     return;
@@ -715,10 +718,12 @@ impl Drop for Env {
             self.stop(i, Duration::ZERO);
         }
         for n in &self.ns {
+            // Cleanup in Drop: a namespace already gone is fine, nothing to report to.
             let _ = std::process::Command::new("ip")
                 .args(["netns", "del", n])
                 .output();
         }
+        // Cleanup in Drop: a directory already gone is fine.
         let _ = std::fs::remove_dir_all(&self.dir);
         for h in ["hA", "hB"] {
             ipc::cleanup_dead_nodes(h);
@@ -1126,6 +1131,7 @@ fn run(busy_n: u64, period_n: u64, rounds: u64) -> Result<(), String> {
     }
     // Stop the gateways: their last line has their counters.
     for g in &gateways {
+        // A gateway that already exited cannot be signalled; stop() below waits for both.
         let _ = env
             .procs
             .get(*g)

@@ -1033,6 +1033,7 @@ mod leading_value_buffer {
                 ..base
             };
             k += 1;
+            // The timed work is the push; a refused sample is part of what is measured.
             let _ = b.push(black_box(s));
             value(b.at(black_box(s.t_ns - 3 * MS / 2), MS))
         });

@@ -109,6 +109,7 @@ fn run(cfg: AxisConfig, script: &[(u16, Command)]) {
     .unwrap();
     let mut prev = *axis.status();
     for (gap, cmd) in script {
+        // Random commands may be refused (ErrorID); the invariants below hold either way.
         let _ = axis.command(cmd);
         for _ in 0..*gap {
             k += 1;

@@ -384,6 +384,7 @@ fn gear_in_pos_on_modulo_axes_with_dynamics_reference() {
     p.step(1);
     let s = p.fs();
     let x = p.follower.status();
+    // Read for its side of the borrow only; the assertions use the pair.
     let _ = x;
     let leader_mod = p.leader.status().position;
     // Synchronous: follower = 180 + (leader - 90) modulo 360.
@@ -584,6 +585,7 @@ fn superimposed_on_the_leader_moves_its_followers_and_exceedances_are_flagged() 
             break;
         }
     }
+    // The state before is not needed past this point.
     let _ = s;
     assert!((p.fs().position_unwrapped - before - 10.0).abs() < 1e-9);
     // Synchronous followers are not clamped to their own limits: ratio 8 at leader 100/s is

@@ -32,6 +32,7 @@ fn three_executives_step_without_allocating() {
         while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
             next += 1;
             for x in nodes.iter_mut() {
+                // Only allocations are counted here; outcomes are checked by the golden and sim tests.
                 let _ = x.apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log);
             }
         }
