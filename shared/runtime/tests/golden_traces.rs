@@ -8,8 +8,9 @@
 //!
 //! A refactoring must leave every file unchanged. When a change of behaviour is intended,
 //! regenerate with `TANDEM_UPDATE_GOLDEN=1 cargo test --release -p tandem-runtime --test
-//! golden_traces` and say why in the commit; `tandem sim config/<example>.toml
-//! config/<example>-script.toml --trace t.csv && sha256sum t.csv` shows the same digest.
+//! golden_traces` and say why in the commit; `tandem sim config/<example>.toml --script
+//! config/<example>-script.toml --trace t.csv && sha256sum t.csv` shows the same digest (the
+//! `example` cell is `config/example-cell.toml`).
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
