@@ -150,37 +150,51 @@ pub fn rss() -> u64 {
     rt::resident_bytes().unwrap_or(0)
 }
 
-/// The hypervisor's steal between two points of a run, from `/proc/stat`.
+/// The first eight fields of the `cpu` line of /proc/stat (clock ticks, all CPUs): user, nice,
+/// system, idle, iowait, irq, softirq, steal; zeros where unreadable.
+fn proc_stat_cpu() -> [u64; 8] {
+    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
+    let mut f = [0u64; 8];
+    let fields = stat.lines().next().unwrap_or("").split_whitespace().skip(1);
+    for (slot, x) in f.iter_mut().zip(fields) {
+        *slot = x.parse().unwrap_or(0);
+    }
+    f
+}
+
+/// The hypervisor's steal between two points of a run, from `/proc/stat`: (all ticks, steal).
 #[derive(Debug, Clone, Copy)]
 pub struct Steal((u64, u64));
 
 impl Steal {
+    fn now() -> (u64, u64) {
+        let f = proc_stat_cpu();
+        (f.iter().sum(), f[7])
+    }
+
     /// Starts measuring.
     pub fn start() -> Self {
-        Self(rt::cpu_and_steal())
+        Self(Self::now())
     }
 
     /// The steal since [`Steal::start`], in % of the machine's CPU time.
     pub fn percent(&self) -> f64 {
-        rt::steal_percent(self.0, rt::cpu_and_steal())
+        let (a, b) = (self.0, Self::now());
+        let total = b.0.saturating_sub(a.0);
+        if total == 0 {
+            0.0
+        } else {
+            100.0 * b.1.saturating_sub(a.1) as f64 / total as f64
+        }
     }
 }
 
 /// The machine's CPU time in clock ticks, all CPUs: (all, used), from /proc/stat; used is
 /// neither idle, iowait nor steal.
 pub fn machine_ticks() -> (u64, u64) {
-    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-    let f: Vec<u64> = stat
-        .lines()
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .skip(1)
-        .take(8)
-        .filter_map(|x| x.parse().ok())
-        .collect();
+    let f = proc_stat_cpu();
     let all: u64 = f.iter().sum();
-    let unused: u64 = [3, 4, 7].iter().filter_map(|i| f.get(*i)).sum();
+    let unused = f[3] + f[4] + f[7];
     (all, all.saturating_sub(unused))
 }
 

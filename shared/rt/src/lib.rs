@@ -253,29 +253,3 @@ pub fn send_signal(pid: u32, signal: libc::c_int) -> Result<(), RtError> {
         })
     }
 }
-
-/// The machine's CPU time and the part of it stolen by the hypervisor (jiffies, all CPUs),
-/// from the `cpu` line of /proc/stat.
-pub fn cpu_and_steal() -> (u64, u64) {
-    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-    let f: Vec<u64> = stat
-        .lines()
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .skip(1)
-        .take(8)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    (f.iter().sum(), f.get(7).copied().unwrap_or(0))
-}
-
-/// Steal in % of the machine's CPU time between two [`cpu_and_steal`] readings.
-pub fn steal_percent(a: (u64, u64), b: (u64, u64)) -> f64 {
-    let total = b.0.saturating_sub(a.0);
-    if total == 0 {
-        0.0
-    } else {
-        100.0 * b.1.saturating_sub(a.1) as f64 / total as f64
-    }
-}
