@@ -34,6 +34,17 @@ pub struct CmdRequest {
 }
 
 impl CmdRequest {
+    /// The diagnostics span of one `tandem cmd` (its job is recorded once known).
+    pub fn span(&self, node: &str, object: &str) -> tracing::Span {
+        info_span!(
+            "cmd",
+            node,
+            object,
+            instruction = %self.instruction,
+            job = tracing::field::Empty
+        )
+    }
+
     /// The node and the object of the target.
     pub fn node_object(&self) -> Result<(&str, &str), CliError> {
         self.target
@@ -142,13 +153,7 @@ impl Ports {
 pub fn cmd(cell_path: &Path, r: &CmdRequest, out: &mut impl Write) -> Result<(), CliError> {
     let cell = load(cell_path)?;
     let (node, object) = r.node_object()?;
-    let span = info_span!(
-        "cmd",
-        node,
-        object,
-        instruction = %r.instruction,
-        job = tracing::field::Empty
-    );
+    let span = r.span(node, object);
     let _entered = span.enter();
     let n = cell.node(node).ok_or_else(|| CliError::UnknownNode {
         node: node.to_string(),

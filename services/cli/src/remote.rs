@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::Duration;
 use tandem_config::Cell;
 use tandem_runtime::exec::Secs;
-use tracing::{debug, info_span};
+use tracing::debug;
 
 /// The given endpoints plus every host's listen endpoints from the cell file (with none given
 /// and none in the cell: multicast scouting).
@@ -49,13 +49,7 @@ pub fn cmd_zenoh(
 ) -> Result<(), CliError> {
     let cell = load(cell_path)?;
     let (node, object) = r.node_object()?;
-    let span = info_span!(
-        "cmd",
-        node,
-        object,
-        instruction = %r.instruction,
-        job = tracing::field::Empty
-    );
+    let span = r.span(node, object);
     let _entered = span.enter();
     r.check(&cell)?;
     let line = r.line();
