@@ -29,7 +29,7 @@ use tandem_motion::objects::axis::{Axis, AxisStatus, CamId, Command};
 use tandem_motion::objects::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::objects::job::{Instruction, JobEvent, JobId};
 use tandem_motion::objects::leading::{
-    LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
+    LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
 
 fn gcd(a: i64, b: i64) -> i64 {
@@ -147,6 +147,55 @@ struct LeaderBuffer {
     missing: Option<Missing>,
     /// The outage was logged.
     logged: bool,
+}
+
+/// How a follower reads one leader: the coupling, and the buffer of samples if it reads it
+/// delayed or from another node.
+#[derive(Debug, Clone, Copy)]
+struct LeaderSource {
+    leader: Leader,
+    coupling: Coupling,
+    buffer: Option<usize>,
+}
+
+/// The order in which the owned axes step, and where each reads its leaders, planned from the
+/// axes' leaders; planned again when they change (a coupling starts or ends).
+#[derive(Debug, Default)]
+struct StepPlan {
+    /// The leaders of every axis when the plan was made.
+    leaders: Vec<[Option<LeaderId>; 2]>,
+    /// Owned axes, leaders before their followers, with the leaders each reads (`None`: a
+    /// leader id the cell does not have).
+    order: Vec<(usize, [Option<(LeaderId, Option<LeaderSource>)>; 2])>,
+    /// Owned axes caught in a coupling loop: stepped last, without leading values.
+    unreached: Vec<usize>,
+    /// Per axis: taken into `order` (while planning).
+    taken: Vec<bool>,
+    /// A plan was made.
+    valid: bool,
+}
+
+impl StepPlan {
+    /// An empty plan with room for `n` axes, so that planning again does not allocate.
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            leaders: Vec::with_capacity(n),
+            order: Vec::with_capacity(n),
+            unreached: Vec::with_capacity(n),
+            taken: vec![false; n],
+            valid: false,
+        }
+    }
+
+    /// Whether the plan still holds: every owned axis has the leaders it was planned with.
+    fn holds(&self, axes: &[Axis], owned: &[bool]) -> bool {
+        self.valid
+            && axes
+                .iter()
+                .zip(&self.leaders)
+                .zip(owned)
+                .all(|((a, l), o)| !o || a.leaders() == *l)
+    }
 }
 
 /// What applying a command did.
@@ -322,11 +371,48 @@ fn leader_buffers(cell: &Cell, owned: &Owned) -> Vec<LeaderBuffer> {
     buffers
 }
 
+/// The encoders and axes of the cell by name, sorted, for commands addressed by name.
+#[derive(Debug)]
+struct Names<'c> {
+    encoders: Vec<(&'c str, usize)>,
+    axes: Vec<(&'c str, usize)>,
+}
+
+impl<'c> Names<'c> {
+    fn of(cell: &'c Cell) -> Self {
+        let sorted = |names: Vec<&'c str>| {
+            let mut v: Vec<(&'c str, usize)> = names.into_iter().zip(0..).collect();
+            // Stable: of two objects with one name, the first in the cell comes first.
+            v.sort_by(|a, b| a.0.cmp(b.0));
+            v
+        };
+        Self {
+            encoders: sorted(cell.encoders.iter().map(|e| e.name.as_str()).collect()),
+            axes: sorted(cell.axes.iter().map(|a| a.name.as_str()).collect()),
+        }
+    }
+
+    /// The index of the first object named `name` in `list`.
+    fn find(list: &[(&str, usize)], name: &str) -> Option<usize> {
+        let k = list.partition_point(|x| x.0 < name);
+        list.get(k).filter(|x| x.0 == name).map(|x| x.1)
+    }
+
+    fn encoder(&self, name: &str) -> Option<usize> {
+        Self::find(&self.encoders, name)
+    }
+
+    fn axis(&self, name: &str) -> Option<usize> {
+        Self::find(&self.axes, name)
+    }
+}
+
 /// The technology objects of one node (or of the whole cell), stepped by the caller.
 #[derive(Debug)]
 pub struct Executive<'c> {
     cell: &'c Cell,
     owned: Owned,
+    names: Names<'c>,
     axes: Vec<Axis>,
     encoders: Vec<ExternalEncoder>,
     /// The cams as the jobs see them: MC_InterpolateCam replaces one (a job keeps its own).
@@ -336,13 +422,15 @@ pub struct Executive<'c> {
     objects: Objects,
     has_objects: Vec<bool>,
     needs_motion: Vec<bool>,
+    /// The axes with `needs_motion`, in index order.
+    motion_axes: Vec<usize>,
     motions: Vec<Option<CycleMotion>>,
     alarms_seen: Vec<[(u16, u16); 8]>,
     status: Vec<AxisStatus>,
     encoder_status: Vec<EncoderStatus>,
     /// The status at each axis' previous cycle (the start of its objects' motion).
     last_cycle: Vec<AxisStatus>,
-    stepped: Vec<bool>,
+    plan: StepPlan,
     buffers: Vec<LeaderBuffer>,
     jobs: Vec<JobNote>,
     /// Notes dropped because more than [`NOTES`] came in one step.
@@ -379,16 +467,20 @@ impl<'c> Executive<'c> {
             cell,
             objects: Objects::new(cell)?,
             owned,
+            names: Names::of(cell),
             cams,
             tick: tick_of(cell, node),
             has_objects,
+            motion_axes: (0..needs_motion.len())
+                .filter(|&i| needs_motion[i])
+                .collect(),
             needs_motion,
             motions: (0..cell.axes.len()).map(|_| None).collect(),
             alarms_seen: vec![[(0, 0); 8]; axes.len()],
             last_cycle: status.clone(),
             status,
             encoder_status,
-            stepped: vec![false; axes.len()],
+            plan: StepPlan::with_capacity(axes.len()),
             cycles,
             axes,
             encoders,
@@ -568,16 +660,15 @@ impl<'c> Executive<'c> {
                 return interpolate_cam(cell, &mut self.cams, cam, from).map(|()| None);
             }
         };
-        if let Some(k) = cell.encoders.iter().position(|x| x.name == target) {
+        if let Some(k) = self.names.encoder(target) {
             if !self.owned.encoders[k] {
                 return Err(ErrorId::IllegalObject);
             }
             return self.encoders[k].command(&command).map(Some);
         }
-        let Some(i) = cell
-            .axes
-            .iter()
-            .position(|a| a.name == target)
+        let Some(i) = self
+            .names
+            .axis(target)
             .map(AxisIndex)
             .filter(|i| self.owned.axis(*i))
         else {
@@ -619,38 +710,49 @@ impl<'c> Executive<'c> {
         result
     }
 
-    /// The value follower `i` reads of leader `l` at time `t`.
-    fn leading_value(&mut self, i: AxisIndex, l: Leader, t: i64) -> Option<LeadingValue> {
+    /// How follower `i` reads leader `l`: its coupling and the buffer of delayed samples, if
+    /// any (found once per plan, not every cycle).
+    fn leader_source(&self, i: AxisIndex, l: Leader) -> LeaderSource {
         let coupling = if l.is_encoder() {
             Coupling::Setpoint
         } else {
             self.cell.coupling(i, l).unwrap_or(Coupling::Setpoint)
         };
-        let owned = self.owned.leader(l);
-        match self
-            .buffers
-            .iter_mut()
-            .find(|b| b.leader == l && b.coupling == coupling)
-        {
-            Some(b) => match b.samples.at(t - b.delay_ns, b.tolerance_ns) {
-                Lookup::Interpolated(v) => {
-                    b.missing = None;
-                    b.logged = false;
-                    Some(v)
-                }
-                Lookup::Extrapolated { value, .. } => {
-                    b.missing = None;
-                    b.logged = false;
-                    self.extrapolated += 1;
-                    Some(value)
-                }
-                Lookup::Missing(m) => {
-                    b.missing = Some(m);
-                    None
-                }
-            },
-            None if owned => self.direct(l, coupling),
-            None => None,
+        LeaderSource {
+            leader: l,
+            coupling,
+            buffer: self
+                .buffers
+                .iter()
+                .position(|b| b.leader == l && b.coupling == coupling),
+        }
+    }
+
+    /// The value a follower reads of the leader of `src` at time `t`.
+    fn leading_value(&mut self, src: LeaderSource, t: i64) -> Option<LeadingValue> {
+        let Some(b) = src.buffer.and_then(|k| self.buffers.get_mut(k)) else {
+            return if self.owned.leader(src.leader) {
+                self.direct(src.leader, src.coupling)
+            } else {
+                None
+            };
+        };
+        match b.samples.at(t - b.delay_ns, b.tolerance_ns) {
+            Lookup::Interpolated(v) => {
+                b.missing = None;
+                b.logged = false;
+                Some(v)
+            }
+            Lookup::Extrapolated { value, .. } => {
+                b.missing = None;
+                b.logged = false;
+                self.extrapolated += 1;
+                Some(value)
+            }
+            Lookup::Missing(m) => {
+                b.missing = Some(m);
+                None
+            }
         }
     }
 
@@ -737,46 +839,82 @@ impl<'c> Executive<'c> {
     }
 
     /// The owned axes, leaders before their followers: an axis steps once every leader it
-    /// needs has, with the leading values of this step.
+    /// needs has, with the leading values of this step. The order is planned again when an
+    /// axis' leaders changed since the last step.
     fn step_axes(&mut self, t: i64) {
+        if !self.plan.holds(&self.axes, &self.owned.axes) {
+            self.replan();
+        }
+        for k in 0..self.plan.order.len() {
+            let (i, reads) = self.plan.order[k];
+            for (id, src) in reads.into_iter().flatten() {
+                let lv = match src {
+                    Some(src) => self.leading_value(src, t),
+                    None => None,
+                };
+                self.axes[i].set_leading_value(id, lv);
+            }
+            if t % self.cycles[i] == 0 {
+                self.axes[i].step(t);
+            }
+        }
+        // Not empty only with a coupling loop, which commands cannot create (16#8019): the
+        // axis then runs without its leading value and raises "leader missing".
+        for k in 0..self.plan.unreached.len() {
+            let i = self.plan.unreached[k];
+            if t % self.cycles[i] == 0 {
+                self.axes[i].step(t);
+            }
+        }
+    }
+
+    /// Plans the order of the owned axes from their current leaders: passes over the axes in
+    /// index order, each taking the axes whose owned leaders are already taken.
+    fn replan(&mut self) {
         let cell = self.cell;
         let n_axes = self.axes.len();
-        self.stepped.fill(false);
+        let mut plan = std::mem::take(&mut self.plan);
+        plan.order.clear();
+        plan.unreached.clear();
+        plan.leaders.clear();
+        plan.leaders.extend(self.axes.iter().map(Axis::leaders));
+        let mut taken = std::mem::take(&mut plan.taken);
+        taken.fill(false);
         for _pass in 0..=n_axes {
             let mut progress = false;
-            for i in cell.axis_indices() {
-                if self.stepped[i.0] || !self.owned.axes[i.0] {
+            for i in 0..n_axes {
+                if taken[i] || !self.owned.axes[i] {
                     continue;
                 }
-                let needs = self.axes[i.0].leaders();
+                let needs = plan.leaders[i];
                 let ready = needs.iter().flatten().all(|l| match cell.leader(*l) {
-                    Some(Leader::Axis(j)) => !self.owned.axes[j.0] || self.stepped[j.0],
+                    Some(Leader::Axis(j)) => !self.owned.axes[j.0] || taken[j.0],
                     _ => true,
                 });
                 if !ready {
                     continue;
                 }
-                for l in needs.into_iter().flatten() {
-                    let lv = cell.leader(l).and_then(|j| self.leading_value(i, j, t));
-                    self.axes[i.0].set_leading_value(l, lv);
-                }
-                if t % self.cycles[i.0] == 0 {
-                    self.axes[i.0].step(t);
-                }
-                self.stepped[i.0] = true;
+                let reads = needs.map(|l| {
+                    l.map(|id| {
+                        (
+                            id,
+                            cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
+                        )
+                    })
+                });
+                plan.order.push((i, reads));
+                taken[i] = true;
                 progress = true;
             }
             if !progress {
                 break;
             }
         }
-        // Not reached only with a coupling loop, which commands cannot create (16#8019): the
-        // axis then runs without its leading value and raises "leader missing".
-        for (i, axis) in self.axes.iter_mut().enumerate() {
-            if self.owned.axes[i] && !self.stepped[i] && t % self.cycles[i] == 0 {
-                axis.step(t);
-            }
-        }
+        plan.unreached
+            .extend((0..n_axes).filter(|&i| self.owned.axes[i] && !taken[i]));
+        plan.taken = taken;
+        plan.valid = true;
+        self.plan = plan;
     }
 
     /// The job events and new alarms of the owned axes, and their status.
@@ -816,8 +954,10 @@ impl<'c> Executive<'c> {
     /// node, with the motion of that cycle.
     fn step_objects(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
-        for (i, m) in self.motions.iter_mut().enumerate() {
-            *m = (t % self.cycles[i] == 0 && self.needs_motion[i]).then(|| {
+        // Only the axes whose motion is needed have one (the others' stay `None`); their
+        // previous cycle's status is kept for it.
+        for &i in &self.motion_axes {
+            self.motions[i] = (t % self.cycles[i] == 0).then(|| {
                 cycle_motion(
                     &self.last_cycle[i],
                     &self.status[i],
@@ -840,7 +980,9 @@ impl<'c> Executive<'c> {
                     self.objects.homing[i.0] = false;
                 }
             }
-            self.last_cycle[i.0] = self.status[i.0];
+            if self.needs_motion[i.0] {
+                self.last_cycle[i.0] = self.status[i.0];
+            }
         }
         Ok(())
     }
