@@ -424,6 +424,9 @@ pub struct Executive<'c> {
     needs_motion: Vec<bool>,
     /// The axes with `needs_motion`, in index order.
     motion_axes: Vec<usize>,
+    /// The owned axes with objects or whose motion is needed, in index order (the others
+    /// have nothing to do after their step).
+    object_axes: Vec<usize>,
     motions: Vec<Option<CycleMotion>>,
     alarms_seen: Vec<[(u16, u16); 8]>,
     status: Vec<AxisStatus>,
@@ -461,6 +464,9 @@ impl<'c> Executive<'c> {
             .collect();
         let (has_objects, needs_motion) = axes_with_objects(cell, &owned);
         let buffers = leader_buffers(cell, &owned);
+        let object_axes = (0..needs_motion.len())
+            .filter(|&i| owned.axes[i] && (has_objects[i] || needs_motion[i]))
+            .collect();
         let status: Vec<AxisStatus> = axes.iter().map(|a| *a.status()).collect();
         let encoder_status = encoders.iter().map(|e| *e.status()).collect();
         Ok(Self {
@@ -474,6 +480,7 @@ impl<'c> Executive<'c> {
             motion_axes: (0..needs_motion.len())
                 .filter(|&i| needs_motion[i])
                 .collect(),
+            object_axes,
             needs_motion,
             motions: (0..cell.axes.len()).map(|_| None).collect(),
             alarms_seen: vec![[(0, 0); 8]; axes.len()],
@@ -928,6 +935,11 @@ impl<'c> Executive<'c> {
                 let name = &cell.axes[i].name;
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
             }
+            // Without a pending alarm, nor one seen last step, there is nothing new to log.
+            if !axis.alarm_pending() && self.alarms_seen[i] == [(0, 0); 8] {
+                self.status[i] = *axis.status();
+                continue;
+            }
             let mut now = [(0u16, 0u16); 8];
             for (slot, a) in now.iter_mut().zip(axis.alarms()) {
                 *slot = (a.id.number(), a.supplement);
@@ -968,8 +980,9 @@ impl<'c> Executive<'c> {
                 )
             });
         }
-        for i in cell.axis_indices() {
-            if !self.owned.axes[i.0] || t % self.cycles[i.0] != 0 {
+        for k in 0..self.object_axes.len() {
+            let i = AxisIndex(self.object_axes[k]);
+            if t % self.cycles[i.0] != 0 {
                 continue;
             }
             if self.has_objects[i.0] {
