@@ -418,6 +418,10 @@ pub struct Executive<'c> {
     /// The cams as the jobs see them: MC_InterpolateCam replaces one (a job keeps its own).
     cams: Vec<(Arc<Cam>, CamDefinition)>,
     cycles: Vec<i64>,
+    /// Per node of the cell: whether its cycle falls on the step's time.
+    due: Vec<bool>,
+    /// Per axis: the index of its node.
+    node_of: Vec<usize>,
     tick: i64,
     objects: Objects,
     has_objects: Vec<bool>,
@@ -489,6 +493,8 @@ impl<'c> Executive<'c> {
             encoder_status,
             plan: StepPlan::with_capacity(axes.len()),
             cycles,
+            due: vec![false; cell.nodes.len()],
+            node_of: cell.axes.iter().map(|a| a.node).collect(),
             axes,
             encoders,
             buffers,
@@ -852,6 +858,10 @@ impl<'c> Executive<'c> {
         if !self.plan.holds(&self.axes, &self.owned.axes) {
             self.replan();
         }
+        // Which nodes' cycles fall on `t` (one division per node, not per axis).
+        for (due, node) in self.due.iter_mut().zip(&self.cell.nodes) {
+            *due = t % node.cycle_ns == 0;
+        }
         for k in 0..self.plan.order.len() {
             let (i, reads) = self.plan.order[k];
             for (id, src) in reads.into_iter().flatten() {
@@ -861,7 +871,7 @@ impl<'c> Executive<'c> {
                 };
                 self.axes[i].set_leading_value(id, lv);
             }
-            if t % self.cycles[i] == 0 {
+            if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
             }
         }
@@ -869,7 +879,7 @@ impl<'c> Executive<'c> {
         // axis then runs without its leading value and raises "leader missing".
         for k in 0..self.plan.unreached.len() {
             let i = self.plan.unreached[k];
-            if t % self.cycles[i] == 0 {
+            if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
             }
         }
@@ -936,7 +946,7 @@ impl<'c> Executive<'c> {
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
             }
             // Without a pending alarm, nor one seen last step, there is nothing new to log.
-            if !axis.alarm_pending() && self.alarms_seen[i] == [(0, 0); 8] {
+            if !axis.alarm_pending() && self.alarms_seen[i].iter().all(|&(n, s)| n | s == 0) {
                 self.status[i] = *axis.status();
                 continue;
             }
