@@ -158,15 +158,29 @@ struct LeaderSource {
     buffer: Option<usize>,
 }
 
+/// One leader an axis reads in its step: its id, and where its value comes from (`None`: a
+/// leader id the cell does not have).
+#[derive(Debug, Clone, Copy)]
+struct LeaderRead {
+    id: LeaderId,
+    source: Option<LeaderSource>,
+}
+
+/// One owned axis in the step order, with the leaders it reads.
+#[derive(Debug, Clone, Copy)]
+struct Planned {
+    axis: usize,
+    reads: [Option<LeaderRead>; 2],
+}
+
 /// The order in which the owned axes step, and where each reads its leaders, planned from the
 /// axes' leaders; planned again when they change (a coupling starts or ends).
 #[derive(Debug, Default)]
 struct StepPlan {
     /// The leaders of every axis when the plan was made.
     leaders: Vec<[Option<LeaderId>; 2]>,
-    /// Owned axes, leaders before their followers, with the leaders each reads (`None`: a
-    /// leader id the cell does not have).
-    order: Vec<(usize, [Option<(LeaderId, Option<LeaderSource>)>; 2])>,
+    /// Owned axes, leaders before their followers, with the leaders each reads.
+    order: Vec<Planned>,
     /// Owned axes caught in a coupling loop: stepped last, without leading values.
     unreached: Vec<usize>,
     /// Per axis: taken into `order` (while planning).
@@ -863,13 +877,13 @@ impl<'c> Executive<'c> {
             *due = t % node.cycle_ns == 0;
         }
         for k in 0..self.plan.order.len() {
-            let (i, reads) = self.plan.order[k];
-            for (id, src) in reads.into_iter().flatten() {
-                let lv = match src {
+            let Planned { axis: i, reads } = self.plan.order[k];
+            for read in reads.into_iter().flatten() {
+                let lv = match read.source {
                     Some(src) => self.leading_value(src, t),
                     None => None,
                 };
-                self.axes[i].set_leading_value(id, lv);
+                self.axes[i].set_leading_value(read.id, lv);
             }
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
@@ -912,14 +926,12 @@ impl<'c> Executive<'c> {
                     continue;
                 }
                 let reads = needs.map(|l| {
-                    l.map(|id| {
-                        (
-                            id,
-                            cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
-                        )
+                    l.map(|id| LeaderRead {
+                        id,
+                        source: cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
                     })
                 });
-                plan.order.push((i, reads));
+                plan.order.push(Planned { axis: i, reads });
                 taken[i] = true;
                 progress = true;
             }
