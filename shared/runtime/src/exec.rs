@@ -29,7 +29,7 @@ use tandem_motion::objects::axis::{Axis, AxisStatus, CamId, Command};
 use tandem_motion::objects::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::objects::job::{Instruction, JobEvent, JobId};
 use tandem_motion::objects::leading::{
-    LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
+    LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
 
 fn gcd(a: i64, b: i64) -> i64 {
@@ -147,6 +147,69 @@ struct LeaderBuffer {
     missing: Option<Missing>,
     /// The outage was logged.
     logged: bool,
+}
+
+/// How a follower reads one leader: the coupling, and the buffer of samples if it reads it
+/// delayed or from another node.
+#[derive(Debug, Clone, Copy)]
+struct LeaderSource {
+    leader: Leader,
+    coupling: Coupling,
+    buffer: Option<usize>,
+}
+
+/// One leader an axis reads in its step: its id, and where its value comes from (`None`: a
+/// leader id the cell does not have).
+#[derive(Debug, Clone, Copy)]
+struct LeaderRead {
+    id: LeaderId,
+    source: Option<LeaderSource>,
+}
+
+/// One owned axis in the step order, with the leaders it reads.
+#[derive(Debug, Clone, Copy)]
+struct Planned {
+    axis: usize,
+    reads: [Option<LeaderRead>; 2],
+}
+
+/// The order in which the owned axes step, and where each reads its leaders, planned from the
+/// axes' leaders; planned again when they change (a coupling starts or ends).
+#[derive(Debug, Default)]
+struct StepPlan {
+    /// The leaders of every axis when the plan was made.
+    leaders: Vec<[Option<LeaderId>; 2]>,
+    /// Owned axes, leaders before their followers, with the leaders each reads.
+    order: Vec<Planned>,
+    /// Owned axes caught in a coupling loop: stepped last, without leading values.
+    unreached: Vec<usize>,
+    /// Per axis: taken into `order` (while planning).
+    taken: Vec<bool>,
+    /// A plan was made.
+    valid: bool,
+}
+
+impl StepPlan {
+    /// An empty plan with room for `n` axes, so that planning again does not allocate.
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            leaders: Vec::with_capacity(n),
+            order: Vec::with_capacity(n),
+            unreached: Vec::with_capacity(n),
+            taken: vec![false; n],
+            valid: false,
+        }
+    }
+
+    /// Whether the plan still holds: every owned axis has the leaders it was planned with.
+    fn holds(&self, axes: &[Axis], owned: &[bool]) -> bool {
+        self.valid
+            && axes
+                .iter()
+                .zip(&self.leaders)
+                .zip(owned)
+                .all(|((a, l), o)| !o || a.leaders() == *l)
+    }
 }
 
 /// What applying a command did.
@@ -322,27 +385,73 @@ fn leader_buffers(cell: &Cell, owned: &Owned) -> Vec<LeaderBuffer> {
     buffers
 }
 
+/// The encoders and axes of the cell by name, sorted, for commands addressed by name.
+#[derive(Debug)]
+struct Names<'c> {
+    encoders: Vec<(&'c str, usize)>,
+    axes: Vec<(&'c str, usize)>,
+}
+
+impl<'c> Names<'c> {
+    fn of(cell: &'c Cell) -> Self {
+        let sorted = |names: Vec<&'c str>| {
+            let mut v: Vec<(&'c str, usize)> = names.into_iter().zip(0..).collect();
+            // Stable: of two objects with one name, the first in the cell comes first.
+            v.sort_by(|a, b| a.0.cmp(b.0));
+            v
+        };
+        Self {
+            encoders: sorted(cell.encoders.iter().map(|e| e.name.as_str()).collect()),
+            axes: sorted(cell.axes.iter().map(|a| a.name.as_str()).collect()),
+        }
+    }
+
+    /// The index of the first object named `name` in `list`.
+    fn find(list: &[(&str, usize)], name: &str) -> Option<usize> {
+        let k = list.partition_point(|x| x.0 < name);
+        list.get(k).filter(|x| x.0 == name).map(|x| x.1)
+    }
+
+    fn encoder(&self, name: &str) -> Option<usize> {
+        Self::find(&self.encoders, name)
+    }
+
+    fn axis(&self, name: &str) -> Option<usize> {
+        Self::find(&self.axes, name)
+    }
+}
+
 /// The technology objects of one node (or of the whole cell), stepped by the caller.
 #[derive(Debug)]
 pub struct Executive<'c> {
     cell: &'c Cell,
     owned: Owned,
+    names: Names<'c>,
     axes: Vec<Axis>,
     encoders: Vec<ExternalEncoder>,
     /// The cams as the jobs see them: MC_InterpolateCam replaces one (a job keeps its own).
     cams: Vec<(Arc<Cam>, CamDefinition)>,
     cycles: Vec<i64>,
+    /// Per node of the cell: whether its cycle falls on the step's time.
+    due: Vec<bool>,
+    /// Per axis: the index of its node.
+    node_of: Vec<usize>,
     tick: i64,
     objects: Objects,
     has_objects: Vec<bool>,
     needs_motion: Vec<bool>,
+    /// The axes with `needs_motion`, in index order.
+    motion_axes: Vec<usize>,
+    /// The owned axes with objects or whose motion is needed, in index order (the others
+    /// have nothing to do after their step).
+    object_axes: Vec<usize>,
     motions: Vec<Option<CycleMotion>>,
     alarms_seen: Vec<[(u16, u16); 8]>,
     status: Vec<AxisStatus>,
     encoder_status: Vec<EncoderStatus>,
     /// The status at each axis' previous cycle (the start of its objects' motion).
     last_cycle: Vec<AxisStatus>,
-    stepped: Vec<bool>,
+    plan: StepPlan,
     buffers: Vec<LeaderBuffer>,
     jobs: Vec<JobNote>,
     /// Notes dropped because more than [`NOTES`] came in one step.
@@ -373,23 +482,33 @@ impl<'c> Executive<'c> {
             .collect();
         let (has_objects, needs_motion) = axes_with_objects(cell, &owned);
         let buffers = leader_buffers(cell, &owned);
+        let object_axes = (0..needs_motion.len())
+            .filter(|&i| owned.axes[i] && (has_objects[i] || needs_motion[i]))
+            .collect();
         let status: Vec<AxisStatus> = axes.iter().map(|a| *a.status()).collect();
         let encoder_status = encoders.iter().map(|e| *e.status()).collect();
         Ok(Self {
             cell,
             objects: Objects::new(cell)?,
             owned,
+            names: Names::of(cell),
             cams,
             tick: tick_of(cell, node),
             has_objects,
+            motion_axes: (0..needs_motion.len())
+                .filter(|&i| needs_motion[i])
+                .collect(),
+            object_axes,
             needs_motion,
             motions: (0..cell.axes.len()).map(|_| None).collect(),
             alarms_seen: vec![[(0, 0); 8]; axes.len()],
             last_cycle: status.clone(),
             status,
             encoder_status,
-            stepped: vec![false; axes.len()],
+            plan: StepPlan::with_capacity(axes.len()),
             cycles,
+            due: vec![false; cell.nodes.len()],
+            node_of: cell.axes.iter().map(|a| a.node).collect(),
             axes,
             encoders,
             buffers,
@@ -568,16 +687,15 @@ impl<'c> Executive<'c> {
                 return interpolate_cam(cell, &mut self.cams, cam, from).map(|()| None);
             }
         };
-        if let Some(k) = cell.encoders.iter().position(|x| x.name == target) {
+        if let Some(k) = self.names.encoder(target) {
             if !self.owned.encoders[k] {
                 return Err(ErrorId::IllegalObject);
             }
             return self.encoders[k].command(&command).map(Some);
         }
-        let Some(i) = cell
-            .axes
-            .iter()
-            .position(|a| a.name == target)
+        let Some(i) = self
+            .names
+            .axis(target)
             .map(AxisIndex)
             .filter(|i| self.owned.axis(*i))
         else {
@@ -619,38 +737,49 @@ impl<'c> Executive<'c> {
         result
     }
 
-    /// The value follower `i` reads of leader `l` at time `t`.
-    fn leading_value(&mut self, i: AxisIndex, l: Leader, t: i64) -> Option<LeadingValue> {
+    /// How follower `i` reads leader `l`: its coupling and the buffer of delayed samples, if
+    /// any (found once per plan, not every cycle).
+    fn leader_source(&self, i: AxisIndex, l: Leader) -> LeaderSource {
         let coupling = if l.is_encoder() {
             Coupling::Setpoint
         } else {
             self.cell.coupling(i, l).unwrap_or(Coupling::Setpoint)
         };
-        let owned = self.owned.leader(l);
-        match self
-            .buffers
-            .iter_mut()
-            .find(|b| b.leader == l && b.coupling == coupling)
-        {
-            Some(b) => match b.samples.at(t - b.delay_ns, b.tolerance_ns) {
-                Lookup::Interpolated(v) => {
-                    b.missing = None;
-                    b.logged = false;
-                    Some(v)
-                }
-                Lookup::Extrapolated { value, .. } => {
-                    b.missing = None;
-                    b.logged = false;
-                    self.extrapolated += 1;
-                    Some(value)
-                }
-                Lookup::Missing(m) => {
-                    b.missing = Some(m);
-                    None
-                }
-            },
-            None if owned => self.direct(l, coupling),
-            None => None,
+        LeaderSource {
+            leader: l,
+            coupling,
+            buffer: self
+                .buffers
+                .iter()
+                .position(|b| b.leader == l && b.coupling == coupling),
+        }
+    }
+
+    /// The value a follower reads of the leader of `src` at time `t`.
+    fn leading_value(&mut self, src: LeaderSource, t: i64) -> Option<LeadingValue> {
+        let Some(b) = src.buffer.and_then(|k| self.buffers.get_mut(k)) else {
+            return if self.owned.leader(src.leader) {
+                self.direct(src.leader, src.coupling)
+            } else {
+                None
+            };
+        };
+        match b.samples.at(t - b.delay_ns, b.tolerance_ns) {
+            Lookup::Interpolated(v) => {
+                b.missing = None;
+                b.logged = false;
+                Some(v)
+            }
+            Lookup::Extrapolated { value, .. } => {
+                b.missing = None;
+                b.logged = false;
+                self.extrapolated += 1;
+                Some(value)
+            }
+            Lookup::Missing(m) => {
+                b.missing = Some(m);
+                None
+            }
         }
     }
 
@@ -737,46 +866,84 @@ impl<'c> Executive<'c> {
     }
 
     /// The owned axes, leaders before their followers: an axis steps once every leader it
-    /// needs has, with the leading values of this step.
+    /// needs has, with the leading values of this step. The order is planned again when an
+    /// axis' leaders changed since the last step.
     fn step_axes(&mut self, t: i64) {
+        if !self.plan.holds(&self.axes, &self.owned.axes) {
+            self.replan();
+        }
+        // Which nodes' cycles fall on `t` (one division per node, not per axis).
+        for (due, node) in self.due.iter_mut().zip(&self.cell.nodes) {
+            *due = t % node.cycle_ns == 0;
+        }
+        for k in 0..self.plan.order.len() {
+            let Planned { axis: i, reads } = self.plan.order[k];
+            for read in reads.into_iter().flatten() {
+                let lv = match read.source {
+                    Some(src) => self.leading_value(src, t),
+                    None => None,
+                };
+                self.axes[i].set_leading_value(read.id, lv);
+            }
+            if self.due[self.node_of[i]] {
+                self.axes[i].step(t);
+            }
+        }
+        // Not empty only with a coupling loop, which commands cannot create (16#8019): the
+        // axis then runs without its leading value and raises "leader missing".
+        for k in 0..self.plan.unreached.len() {
+            let i = self.plan.unreached[k];
+            if self.due[self.node_of[i]] {
+                self.axes[i].step(t);
+            }
+        }
+    }
+
+    /// Plans the order of the owned axes from their current leaders: passes over the axes in
+    /// index order, each taking the axes whose owned leaders are already taken.
+    fn replan(&mut self) {
         let cell = self.cell;
         let n_axes = self.axes.len();
-        self.stepped.fill(false);
+        let mut plan = std::mem::take(&mut self.plan);
+        plan.order.clear();
+        plan.unreached.clear();
+        plan.leaders.clear();
+        plan.leaders.extend(self.axes.iter().map(Axis::leaders));
+        let mut taken = std::mem::take(&mut plan.taken);
+        taken.fill(false);
         for _pass in 0..=n_axes {
             let mut progress = false;
-            for i in cell.axis_indices() {
-                if self.stepped[i.0] || !self.owned.axes[i.0] {
+            for i in 0..n_axes {
+                if taken[i] || !self.owned.axes[i] {
                     continue;
                 }
-                let needs = self.axes[i.0].leaders();
+                let needs = plan.leaders[i];
                 let ready = needs.iter().flatten().all(|l| match cell.leader(*l) {
-                    Some(Leader::Axis(j)) => !self.owned.axes[j.0] || self.stepped[j.0],
+                    Some(Leader::Axis(j)) => !self.owned.axes[j.0] || taken[j.0],
                     _ => true,
                 });
                 if !ready {
                     continue;
                 }
-                for l in needs.into_iter().flatten() {
-                    let lv = cell.leader(l).and_then(|j| self.leading_value(i, j, t));
-                    self.axes[i.0].set_leading_value(l, lv);
-                }
-                if t % self.cycles[i.0] == 0 {
-                    self.axes[i.0].step(t);
-                }
-                self.stepped[i.0] = true;
+                let reads = needs.map(|l| {
+                    l.map(|id| LeaderRead {
+                        id,
+                        source: cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
+                    })
+                });
+                plan.order.push(Planned { axis: i, reads });
+                taken[i] = true;
                 progress = true;
             }
             if !progress {
                 break;
             }
         }
-        // Not reached only with a coupling loop, which commands cannot create (16#8019): the
-        // axis then runs without its leading value and raises "leader missing".
-        for (i, axis) in self.axes.iter_mut().enumerate() {
-            if self.owned.axes[i] && !self.stepped[i] && t % self.cycles[i] == 0 {
-                axis.step(t);
-            }
-        }
+        plan.unreached
+            .extend((0..n_axes).filter(|&i| self.owned.axes[i] && !taken[i]));
+        plan.taken = taken;
+        plan.valid = true;
+        self.plan = plan;
     }
 
     /// The job events and new alarms of the owned axes, and their status.
@@ -789,6 +956,11 @@ impl<'c> Executive<'c> {
             while let Some(ev) = axis.pop_event() {
                 let name = &cell.axes[i].name;
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
+            }
+            // Without a pending alarm, nor one seen last step, there is nothing new to log.
+            if !axis.alarm_pending() && self.alarms_seen[i].iter().all(|&(n, s)| n | s == 0) {
+                self.status[i] = *axis.status();
+                continue;
             }
             let mut now = [(0u16, 0u16); 8];
             for (slot, a) in now.iter_mut().zip(axis.alarms()) {
@@ -816,8 +988,10 @@ impl<'c> Executive<'c> {
     /// node, with the motion of that cycle.
     fn step_objects(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
-        for (i, m) in self.motions.iter_mut().enumerate() {
-            *m = (t % self.cycles[i] == 0 && self.needs_motion[i]).then(|| {
+        // Only the axes whose motion is needed have one (the others' stay `None`); their
+        // previous cycle's status is kept for it.
+        for &i in &self.motion_axes {
+            self.motions[i] = (t % self.cycles[i] == 0).then(|| {
                 cycle_motion(
                     &self.last_cycle[i],
                     &self.status[i],
@@ -828,8 +1002,9 @@ impl<'c> Executive<'c> {
                 )
             });
         }
-        for i in cell.axis_indices() {
-            if !self.owned.axes[i.0] || t % self.cycles[i.0] != 0 {
+        for k in 0..self.object_axes.len() {
+            let i = AxisIndex(self.object_axes[k]);
+            if t % self.cycles[i.0] != 0 {
                 continue;
             }
             if self.has_objects[i.0] {
@@ -840,7 +1015,9 @@ impl<'c> Executive<'c> {
                     self.objects.homing[i.0] = false;
                 }
             }
-            self.last_cycle[i.0] = self.status[i.0];
+            if self.needs_motion[i.0] {
+                self.last_cycle[i.0] = self.status[i.0];
+            }
         }
         Ok(())
     }

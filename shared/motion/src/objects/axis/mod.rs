@@ -293,6 +293,8 @@ pub struct Axis {
     extrapolator: Extrapolator,
     actual_output: bool,
     alarms: [Option<AlarmInstance>; MAX_ALARMS],
+    /// Whether `alarms` has one (kept with it, so the cycle need not scan the slots).
+    alarm_pending: bool,
     hw_trigger: Option<(Sense, f64)>,
     sw_active: Option<Sense>,
     standstill_since: Option<i64>,
@@ -367,6 +369,7 @@ impl Axis {
             extrapolator: Extrapolator::new(cfg.extrapolation, cfg.cycle),
             actual_output: false,
             alarms: [None; MAX_ALARMS],
+            alarm_pending: false,
             hw_trigger: None,
             sw_active: None,
             standstill_since: None,
@@ -419,6 +422,11 @@ impl Axis {
     /// Takes the oldest pending job event.
     pub fn pop_event(&mut self) -> Option<JobEvent> {
         self.events.pop()
+    }
+
+    /// Whether a technology alarm is pending (as `alarms().next().is_some()`, without scanning).
+    pub fn alarm_pending(&self) -> bool {
+        self.alarm_pending
     }
 
     /// Pending technology alarms.
@@ -710,6 +718,7 @@ impl Axis {
         };
         if let Some(slot) = self.alarms.iter_mut().find(|a| a.is_none()) {
             *slot = Some(AlarmInstance::new(id, supp).with_reaction(reaction));
+            self.alarm_pending = true;
         }
         if reaction == Reaction::None {
             return;
@@ -1175,6 +1184,7 @@ impl Axis {
             self.abort_sync(JobEventKind::CommandAborted);
             self.abort_pending(JobEventKind::CommandAborted);
             self.alarms = [None; MAX_ALARMS];
+            self.alarm_pending = false;
             self.homed = self.cfg.encoder == EncoderType::Absolute;
             self.offset = if self.homed {
                 self.abs_encoder_offset
@@ -1192,6 +1202,7 @@ impl Axis {
                     *a = None;
                 }
             }
+            self.alarm_pending = self.alarms.iter().any(Option::is_some);
         }
         // Automatic re-enable after acknowledgement while Enable is still held.
         if self.power.enable && !self.enabled && !self.alarms().any(|a| a.reaction.removes_enable())

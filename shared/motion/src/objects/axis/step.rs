@@ -625,7 +625,7 @@ impl Axis {
     fn alarm_words(&self) -> (u32, u32, ErrorDetail) {
         let mut ew = 0u32;
         let mut ww = 0u32;
-        let detail = if self.alarms.iter().any(Option::is_some) {
+        let detail = if self.alarm_pending {
             for a in self.alarms() {
                 let spec = a.spec();
                 ew |= spec.error_mask();
