@@ -401,6 +401,7 @@ impl Drop for PongProcess {
                 _ => {
                     // Cleanup after the grace time: a child that is gone already is fine.
                     let _ = self.0.kill();
+                    // Reaps the killed child; an error means it is gone already.
                     let _ = self.0.wait();
                     return;
                 }

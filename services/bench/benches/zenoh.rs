@@ -704,6 +704,7 @@ impl Env {
                 Ok(None) => {
                     // Last resort after the grace time: a child that is gone already is fine.
                     let _ = p.child.kill();
+                    // Reaps the killed child; an error means it is gone already.
                     let _ = p.child.wait();
                     return;
                 }
