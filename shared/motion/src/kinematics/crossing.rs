@@ -106,13 +106,7 @@ impl RangeSet {
             return;
         }
         let up = to > from;
-        let inside = |c: f64| {
-            if up {
-                c > from && c <= to
-            } else {
-                c >= to && c < from
-            }
-        };
+        let inside = |c: f64| passed(c, from, to);
         match *self {
             RangeSet::Empty | RangeSet::Full => {}
             RangeSet::Interval { lo, hi } => {
@@ -328,6 +322,16 @@ impl Path {
     }
 }
 
+/// Whether a monotone motion from `from` to `to` crosses `c`: `c` in `(from, to]` moving up, in
+/// `[to, from)` moving down.
+fn passed(c: f64, from: f64, to: f64) -> bool {
+    if to > from {
+        c > from && c <= to
+    } else {
+        c >= to && c < from
+    }
+}
+
 /// Calls `f(c)` for every point `p + k * period` (every `k`; only `p` without a period) crossed
 /// by a monotone motion from `from` to `to` (`(from, to]` or `[to, from)`), in motion order.
 pub(crate) fn point_crossings(
@@ -341,13 +345,7 @@ pub(crate) fn point_crossings(
         return;
     }
     let up = to > from;
-    let inside = |c: f64| {
-        if up {
-            c > from && c <= to
-        } else {
-            c >= to && c < from
-        }
-    };
+    let inside = |c: f64| passed(c, from, to);
     match period {
         None => {
             if inside(p) {
