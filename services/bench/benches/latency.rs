@@ -559,19 +559,7 @@ fn main() -> ExitCode {
             }
         };
     }
-    let quick = m.get_flag("quick");
-    let scale = if quick { 10 } else { 1 };
-    let busy_n = m.get_one::<u64>("iterations").copied().unwrap_or(200_000) / scale;
-    let period_n = m
-        .get_one::<u64>("period-iterations")
-        .copied()
-        .unwrap_or(5000)
-        / scale;
-    let rounds = if quick {
-        1
-    } else {
-        m.get_one::<u64>("rounds").copied().unwrap_or(3)
-    };
+    let (busy_n, period_n, rounds) = tandem_bench::ping_pong_sizes(&m, 200_000);
     match run(busy_n.max(1), period_n.max(1), rounds) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

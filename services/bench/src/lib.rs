@@ -120,6 +120,30 @@ pub fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// The sizes of a ping-pong run from its command line: (busy iterations, period iterations,
+/// rounds) from `--iterations` (default `busy_default`), `--period-iterations` (default 5,000)
+/// and `--rounds` (default 3); `--quick` divides the iterations by 10 and runs one round.
+pub fn ping_pong_sizes(m: &clap::ArgMatches, busy_default: u64) -> (u64, u64, u64) {
+    let quick = m.get_flag("quick");
+    let scale = if quick { 10 } else { 1 };
+    let busy = m
+        .get_one::<u64>("iterations")
+        .copied()
+        .unwrap_or(busy_default)
+        / scale;
+    let period = m
+        .get_one::<u64>("period-iterations")
+        .copied()
+        .unwrap_or(5000)
+        / scale;
+    let rounds = if quick {
+        1
+    } else {
+        m.get_one::<u64>("rounds").copied().unwrap_or(3)
+    };
+    (busy, period, rounds)
+}
+
 /// `a / b`, 0 when `b` is 0.
 pub fn ratio(a: f64, b: f64) -> f64 {
     if b == 0.0 {
