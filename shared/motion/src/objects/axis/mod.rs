@@ -30,7 +30,7 @@ use crate::kinematics::modulo::Modulo;
 use crate::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, State};
 use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
 use crate::objects::leading::LeadingValue;
-use crate::plant::drive::SimDrive;
+use crate::plant::link::{AxisSignals, DriveInputs, DriveLink, DriveOutputs, SimPlant};
 
 /// PLCopen axis states (S7-1500T Motion Control V4.0 function manual, A.2.35 'StatusWord tag' (the
 /// manual draws no state diagram), PLCopen Motion Control part 1, axis state diagram).
@@ -248,11 +248,13 @@ struct Power {
     disabling: bool,
 }
 
-/// An axis technology object with its simulated drive.
+/// An axis technology object with its drive connection.
 #[derive(Clone, Debug)]
 pub struct Axis {
     cfg: AxisConfig,
-    drive: SimDrive,
+    link: DriveLink,
+    /// The input signals of the last cycle.
+    signals: AxisSignals,
     power: Power,
     enabled: bool,
     pos_ctrl: bool,
@@ -322,16 +324,18 @@ impl Axis {
     /// Builds an axis from a validated configuration, disabled, at rest.
     pub fn new(cfg: AxisConfig) -> Result<Self, AxisConfigError> {
         cfg.validate()?;
-        let drive = SimDrive::new(
+        let link = DriveLink::Simulation(SimPlant::new(
             cfg.drive,
+            cfg.plant,
             cfg.cycle,
             cfg.defaults.emergency_deceleration,
             cfg.initial_position,
-        );
+        ));
         let p0 = cfg.initial_position;
         let homed = cfg.encoder == EncoderType::Absolute;
         let mut axis = Self {
-            drive,
+            link,
+            signals: AxisSignals::default(),
             power: Power {
                 enable: false,
                 start_mode: StartMode::PositionControlled,
@@ -1194,7 +1198,7 @@ impl Axis {
             self.override_pct = 100.0;
             self.hw_trigger = None;
             self.sw_active = None;
-            self.actual_p = self.drive.actual().p + self.offset;
+            self.actual_p = self.drive_actual().p + self.offset;
             self.basic = State::rest(self.actual_p);
         } else {
             for a in self.alarms.iter_mut() {
@@ -1519,7 +1523,7 @@ impl Axis {
         }
         let home = end - h.home_position_offset;
         let search_dir = h.approach_direction.sign();
-        let on_cam = self.on_cam(self.drive.actual().p);
+        let on_cam = self.on_reference_cam_now();
         let (phase, v) = match (h.active_mark, on_cam) {
             (HomingMark::ZeroMark, _) => (
                 HomePhase::Armed,
@@ -1590,10 +1594,58 @@ impl Axis {
         self.replan();
     }
 
-    fn on_cam(&self, phys: f64) -> bool {
-        match self.cfg.plant.reference_cam {
-            Some((lo, hi)) => phys >= lo && phys <= hi,
-            None => false,
+    /// The drive's actual values now: in simulation the drive after its last step, else the
+    /// inputs as last set.
+    fn drive_actual(&self) -> crate::plant::drive::Actual {
+        match &self.link {
+            DriveLink::Simulation(p) => p.actual(),
+            DriveLink::Connected { inputs, .. } => inputs.actual,
+        }
+    }
+
+    /// Whether the reference cam is active now (when a homing job starts between cycles).
+    fn on_reference_cam_now(&self) -> bool {
+        match &self.link {
+            DriveLink::Simulation(p) => {
+                let x = p.actual().p;
+                p.plant()
+                    .reference_cam
+                    .is_some_and(|(lo, hi)| x >= lo && x <= hi)
+            }
+            DriveLink::Connected { inputs, .. } => inputs.signals.reference_cam,
+        }
+    }
+
+    /// Connects the axis to a drive behind the process image instead of its simulated drive.
+    /// The drive's inputs are then set before each cycle ([`Axis::set_drive_inputs`]) and its
+    /// outputs read after it ([`Axis::drive_outputs`]).
+    pub fn connect_drive(&mut self) {
+        let actual = self.drive_actual();
+        self.link = DriveLink::Connected {
+            inputs: DriveInputs {
+                actual,
+                ..DriveInputs::default()
+            },
+            outputs: DriveOutputs {
+                position: actual.p,
+                ..DriveOutputs::default()
+            },
+        };
+    }
+
+    /// Sets the inputs of a connected drive for the coming cycle (ignored in simulation).
+    pub fn set_drive_inputs(&mut self, inp: &DriveInputs) {
+        if let DriveLink::Connected { inputs, .. } = &mut self.link {
+            *inputs = *inp;
+        }
+    }
+
+    /// The outputs the axis wrote in its last cycle (in simulation: those applied to the
+    /// simulated drive).
+    pub fn drive_outputs(&self) -> DriveOutputs {
+        match &self.link {
+            DriveLink::Simulation(_) => self.outputs(),
+            DriveLink::Connected { outputs, .. } => *outputs,
         }
     }
 }

@@ -8,13 +8,19 @@ use super::{
 use crate::catalog::alarm::{status_bit, supplement, AlarmId, ErrorDetail, Reaction};
 use crate::kinematics::profile::{plan_position, Limits, State};
 use crate::objects::job::{Instruction, JobEventKind};
+use crate::plant::link::{DriveLink, DriveOutputs};
 
 impl Axis {
     /// Runs one cycle for time `now_ns` (cell clock, ns): the setpoint computed here is the
     /// setpoint for `now_ns`; the simulated drive then moves the plant to the next cycle.
     pub fn step(&mut self, now_ns: i64) {
         self.now = now_ns;
-        let act = self.drive.actual();
+        let inputs = match &mut self.link {
+            DriveLink::Simulation(plant) => plant.sample(),
+            DriveLink::Connected { inputs, .. } => *inputs,
+        };
+        self.signals = inputs.signals;
+        let act = inputs.actual;
         let phys = act.p;
         let prev = self.prev_phys;
         self.prev_phys = phys;
@@ -34,10 +40,24 @@ impl Axis {
         self.update_jobs();
         self.monitor(act.balanced + self.offset);
 
-        let tot = self.total();
-        self.drive
-            .step(tot.p - self.offset, tot.v, self.enabled, self.pos_ctrl);
+        let out = self.outputs();
+        match &mut self.link {
+            DriveLink::Simulation(plant) => plant.apply(&out),
+            DriveLink::Connected { outputs, .. } => *outputs = out,
+        }
         self.refresh_status();
+    }
+
+    /// The drive outputs of this cycle: the total setpoint in physical coordinates.
+    pub(super) fn outputs(&self) -> DriveOutputs {
+        let tot = self.total();
+        DriveOutputs {
+            position: tot.p - self.offset,
+            velocity: tot.v,
+            enable: self.enabled,
+            position_controlled: self.pos_ctrl,
+            fault_reset: false,
+        }
     }
 
     /// The total setpoint predicted one cycle ahead (for the software-limit look-ahead).
@@ -195,9 +215,8 @@ impl Axis {
         if !self.cfg.hw_limits_active || self.cfg.virtual_axis {
             return;
         }
-        let plant = self.cfg.plant;
-        let max_on = plant.hw_limit_max.map(|x| phys >= x).unwrap_or(false);
-        let min_on = plant.hw_limit_min.map(|x| phys <= x).unwrap_or(false);
+        let max_on = self.signals.limit_positive;
+        let min_on = self.signals.limit_negative;
         if let Some((sense, at)) = self.hw_trigger {
             // Cleared once the switch is left and the axis is back beyond the stored position.
             let cleared = match sense {
@@ -243,10 +262,8 @@ impl Axis {
         }
     }
 
-    fn hw_switch_hit(&self, phys: f64, dir: f64) -> bool {
-        let p = self.cfg.plant;
-        (dir > 0.0 && p.hw_limit_max.map(|x| phys >= x).unwrap_or(false))
-            || (dir < 0.0 && p.hw_limit_min.map(|x| phys <= x).unwrap_or(false))
+    fn hw_switch_hit(&self, dir: f64) -> bool {
+        (dir > 0.0 && self.signals.limit_positive) || (dir < 0.0 && self.signals.limit_negative)
     }
 
     /// Sets the axis position so that the physical mark `m` has the axis value `home`.
@@ -280,7 +297,7 @@ impl Axis {
         };
         match h.phase {
             HomePhase::Search | HomePhase::OnCam | HomePhase::Armed
-                if hc.auto_reversal && self.hw_switch_hit(phys, heading) =>
+                if hc.auto_reversal && self.hw_switch_hit(heading) =>
             {
                 // Reversing cam: brake with the maximum deceleration, continue the other way at
                 // approach velocity. The second reversal means nothing was found.
@@ -301,7 +318,7 @@ impl Axis {
                 });
             }
             HomePhase::Search => {
-                if self.on_cam(phys) {
+                if self.signals.reference_cam {
                     h.phase = HomePhase::OnCam;
                     new_goal = Some(Goal::Velocity {
                         v: hd * hc.referencing_velocity,
@@ -310,10 +327,9 @@ impl Axis {
                 }
             }
             HomePhase::OnCam => {
-                if !self.on_cam(phys) && moved == hd {
+                if !self.signals.reference_cam && moved == hd {
                     if hc.active_mark == HomingMark::DigitalInput {
-                        if let Some((lo, hi)) = self.cfg.plant.reference_cam {
-                            let m = if hd > 0.0 { hi } else { lo };
+                        if let Some(m) = self.signals.reference_cam_left {
                             self.home_at_mark(m, h.home);
                             h.phase = HomePhase::Travel;
                         }
@@ -324,7 +340,7 @@ impl Axis {
             }
             HomePhase::Armed => {
                 if moved == hd {
-                    if let Some(m) = self.cfg.plant.zero_mark.and_then(|z| z.crossed(prev, phys)) {
+                    if let Some(m) = self.signals.zero_mark {
                         self.home_at_mark(m, h.home);
                         h.phase = HomePhase::Travel;
                     }
@@ -371,17 +387,15 @@ impl Axis {
         let mut hit = None;
         match ph.phase {
             HomePhase::Search => {
-                if dir_ok && self.on_cam(phys) {
+                if dir_ok && self.signals.reference_cam {
                     ph.phase = HomePhase::OnCam;
                 }
             }
             HomePhase::OnCam => {
-                if !self.on_cam(phys) {
+                if !self.signals.reference_cam {
                     if dir_ok {
                         if mark == HomingMark::DigitalInput {
-                            if let Some((lo, hi)) = self.cfg.plant.reference_cam {
-                                hit = Some(if moved > 0.0 { hi } else { lo });
-                            }
+                            hit = self.signals.reference_cam_left;
                         } else {
                             ph.phase = HomePhase::Armed;
                             ph.armed_dir = moved;
@@ -396,7 +410,7 @@ impl Axis {
                     // A reversal after leaving the cam: the cam must be detected again.
                     ph.phase = HomePhase::Search;
                 } else if dir_ok {
-                    hit = self.cfg.plant.zero_mark.and_then(|z| z.crossed(prev, phys));
+                    hit = self.signals.zero_mark;
                 }
             }
             HomePhase::Travel => {}

@@ -1,0 +1,178 @@
+//! The connection of an axis to its drive and sensors: what the axis reads at the start of its
+//! cycle ([`DriveInputs`]) and what it writes at the end ([`DriveOutputs`]), whatever is behind
+//! them.
+//!
+//! Two kinds of connection, as in S7-1500T (S7-1500T Motion Control V4.0 function manual, 'Drive
+//! and encoder connection' and 'Simulated/virtual actual value'):
+//! - [`DriveLink::Simulation`]: the axis in simulation. The drive model and the sensors of the
+//!   plant ([`SimPlant`]) are inside the axis and stepped with it; no process image.
+//! - [`DriveLink::Connected`]: a drive behind the node's process image (a CiA 402 drive, real or
+//!   simulated, or an analog output with an encoder). The node's drive adapter fills
+//!   [`DriveInputs`] from the image before the axis steps ([`crate::objects::axis::Axis::set_drive_inputs`])
+//!   and turns [`DriveOutputs`] into the drive's command after it.
+//!
+//! Positions here are physical: the drive's own coordinate, before the axis adds its homing
+//! offset.
+
+use super::drive::{Actual, DriveModel, Plant, SimDrive};
+
+/// The axis's input signals of one cycle, in physical coordinates (S7-1500T: hardware limit
+/// switches, the reference cam and the encoder zero mark, sampled with the drive's actual
+/// values in the servo process image partition).
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct AxisSignals {
+    /// Positive hardware limit switch active (`PositionLimits_HW.MaxSwitch`).
+    pub limit_positive: bool,
+    /// Negative hardware limit switch active (`PositionLimits_HW.MinSwitch`).
+    pub limit_negative: bool,
+    /// The reference cam (homing switch) is active.
+    pub reference_cam: bool,
+    /// The reference cam went inactive since the last cycle, at this physical position (its
+    /// edge, latched by the drive's measuring input as the homing mark "digital input").
+    pub reference_cam_left: Option<f64>,
+    /// An encoder zero mark was passed since the last cycle, at this physical position.
+    pub zero_mark: Option<f64>,
+}
+
+/// The state of the drive as the axis sees it.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub enum DriveState {
+    /// Ready, not enabled (no torque).
+    #[default]
+    Disabled,
+    /// The enable sequence runs; `step` names the step it waits for (drive-specific numbering,
+    /// documented with the drive connection).
+    Enabling {
+        /// The step waited for.
+        step: u8,
+    },
+    /// Enabled: the drive follows the setpoints.
+    Operational,
+    /// The drive reports a fault with this error code (CiA 402 0x603F; 0 when the drive gives
+    /// none).
+    Fault {
+        /// The drive's error code.
+        code: u16,
+    },
+    /// The enable sequence did not complete in time: `step` names the step that did not.
+    EnableTimedOut {
+        /// The step that did not complete.
+        step: u8,
+    },
+}
+
+/// What the axis reads at the start of its cycle.
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct DriveInputs {
+    /// Actual position and velocity (physical) and the balanced setpoint, the reference of
+    /// the following error.
+    pub actual: Actual,
+    /// Limit switches, reference cam, zero mark.
+    pub signals: AxisSignals,
+    /// The drive's state.
+    pub state: DriveState,
+}
+
+/// What the axis writes at the end of its cycle: the setpoint for the next cycle.
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct DriveOutputs {
+    /// Position setpoint (physical).
+    pub position: f64,
+    /// Velocity setpoint (precontrol).
+    pub velocity: f64,
+    /// The enable: the drive is to be (or stay) operational.
+    pub enable: bool,
+    /// Position-controlled operation (`false`: the velocity setpoint alone acts).
+    pub position_controlled: bool,
+    /// Acknowledge a drive fault (MC_Reset): set for the one cycle of the reset.
+    pub fault_reset: bool,
+}
+
+/// The simulated drive and the sensors of its plant (the axis in simulation).
+#[derive(Clone, Debug)]
+pub struct SimPlant {
+    drive: SimDrive,
+    plant: Plant,
+    /// The physical position of the last sample, for the edges since then.
+    last: f64,
+}
+
+impl SimPlant {
+    /// A drive at rest at physical position `p0` on a servo cycle of `cycle` s, braking on
+    /// `stop_deceleration` without its enable.
+    pub fn new(
+        model: DriveModel,
+        plant: Plant,
+        cycle: f64,
+        stop_deceleration: f64,
+        p0: f64,
+    ) -> Self {
+        Self {
+            drive: SimDrive::new(model, cycle, stop_deceleration, p0),
+            plant,
+            last: p0,
+        }
+    }
+
+    /// The sensors of the plant (reference cam, zero marks, hardware limits).
+    pub fn plant(&self) -> &Plant {
+        &self.plant
+    }
+
+    /// Actual values now, without taking a sample.
+    pub fn actual(&self) -> Actual {
+        self.drive.actual()
+    }
+
+    /// Samples the drive and the sensors: the inputs of this cycle. The edges are those since
+    /// the previous sample.
+    pub fn sample(&mut self) -> DriveInputs {
+        let actual = self.drive.actual();
+        let (prev, p) = (self.last, actual.p);
+        self.last = p;
+        let on_cam = |x: f64| {
+            self.plant
+                .reference_cam
+                .is_some_and(|(lo, hi)| x >= lo && x <= hi)
+        };
+        let reference_cam_left = match self.plant.reference_cam {
+            Some((lo, hi)) if on_cam(prev) && !on_cam(p) => Some(if p > prev { hi } else { lo }),
+            _ => None,
+        };
+        DriveInputs {
+            actual,
+            signals: AxisSignals {
+                limit_positive: self.plant.hw_limit_max.is_some_and(|x| p >= x),
+                limit_negative: self.plant.hw_limit_min.is_some_and(|x| p <= x),
+                reference_cam: on_cam(p),
+                reference_cam_left,
+                zero_mark: self.plant.zero_mark.and_then(|z| z.crossed(prev, p)),
+            },
+            state: DriveState::Operational,
+        }
+    }
+
+    /// Applies the setpoint for one cycle and moves the plant to the start of the next.
+    pub fn apply(&mut self, out: &DriveOutputs) {
+        self.drive.step(
+            out.position,
+            out.velocity,
+            out.enable,
+            out.position_controlled,
+        );
+    }
+}
+
+/// How an axis reaches its drive.
+#[derive(Clone, Debug)]
+pub enum DriveLink {
+    /// The axis in simulation: drive model and plant inside the axis.
+    Simulation(SimPlant),
+    /// A drive behind the process image: the inputs as last set, the outputs as last written.
+    Connected {
+        /// Set by the node before the axis steps.
+        inputs: DriveInputs,
+        /// Written by the axis; read by the node after the axis stepped.
+        outputs: DriveOutputs,
+    },
+}
