@@ -639,6 +639,25 @@ pub mod supplement {
     /// 531: both HW limit switches active, retraction not possible.
     pub const HW_LIMIT_BOTH: u16 = 5;
 
+    /// 421 "Alarm message from drive" when the drive gives no error code of its own.
+    pub const DRIVE_ALARM: u16 = 1;
+    /// 421 "Drive has shut down": the drive left operation without a fault while enabled.
+    pub const DRIVE_SHUT_DOWN: u16 = 3;
+    /// 421 "Drive enable not possible": this plus the step of the enable sequence that did not
+    /// complete in time (0 fault reset, 1 shutdown, 2 switch on, 3 enable operation for a
+    /// CiA 402 drive).
+    pub const DRIVE_ENABLE_NOT_POSSIBLE: u16 = 0x10;
+
+    /// 421 "Alarm message from drive": the drive's own error code (CiA 402 object 0x603F, CiA
+    /// 301 ranges from 0x1000), or [`DRIVE_ALARM`] when it gives none.
+    pub const fn drive_fault_code(code: u16) -> u16 {
+        if code == 0 {
+            DRIVE_ALARM
+        } else {
+            code
+        }
+    }
+
     /// 541: the target range was not reached within the tolerance time.
     pub const TARGET_NOT_REACHED: u16 = 1;
     /// 541: the target range was left again during the minimum dwell time.

@@ -246,6 +246,13 @@ struct Power {
     job: JobId,
     /// A user disable is braking before the enable is removed.
     disabling: bool,
+    /// A connected drive was asked for its enable and is not operational yet.
+    awaiting_drive: bool,
+    /// MC_Reset asked the connected drive to acknowledge its fault (sent with the next outputs).
+    fault_reset: bool,
+    /// The enable being awaited follows a fault reset: the drive may still report its fault
+    /// until it has processed the reset.
+    after_reset: bool,
 }
 
 /// An axis technology object with its drive connection.
@@ -342,6 +349,9 @@ impl Axis {
                 stop_mode: StopMode::Emergency,
                 job: 0,
                 disabling: false,
+                awaiting_drive: false,
+                fault_reset: false,
+                after_reset: false,
             },
             enabled: false,
             pos_ctrl: false,
@@ -748,7 +758,17 @@ impl Axis {
         }
     }
 
+    /// The enable: at once in simulation; a connected drive is asked for it and the axis is
+    /// enabled when the drive reports it operational ([`Axis::drive_state`]).
+    fn request_enable(&mut self) {
+        match self.link {
+            DriveLink::Simulation(_) => self.enable_now(),
+            DriveLink::Connected { .. } => self.power.awaiting_drive = true,
+        }
+    }
+
     fn remove_enable(&mut self) {
+        self.power.awaiting_drive = false;
         if self.enabled {
             self.enabled = false;
             self.emit(
@@ -1140,13 +1160,17 @@ impl Axis {
                 stop_mode,
                 job: self.new_id(),
                 disabling: false,
+                awaiting_drive: false,
+                fault_reset: false,
+                after_reset: false,
             };
             self.emit(self.power.job, Instruction::Power, JobEventKind::Busy);
             if !self.alarms().any(|a| a.reaction.removes_enable()) {
-                self.enable_now();
+                self.request_enable();
             }
         } else if !enable && self.power.enable {
             self.power.enable = false;
+            self.power.awaiting_drive = false;
             self.power.stop_mode = stop_mode;
             self.abort_all(JobEventKind::CommandAborted);
             if self.enabled {
@@ -1208,10 +1232,15 @@ impl Axis {
             }
             self.alarm_pending = self.alarms.iter().any(Option::is_some);
         }
+        // A connected drive acknowledges its own fault with the next outputs.
+        if matches!(self.link, DriveLink::Connected { .. }) {
+            self.power.fault_reset = true;
+        }
         // Automatic re-enable after acknowledgement while Enable is still held.
         if self.power.enable && !self.enabled && !self.alarms().any(|a| a.reaction.removes_enable())
         {
-            self.enable_now();
+            self.power.after_reset = true;
+            self.request_enable();
         }
         self.emit(id, Instruction::Reset, JobEventKind::Done);
         Ok(id)

@@ -8,7 +8,7 @@ use super::{
 use crate::catalog::alarm::{status_bit, supplement, AlarmId, ErrorDetail, Reaction};
 use crate::kinematics::profile::{plan_position, Limits, State};
 use crate::objects::job::{Instruction, JobEventKind};
-use crate::plant::link::{DriveLink, DriveOutputs};
+use crate::plant::link::{DriveLink, DriveOutputs, DriveState};
 
 impl Axis {
     /// Runs one cycle for time `now_ns` (cell clock, ns): the setpoint computed here is the
@@ -20,6 +20,9 @@ impl Axis {
             DriveLink::Connected { inputs, .. } => *inputs,
         };
         self.signals = inputs.signals;
+        if matches!(self.link, DriveLink::Connected { .. }) {
+            self.drive_state(inputs.state);
+        }
         let act = inputs.actual;
         let phys = act.p;
         let prev = self.prev_phys;
@@ -41,6 +44,7 @@ impl Axis {
         self.monitor(act.balanced + self.offset);
 
         let out = self.outputs();
+        self.power.fault_reset = false;
         match &mut self.link {
             DriveLink::Simulation(plant) => plant.apply(&out),
             DriveLink::Connected { outputs, .. } => *outputs = out,
@@ -54,9 +58,45 @@ impl Axis {
         DriveOutputs {
             position: tot.p - self.offset,
             velocity: tot.v,
-            enable: self.enabled,
+            enable: self.enabled || self.power.awaiting_drive,
             position_controlled: self.pos_ctrl,
-            fault_reset: false,
+            fault_reset: self.power.fault_reset,
+        }
+    }
+
+    /// What the state of a connected drive means for the axis (S7-1500T Motion Control V4.0
+    /// function manual, technology alarm 421 "Faulty drive" and its causes): the enable comes
+    /// when the drive is operational; a drive fault, a drive that shuts down on its own and an
+    /// enable that is not possible raise alarm 421 (remove enable) with the cause in the
+    /// supplement ([`supplement::drive_fault_code`]).
+    fn drive_state(&mut self, state: DriveState) {
+        match state {
+            DriveState::Operational => {
+                if self.power.awaiting_drive {
+                    self.power.awaiting_drive = false;
+                    self.power.after_reset = false;
+                    self.enable_now();
+                }
+            }
+            DriveState::Fault { code } => {
+                // After MC_Reset the fault stays until the drive has processed the reset.
+                if self.enabled || (self.power.awaiting_drive && !self.power.after_reset) {
+                    self.raise(AlarmId::DriveFault, supplement::drive_fault_code(code));
+                }
+            }
+            DriveState::EnableTimedOut { step } => {
+                if self.power.awaiting_drive {
+                    self.raise(
+                        AlarmId::DriveFault,
+                        supplement::DRIVE_ENABLE_NOT_POSSIBLE + u16::from(step),
+                    );
+                }
+            }
+            DriveState::Disabled | DriveState::Enabling { .. } => {
+                if self.enabled {
+                    self.raise(AlarmId::DriveFault, supplement::DRIVE_SHUT_DOWN);
+                }
+            }
         }
     }
 
