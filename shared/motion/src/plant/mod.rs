@@ -2,5 +2,6 @@
 //! and the timestamped edges of a mark sensor ([`sensor`]). Objects use these in simulation in
 //! place of the real hardware.
 
+pub mod cia402;
 pub mod drive;
 pub mod sensor;
