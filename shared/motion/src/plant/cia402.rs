@@ -545,10 +545,11 @@ pub mod touch_probe {
     pub const STATUS_POSITIVE_STORED: u16 = 0x0002;
     /// Status bit 2: a negative edge value is stored.
     pub const STATUS_NEGATIVE_STORED: u16 = 0x0004;
-    /// Status bit 6 (user bit): toggles with every positive edge value stored (inferred: the
-    /// usual use of the user bits in continuous mode).
+    /// Status bit 6 (user bit): toggles with every positive edge value stored in continuous
+    /// mode (inferred: the usual use of the user bits).
     pub const STATUS_POSITIVE_TOGGLE: u16 = 0x0040;
-    /// Status bit 7 (user bit): toggles with every negative edge value stored (inferred).
+    /// Status bit 7 (user bit): toggles with every negative edge value stored in continuous
+    /// mode (inferred).
     pub const STATUS_NEGATIVE_TOGGLE: u16 = 0x0080;
     /// The shift from the touch probe 1 bits to the touch probe 2 bits.
     pub const PROBE_2_SHIFT: u32 = 8;
