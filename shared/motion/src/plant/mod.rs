@@ -5,3 +5,4 @@
 pub mod cia402;
 pub mod drive;
 pub mod sensor;
+pub mod servo;
