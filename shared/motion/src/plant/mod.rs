@@ -2,6 +2,8 @@
 //! and the timestamped edges of a mark sensor ([`sensor`]). Objects use these in simulation in
 //! place of the real hardware.
 
+pub mod cia402;
 pub mod drive;
 pub mod link;
 pub mod sensor;
+pub mod servo;
