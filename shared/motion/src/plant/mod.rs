@@ -3,4 +3,5 @@
 //! place of the real hardware.
 
 pub mod drive;
+pub mod mechanics;
 pub mod sensor;
