@@ -615,6 +615,9 @@ fn drive_increments_wrap_like_i32() {
     assert_eq!(s.drive_increments(f64::NAN), 0);
     assert_eq!(s.drive_increments(f64::INFINITY), -1);
     assert_eq!(s.count(f64::NEG_INFINITY), i64::MIN);
+    assert_eq!(s.count(1e300), i64::MAX);
+    assert_eq!(s.count(-1e300), i64::MIN);
+    assert_eq!(s.count(f64::NAN), 0);
 }
 
 /// The cyclic methods do not allocate.

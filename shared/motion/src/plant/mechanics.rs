@@ -512,40 +512,51 @@ impl Ratio {
     #[inline]
     fn units(&self, count: i64) -> f64 {
         let c_hi = count as f64;
-        // |count - c_hi| <= 2^10: exact (i128: c_hi may be 2^63, beyond i64).
-        let c_lo = (i128::from(count) - c_hi as i128) as f64;
+        let c_lo = if count.unsigned_abs() <= 1 << 53 {
+            0.0
+        } else {
+            // |count - c_hi| <= 2^10: exact (i128: c_hi may be 2^63, beyond i64).
+            (i128::from(count) - c_hi as i128) as f64
+        };
         let (p, e) = two_product(c_hi, self.hi);
         p + (e + c_hi * self.lo + c_lo * self.hi)
     }
 
-    /// The count whose units are nearest to `x`; saturates at the ends of i64, 0 for NaN.
+    /// The count whose units are nearest to `x` (of two equally near, either); saturates at the
+    /// ends of i64, 0 for NaN.
     #[inline]
     fn counts(&self, x: f64) -> i64 {
         if x.is_nan() {
             return 0;
         }
-        // Float to integer casts saturate.
-        let c0 = (x / self.hi).round() as i64;
-        // One correction step: the residual is accurate to about an ulp of `x`.
-        let c1 = c0.saturating_add(((x - self.units(c0)) / self.hi).round() as i64);
-        self.refine(c1, x)
+        if x.is_infinite() {
+            return if x > 0.0 { i64::MAX } else { i64::MIN };
+        }
+        // x / (hi + lo) to first order in lo / hi: within a count of the nearest for
+        // |count| <= 2^52. Float to integer casts saturate.
+        let q = x / self.hi;
+        let c = (q - q * (self.lo / self.hi)).round() as i64;
+        self.refine(c, x)
     }
 
-    /// Moves `c` to the neighbour whose units are nearer `x`, while there is one (at most a few
-    /// steps: the estimate is within a count or two for |count| <= 2^53).
+    /// Steps from `c` towards `x` while the next count is nearer (positions grow with the count,
+    /// so the nearest count lies that way; at most a few steps).
     #[inline]
     fn refine(&self, mut c: i64, x: f64) -> i64 {
-        let mut best = (self.units(c) - x).abs();
+        let mut u = self.units(c);
+        let up = u < x;
         for _ in 0..4 {
-            if best == 0.0 {
+            if u == x {
                 break;
             }
-            let (down, up) = (c.saturating_sub(1), c.saturating_add(1));
-            let (d_down, d_up) = ((self.units(down) - x).abs(), (self.units(up) - x).abs());
-            if d_down < best && d_down <= d_up {
-                (c, best) = (down, d_down);
-            } else if d_up < best {
-                (c, best) = (up, d_up);
+            let next = if up {
+                c.saturating_add(1)
+            } else {
+                c.saturating_sub(1)
+            };
+            let v = self.units(next);
+            if (v - x).abs() < (u - x).abs() {
+                (c, u) = (next, v);
             } else {
                 break;
             }
