@@ -370,7 +370,7 @@ fn refused_configurations_name_field_and_rule() {
                 m,
             ),
             MechanicsField::DistancePerRevolution,
-            MechanicsRule::NotPositive,
+            MechanicsRule::LengthOutOfRange,
         ),
         (
             refused(e, gear(0, 1)),
@@ -391,7 +391,7 @@ fn refused_configurations_name_field_and_rule() {
                 },
             ),
             MechanicsField::LeadscrewPitch,
-            MechanicsRule::NotPositive,
+            MechanicsRule::LengthOutOfRange,
         ),
         (
             refused(
@@ -402,7 +402,7 @@ fn refused_configurations_name_field_and_rule() {
                 },
             ),
             MechanicsField::LeadscrewPitch,
-            MechanicsRule::NotPositive,
+            MechanicsRule::LengthOutOfRange,
         ),
         (
             refused(

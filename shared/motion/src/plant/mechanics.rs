@@ -40,6 +40,12 @@ pub const MAX_STEPS_PER_REVOLUTION: u32 = 8_388_608;
 pub const MAX_FINE_RESOLUTION_BITS: u8 = 31;
 /// The widest raw word a [`RawCounter`] extends (bits).
 pub const MAX_RAW_BITS: u8 = 32;
+/// The smallest leadscrew pitch or distance per revolution (units). Inferred: the manual's
+/// lengths span 0.001..1e12 (e.g. `Modulo.Length`); the margin keeps the conversion's
+/// arithmetic far from underflow and overflow.
+pub const MIN_LENGTH: f64 = 1e-12;
+/// The largest leadscrew pitch or distance per revolution (units).
+pub const MAX_LENGTH: f64 = 1e12;
 /// Units per load revolution of a rotary axis (degrees).
 pub const DEGREES_PER_REVOLUTION: f64 = 360.0;
 
@@ -82,7 +88,7 @@ pub enum Mounting {
     /// 2: an external measuring system; one encoder revolution is `distance_per_revolution`
     /// units, neither gear nor leadscrew applies.
     External {
-        /// `Sensor[n].Parameter.DistancePerRevolution` (units, finite, > 0).
+        /// `Sensor[n].Parameter.DistancePerRevolution` (units, [`MIN_LENGTH`]..=[`MAX_LENGTH`]).
         distance_per_revolution: f64,
     },
 }
@@ -126,9 +132,9 @@ pub struct Mechanics {
     /// `LoadGear.Denominator`: ... per this many load revolutions (>= 1).
     #[doc(alias = "LoadGear.Denominator")]
     pub load_gear_denominator: u32,
-    /// `Mechanics.LeadScrew`: a linear axis moves this many units (finite, greater than 0) per
-    /// load revolution. `None`: a rotary axis, whose unit is the degree: 360 units per load
-    /// revolution ([`DEGREES_PER_REVOLUTION`]).
+    /// `Mechanics.LeadScrew`: a linear axis moves this many units per load revolution
+    /// ([`MIN_LENGTH`]..=[`MAX_LENGTH`]). `None`: a rotary axis, whose unit is the degree: 360
+    /// units per load revolution ([`DEGREES_PER_REVOLUTION`]).
     #[doc(alias = "Mechanics.LeadScrew")]
     pub leadscrew_pitch: Option<f64>,
     /// `Actor.InverseDirection`: the drive's setpoint (increments, velocity, torque) is inverted.
@@ -225,8 +231,9 @@ pub enum MechanicsRule {
         /// The largest value allowed.
         max: u64,
     },
-    /// A number that is not finite and greater than 0.
-    NotPositive,
+    /// A length (pitch, distance per revolution) outside [`MIN_LENGTH`]`..=`[`MAX_LENGTH`] units
+    /// (not a number, not positive, or too small or large for the conversion's arithmetic).
+    LengthOutOfRange,
     /// An efficiency outside `(0, 1]`.
     NotFraction,
     /// An absolute encoder whose range (`steps * 2^fine * revolutions` counts) exceeds the raw
@@ -254,7 +261,9 @@ impl fmt::Display for MechanicsRule {
             Self::OutOfRange { found, min, max } => {
                 write!(f, "is {found}, must be in {min}..={max}")
             }
-            Self::NotPositive => f.write_str("must be a finite number greater than 0"),
+            Self::LengthOutOfRange => {
+                write!(f, "must be a number from {MIN_LENGTH:e} to {MAX_LENGTH:e}")
+            }
             Self::NotFraction => f.write_str("must be greater than 0 and at most 1"),
             Self::RangeExceedsRawWord { range, raw_bits } => write!(
                 f,
@@ -297,13 +306,13 @@ fn in_range(field: MechanicsField, found: u64, min: u64, max: u64) -> Result<(),
     }
 }
 
-fn positive(field: MechanicsField, x: f64) -> Result<(), MechanicsError> {
-    if x.is_finite() && x > 0.0 {
+fn length(field: MechanicsField, x: f64) -> Result<(), MechanicsError> {
+    if (MIN_LENGTH..=MAX_LENGTH).contains(&x) {
         Ok(())
     } else {
         Err(MechanicsError {
             field,
-            rule: MechanicsRule::NotPositive,
+            rule: MechanicsRule::LengthOutOfRange,
         })
     }
 }
@@ -437,10 +446,10 @@ impl RawCounter {
 
     /// Whether the count moved a quarter of the raw range or more away from `retained`, the
     /// count last retained. Retaining the count whenever this is true keeps a
-    /// [`resume`](Self::resume) exact as long as the encoder moves less than a quarter range while the
-    /// node is off (inferred: the manual allows half a range while powered off with a retentive
-    /// memory written at power loss; a file cannot be written every cycle, so a quarter range is
-    /// spent on the motion since the last write).
+    /// [`resume`](Self::resume) exact as long as the encoder moves less than a quarter range
+    /// while the node is off (inferred: the manual allows half a range while powered off with a
+    /// retentive memory written at power loss; a file cannot be written every cycle, so a
+    /// quarter range is spent on the motion since the last write).
     pub fn retain_due(&self, retained: i64) -> bool {
         let quarter = (self.half >> 1).max(1);
         self.count.wrapping_sub(retained).unsigned_abs() >= quarter
@@ -589,9 +598,9 @@ pub struct Scaling {
 impl Scaling {
     /// Validates `encoder` and `mechanics` and builds the conversion. Refuses, naming the field
     /// and the rule, any value outside the S7 ranges ('Mechanics': steps 1..=8388608, fine
-    /// resolution 0..=31 bits, gear 1..=4294967295 : 1..=4294967295, pitch, distance > 0), a raw
-    /// word outside 1..=32 bits, an absolute encoder range that does not fit the raw word, and an
-    /// efficiency outside (0, 1].
+    /// resolution 0..=31 bits, gear 1..=4294967295 : 1..=4294967295), a pitch or distance per
+    /// revolution outside [`MIN_LENGTH`]..=[`MAX_LENGTH`], a raw word outside 1..=32 bits, an
+    /// absolute encoder range that does not fit the raw word, and an efficiency outside (0, 1].
     pub fn new(encoder: &EncoderConfig, mechanics: &Mechanics) -> Result<Self, MechanicsError> {
         validate_encoder(encoder)?;
         validate_mechanics(mechanics)?;
@@ -793,7 +802,7 @@ fn validate_encoder(e: &EncoderConfig) -> Result<(), MechanicsError> {
         distance_per_revolution,
     } = e.mounting
     {
-        positive(F::DistancePerRevolution, distance_per_revolution)?;
+        length(F::DistancePerRevolution, distance_per_revolution)?;
     }
     if e.kind == EncoderKind::Incremental {
         return Ok(());
@@ -839,7 +848,7 @@ fn validate_mechanics(m: &Mechanics) -> Result<(), MechanicsError> {
         max,
     )?;
     if let Some(pitch) = m.leadscrew_pitch {
-        positive(F::LeadscrewPitch, pitch)?;
+        length(F::LeadscrewPitch, pitch)?;
     }
     if !(m.efficiency > 0.0 && m.efficiency <= 1.0) {
         return Err(MechanicsError {
