@@ -21,6 +21,7 @@
 #![allow(unsafe_code)]
 
 pub mod diag;
+pub mod retain;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -1,9 +1,12 @@
-//! The simulated plant and sensors: a drive with its position loop and mechanics ([`drive`]),
-//! and the timestamped edges of a mark sensor ([`sensor`]). Objects use these in simulation in
-//! place of the real hardware.
+//! The machine side of the axes: the CiA 402 drive profile ([`cia402`]) and a simulated servo
+//! drive that speaks it ([`servo`]); encoders and mechanics between drive increments and the
+//! axis's units ([`mechanics`]); the axis's connection to its drive ([`link`]); the simulated
+//! drive model and plant of an axis in simulation ([`drive`]); and the timestamped edges of a
+//! mark sensor ([`sensor`]).
 
 pub mod cia402;
 pub mod drive;
 pub mod link;
+pub mod mechanics;
 pub mod sensor;
 pub mod servo;
