@@ -12,9 +12,8 @@
 //!   technology object enables the drive and reacts to its faults; MC_Reset acknowledges them on
 //!   the drive).
 //!
-//! Reference: IEC 61800-7-201 (CiA 402) drive profile, objects 0x6040, 0x6041, 0x605A, 0x6060,
-//! 0x6061 and the state diagram (state-machine transitions 0..16), as digested in the
-//! EtherCAT + CiA 402 reference, section 8.
+//! Reference: IEC 61800-7-201 (CiA 402) drive profile: objects 0x6040, 0x6041, 0x605A, 0x6060,
+//! 0x6061, 0x60B8, 0x60B9 and the state diagram (transitions 0..16).
 //!
 //! Every function here is pure: no clock (time is an input), no allocation.
 
