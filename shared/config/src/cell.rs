@@ -121,6 +121,49 @@ pub enum Coupling {
     Actual,
 }
 
+/// Index of a device in [`Cell::devices`].
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct DeviceIndex(pub usize);
+
+/// A device of a node's process image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceEntry {
+    /// Name (unique among devices).
+    pub name: String,
+    /// Index into [`Cell::nodes`]: the node whose process image holds it.
+    pub node: usize,
+    /// What it is.
+    pub kind: DeviceKind,
+}
+
+/// The kinds of device.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DeviceKind {
+    /// A simulated CiA 402 servo drive (`kind = "sim_servo"`).
+    SimServo(tandem_motion::plant::servo::ServoParams),
+}
+
+/// How an axis reaches its drive (`[axes.<name>.drive] type`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum DriveConnection {
+    /// `simulation`: the drive model inside the axis (`[axes.<name>.drive] model`).
+    #[default]
+    Simulation,
+    /// `cia402`: a CiA 402 drive of the node's process image.
+    Cia402(Cia402Connection),
+}
+
+/// An axis on a CiA 402 drive of the process image.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Cia402Connection {
+    /// The drive.
+    pub device: DeviceIndex,
+    /// Time allowed for each step of the enable sequence (ns).
+    pub enable_timeout_ns: i64,
+    /// Encoder and mechanics: the drive's increments to and from the axis's units.
+    pub scaling: tandem_motion::plant::mechanics::Scaling,
+}
+
 /// An axis of the cell, with the node that hosts it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AxisEntry {
@@ -134,6 +177,8 @@ pub struct AxisEntry {
     pub leaders: Option<Vec<(Leader, Coupling)>>,
     /// Its leading-value delay and tolerance, as a leader.
     pub leading: LeadingValueConfig,
+    /// Its drive connection.
+    pub drive: DriveConnection,
 }
 
 impl AxisEntry {
@@ -329,6 +374,8 @@ pub struct Cell {
     pub cam_tracks: Vec<CamTrackEntry>,
     /// Measuring inputs, in file order.
     pub measuring_inputs: Vec<MeasuringInputEntry>,
+    /// The devices of the nodes' process images, in name order.
+    pub devices: Vec<DeviceEntry>,
 }
 
 impl Cell {

@@ -165,6 +165,32 @@ pub enum Problem {
     },
     /// A script instruction or its parameters.
     Command(CommandError),
+    /// A required key that is missing.
+    Missing(&'static str),
+    /// A key of a drive of the process image on an axis with the simulated drive.
+    OnlyWithDrive,
+    /// A virtual axis bound to a drive.
+    VirtualWithDrive,
+    /// A drive of another node's process image.
+    DeviceNode {
+        /// The device.
+        device: String,
+        /// The axis's node (index).
+        axis_node: usize,
+        /// The device's node (index).
+        device_node: usize,
+    },
+    /// A device already bound to another axis.
+    DeviceTaken {
+        /// The device.
+        device: String,
+        /// The axis it is bound to.
+        axis: String,
+    },
+    /// Encoder or mechanics values that cannot convert increments to units.
+    Mechanics(tandem_motion::plant::mechanics::MechanicsError),
+    /// Parameters of a simulated servo drive that the model refuses.
+    Servo(tandem_motion::plant::servo::ServoParamsError),
 }
 
 /// A leading-value delay shorter than the link from a leader to a follower on another node
@@ -250,6 +276,28 @@ impl fmt::Display for Problem {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Problem::Unreadable(e) => write!(f, "cannot read: {e}"),
+            Problem::Missing(k) => write!(f, "`{k}` is required here"),
+            Problem::OnlyWithDrive => f.write_str(
+                "only for a drive of the process image (`[axes.<name>.drive] type = \"cia402\"`); \
+                 this axis has the simulated drive",
+            ),
+            Problem::VirtualWithDrive => {
+                f.write_str("a virtual axis has no drive; remove `virtual` or the drive's `type`")
+            }
+            Problem::DeviceNode {
+                device,
+                axis_node,
+                device_node,
+            } => write!(
+                f,
+                "device `{device}` is in the process image of node {device_node}, the axis runs \
+                 on node {axis_node}: an axis drives only devices of its own node"
+            ),
+            Problem::DeviceTaken { device, axis } => {
+                write!(f, "device `{device}` already drives axis `{axis}`")
+            }
+            Problem::Mechanics(e) => write!(f, "{e}"),
+            Problem::Servo(e) => write!(f, "{e}"),
             Problem::Syntax(m) => f.write_str(m),
             Problem::Invalid(m) => f.write_str(m),
             Problem::Axis(p) => f.write_str(p.text()),

@@ -53,9 +53,10 @@ mod schema;
 pub mod script;
 
 pub use cell::{
-    AxisEntry, AxisIndex, CamEntry, CamTrackEntry, Cell, Coupling, EncoderEntry, EncoderIndex,
-    EncoderSource, Leader, LeadingValueConfig, MeasuringInputEntry, Node, OutputCamEntry, Realtime,
-    Registration, SensorEntry, LEADING_BUFFER,
+    AxisEntry, AxisIndex, CamEntry, CamTrackEntry, Cell, Cia402Connection, Coupling, DeviceEntry,
+    DeviceIndex, DeviceKind, DriveConnection, EncoderEntry, EncoderIndex, EncoderSource, Leader,
+    LeadingValueConfig, MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration,
+    SensorEntry, LEADING_BUFFER,
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};

@@ -34,6 +34,185 @@ pub struct CellFile {
     /// `[[measuring_inputs]]`.
     #[serde(default)]
     pub measuring_inputs: Vec<MeasuringInputSection>,
+    /// `[devices.<name>]`: the devices of the nodes' process images.
+    #[serde(default)]
+    pub devices: BTreeMap<String, DeviceSection>,
+}
+
+/// `[devices.<name>]`: a device in a node's process image. Its kind says which keys it has;
+/// every parameter has a default.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceSection {
+    /// The node whose process image holds it.
+    pub node: String,
+    /// `sim_servo`: a simulated CiA 402 servo drive.
+    pub kind: String,
+    /// sim_servo: increments per motor revolution of its position actual value (0x6064).
+    pub increments_per_revolution: Option<u32>,
+    /// sim_servo: rated torque (N·m), the 1000 ‰ of the torque objects.
+    pub rated_torque: Option<f64>,
+    /// sim_servo: torque limit (‰ of the rated torque, 0x6072).
+    pub max_torque: Option<u16>,
+    /// sim_servo: motor inertia plus the load's, seen at the motor (kg·m²).
+    pub inertia: Option<f64>,
+    /// sim_servo: viscous friction (N·m·s/rad).
+    pub viscous_friction: Option<f64>,
+    /// sim_servo: Coulomb friction (N·m).
+    pub coulomb_friction: Option<f64>,
+    /// sim_servo: gain of the drive's position loop in CSP (1/s).
+    pub kv: Option<f64>,
+    /// sim_servo: proportional gain of the drive's velocity loop (N·m·s/rad).
+    pub velocity_gain: Option<f64>,
+    /// sim_servo: integral time of the drive's velocity loop (s).
+    pub velocity_integral_time: Option<f64>,
+    /// sim_servo: quick-stop deceleration (rad/s², 0x6085).
+    pub quick_stop_deceleration: Option<f64>,
+    /// sim_servo: quick stop option code (0x605A, 0..8).
+    pub quick_stop_option: Option<i16>,
+    /// sim_servo: following error window (increments, 0x6065) beyond which the drive faults
+    /// with 0x8611.
+    pub following_error_window: Option<u32>,
+    /// sim_servo: increment offset of the encoder zero pulse within a revolution.
+    pub zero_pulse_offset: Option<u32>,
+}
+
+/// `encoder`: the encoder type alone (`encoder = "absolute"`), or the table
+/// `[axes.<name>.encoder]` with the measuring system of a drive behind the process image.
+#[derive(Debug)]
+pub enum EncoderSpec {
+    /// `encoder = "<type>"`.
+    Type(String),
+    /// `[axes.<name>.encoder]`.
+    Table(EncoderTable),
+}
+
+impl EncoderSpec {
+    /// The encoder type's name.
+    pub fn type_name(&self) -> &str {
+        match self {
+            Self::Type(t) => t,
+            Self::Table(t) => &t.kind,
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for EncoderSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = toml::Value::deserialize(d)?;
+        match v {
+            toml::Value::String(s) => Ok(Self::Type(s)),
+            toml::Value::Table(_) => EncoderTable::deserialize(v)
+                .map(Self::Table)
+                .map_err(serde::de::Error::custom),
+            other => Err(serde::de::Error::custom(format!(
+                "expected an encoder type (\"incremental\", \"absolute\", \"cyclic_absolute\") \
+                 or a table, found a {}",
+                other.type_str()
+            ))),
+        }
+    }
+}
+
+impl Default for EncoderSpec {
+    fn default() -> Self {
+        Self::Type(default_encoder())
+    }
+}
+
+/// `[axes.<name>.encoder]`: the encoder of a drive behind the process image (S7-1500T
+/// `Sensor[1]`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderTable {
+    /// `incremental` (default), `absolute` or `cyclic_absolute`.
+    #[serde(rename = "type", default = "default_encoder")]
+    pub kind: String,
+    /// `Parameter.StepsPerRevolution` (default: the increments per revolution of the drive's
+    /// position actual value, for a simulated servo its `increments_per_revolution`).
+    pub steps_per_revolution: Option<u32>,
+    /// `Parameter.FineResolutionXist1` (bits, default 0).
+    #[serde(default)]
+    pub fine_resolution_bits: u8,
+    /// `Parameter.DeterminableRevolutions` of an absolute encoder (default 1: single turn).
+    #[serde(default = "d_one_u32")]
+    pub determinable_revolutions: u32,
+    /// Width of the raw position word (default 32, the drive's 0x6064).
+    #[serde(default = "d_raw_bits")]
+    pub raw_bits: u8,
+    /// `InverseDirection` of the actual value.
+    #[serde(default)]
+    pub inverse: bool,
+    /// `MountingMode`: `motor_shaft` (default), `load_side` or `external`.
+    #[serde(default = "d_mounting")]
+    pub mounting: String,
+    /// `Parameter.DistancePerRevolution` of an external measuring system.
+    pub distance_per_revolution: Option<f64>,
+}
+
+impl EncoderTable {
+    /// The table of an encoder given by its type alone (`encoder = "<type>"`) on a drive of the
+    /// process image: the drive's own motor encoder, its position actual value in increments.
+    pub fn of_drive(kind: &str) -> Self {
+        Self {
+            kind: kind.into(),
+            steps_per_revolution: None,
+            fine_resolution_bits: 0,
+            determinable_revolutions: 1,
+            raw_bits: d_raw_bits(),
+            inverse: false,
+            mounting: d_mounting(),
+            distance_per_revolution: None,
+        }
+    }
+
+    /// The encoder type (checked by the axis's `encoder` key: `incremental`, `absolute` or
+    /// `cyclic_absolute`).
+    pub fn encoder_kind(&self) -> tandem_motion::plant::mechanics::EncoderKind {
+        use tandem_motion::plant::mechanics::EncoderKind;
+        match self.kind.as_str() {
+            "absolute" => EncoderKind::Absolute,
+            "cyclic_absolute" => EncoderKind::CyclicAbsolute,
+            _ => EncoderKind::Incremental,
+        }
+    }
+}
+
+fn d_one_u32() -> u32 {
+    1
+}
+fn d_raw_bits() -> u8 {
+    32
+}
+fn d_mounting() -> String {
+    "motor_shaft".into()
+}
+
+/// `[axes.<name>.mechanics]`: gear, leadscrew and inversion between the motor and the load.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MechanicsSection {
+    /// `LoadGear.Numerator/Denominator`: motor revolutions : load revolutions (default
+    /// `[1, 1]`).
+    #[serde(default = "d_gear")]
+    pub load_gear: [u32; 2],
+    /// `LeadScrew`: units per load revolution of a linear axis; without it a load revolution is
+    /// 360 units.
+    pub leadscrew_pitch: Option<f64>,
+    /// `Actor.InverseDirection`: the setpoint is inverted.
+    #[serde(default)]
+    pub inverse_drive: bool,
+    /// `Actor.Efficiency` of gear and leadscrew (0 < e <= 1, default 1), for torques.
+    #[serde(default = "d_efficiency")]
+    pub efficiency: f64,
+}
+
+fn d_efficiency() -> f64 {
+    1.0
+}
+
+fn d_gear() -> [u32; 2] {
+    [1, 1]
 }
 
 fn d_distance() -> String {
@@ -421,9 +600,11 @@ pub struct AxisSection {
     /// `linear` or `rotary`.
     #[serde(default = "default_motion_type")]
     pub motion_type: String,
-    /// `incremental` or `absolute`.
-    #[serde(default = "default_encoder")]
-    pub encoder: String,
+    /// `incremental`, `absolute` or `cyclic_absolute`, or the table with the measuring system.
+    #[serde(default)]
+    pub encoder: EncoderSpec,
+    /// `[axes.<name>.mechanics]`: for a drive behind the process image.
+    pub mechanics: Option<MechanicsSection>,
     /// Virtual axis / simulation mode.
     #[serde(default, rename = "virtual")]
     pub virtual_axis: bool,
@@ -775,11 +956,19 @@ impl Default for HomingSection {
     }
 }
 
-/// Simulated drive.
+/// `[axes.<name>.drive]`: the drive connection; the simulated drive model by default.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveSection {
-    /// `position_loop` or `delay`.
+    /// `simulation` (default: the drive model inside the axis) or `cia402` (a CiA 402 drive
+    /// of the process image, `device`).
+    #[serde(rename = "type", default = "d_drive_type")]
+    pub kind: String,
+    /// cia402: the device (`[devices.<name>]`).
+    pub device: Option<String>,
+    /// cia402: time allowed for each step of the enable sequence (s, default 1).
+    pub enable_timeout: Option<f64>,
+    /// simulation: `position_loop` or `delay`.
     #[serde(default = "d_model")]
     pub model: String,
     /// `PositionControl.Kv` (1/s).
@@ -812,9 +1001,16 @@ fn d_delay() -> f64 {
     0.003
 }
 
+fn d_drive_type() -> String {
+    "simulation".into()
+}
+
 impl Default for DriveSection {
     fn default() -> Self {
         Self {
+            kind: d_drive_type(),
+            device: None,
+            enable_timeout: None,
             model: d_model(),
             kv: d_kv(),
             kpc: d_kpc(),

@@ -14,9 +14,12 @@ use tandem_motion::objects::axis::{
 use tandem_motion::plant::drive::{DriveModel, Plant, ZeroMark};
 
 /// The encoder types by name.
-pub(super) const ENCODER_TYPES: [(&str, EncoderType); 2] = [
+pub(super) const ENCODER_TYPES: [(&str, EncoderType); 3] = [
     ("incremental", EncoderType::Incremental),
     ("absolute", EncoderType::Absolute),
+    // S7 `Sensor[n].Type` 2: homed like an absolute encoder; the count of traversed ranges is
+    // retained (the measuring system, `[axes.<name>.encoder]`).
+    ("cyclic_absolute", EncoderType::Absolute),
 ];
 
 /// The axis configuration of `a` on a node with cycle `cycle` (s); not yet validated.
@@ -38,7 +41,7 @@ pub(super) fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, Fie
             ("rotary", MotionType::Rotary),
         ],
     )?;
-    let encoder = pick("encoder", &a.encoder, &ENCODER_TYPES)?;
+    let encoder = pick("encoder", a.encoder.type_name(), &ENCODER_TYPES)?;
     let homing = homing(&a.homing)?;
     let drive = drive(a)?;
     let leader_missing_reaction = leader_missing_reaction(a)?;

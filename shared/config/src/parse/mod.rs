@@ -4,10 +4,13 @@
 
 mod axis;
 mod cam;
+mod device;
 mod encoder;
 mod objects;
 
-use crate::cell::{AxisEntry, AxisIndex, Cell, Coupling, Leader, LeadingValueConfig, Node};
+use crate::cell::{
+    AxisEntry, AxisIndex, Cell, Coupling, DriveConnection, Leader, LeadingValueConfig, Node,
+};
 use crate::cell::{EncoderIndex, Realtime, LEADING_BUFFER};
 use crate::error::{ConfigError, DelayShortfall, Problem};
 use crate::schema::CellFile;
@@ -154,7 +157,9 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     check_cell_section(cx, &raw)?;
     let hosts = hosts(cx, &raw)?;
     let nodes = nodes(cx, &raw, &hosts)?;
+    let devices = device::devices(cx, &raw, &nodes)?;
     let mut axes = axes(cx, &raw, &nodes)?;
+    device::drives(cx, &raw, &mut axes, &devices)?;
     leaders(cx, &raw, &mut axes)?;
     let mut encoders = encoder::encoders(cx, &raw, &axes, &nodes)?;
     let cams = cam::cams(cx, &raw, dir)?;
@@ -180,6 +185,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         output_cams: objects.output_cams,
         cam_tracks: objects.cam_tracks,
         measuring_inputs: objects.measuring_inputs,
+        devices,
     })
 }
 
@@ -310,6 +316,7 @@ fn axes(cx: Ctx<'_>, raw: &CellFile, nodes: &[Node]) -> Result<Vec<AxisEntry>, C
                 delay_ns: 0,
                 tolerance_ns: 0,
             },
+            drive: DriveConnection::Simulation,
         });
     }
     Ok(axes)

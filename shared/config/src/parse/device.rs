@@ -1,0 +1,265 @@
+//! `[devices.<name>]` and the drive connection of each axis (`[axes.<name>.drive]`,
+//! `[axes.<name>.encoder]`, `[axes.<name>.mechanics]`): which device of which node's process
+//! image drives the axis, and how the drive's increments become the axis's units.
+
+use super::{node_named, pick, Ctx};
+use crate::cell::{
+    AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind, DriveConnection, Node,
+};
+use crate::error::{ConfigError, Problem};
+use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
+use tandem_motion::plant::cia402::QuickStopOption;
+use tandem_motion::plant::mechanics::{
+    EncoderConfig, Mechanics, MechanicsError, MechanicsField, Mounting, Scaling,
+};
+use tandem_motion::plant::servo::{ServoParams, SimServo};
+
+/// The device kinds by name.
+const DEVICE_KINDS: [(&str, ()); 1] = [("sim_servo", ())];
+
+/// The encoder mountings by name (S7 `Sensor[n].MountingMode` 0, 1, 2).
+const MOUNTINGS: [(&str, ()); 3] = [("motor_shaft", ()), ("load_side", ()), ("external", ())];
+
+/// Default time allowed for each step of a drive's enable sequence (s).
+const ENABLE_TIMEOUT_S: f64 = 1.0;
+
+/// `[devices.<name>]`: each device, on its node, with its parameters checked.
+pub(super) fn devices(
+    cx: Ctx<'_>,
+    raw: &CellFile,
+    nodes: &[Node],
+) -> Result<Vec<DeviceEntry>, ConfigError> {
+    let mut out = Vec::new();
+    for (name, d) in &raw.devices {
+        let node = node_named(cx, nodes, &d.node, &["devices", name, "node"])?;
+        pick("kind", &d.kind, &DEVICE_KINDS).map_err(|(k, p)| cx.at(&["devices", name, k], p))?;
+        let params = servo_params(d, nodes[node].cycle_ns)
+            .map_err(|(k, p)| cx.at(&["devices", name, k], p))?;
+        SimServo::new(params).map_err(|e| {
+            cx.at_or_table(&["devices", name, servo_key(e.field)], Problem::Servo(e))
+        })?;
+        out.push(DeviceEntry {
+            name: name.clone(),
+            node,
+            kind: DeviceKind::SimServo(params),
+        });
+    }
+    Ok(out)
+}
+
+/// The key of `[devices.<name>]` that sets a [`ServoParams`] field.
+fn servo_key(field: &'static str) -> &'static str {
+    match field {
+        "max_torque_per_mille" => "max_torque",
+        "velocity_loop_gain" => "velocity_gain",
+        "velocity_loop_integral_time" => "velocity_integral_time",
+        "cycle_ns" => "node",
+        other => other,
+    }
+}
+
+/// The parameters of a simulated servo: the section's values over the defaults
+/// ([`ServoParams::example`] for the node's cycle).
+fn servo_params(d: &DeviceSection, cycle_ns: i64) -> Result<ServoParams, super::FieldError> {
+    let p = ServoParams::example(cycle_ns);
+    let quick_stop_option = match d.quick_stop_option {
+        Some(code) => QuickStopOption::try_from(code).map_err(|_| {
+            (
+                "quick_stop_option",
+                Problem::Invalid("must be a 0x605A code, 0 to 8"),
+            )
+        })?,
+        None => p.quick_stop_option,
+    };
+    Ok(ServoParams {
+        cycle_ns,
+        increments_per_revolution: d
+            .increments_per_revolution
+            .unwrap_or(p.increments_per_revolution),
+        rated_torque: d.rated_torque.unwrap_or(p.rated_torque),
+        max_torque_per_mille: d.max_torque.unwrap_or(p.max_torque_per_mille),
+        inertia: d.inertia.unwrap_or(p.inertia),
+        viscous_friction: d.viscous_friction.unwrap_or(p.viscous_friction),
+        coulomb_friction: d.coulomb_friction.unwrap_or(p.coulomb_friction),
+        kv: d.kv.unwrap_or(p.kv),
+        velocity_loop_gain: d.velocity_gain.unwrap_or(p.velocity_loop_gain),
+        velocity_loop_integral_time: d
+            .velocity_integral_time
+            .unwrap_or(p.velocity_loop_integral_time),
+        quick_stop_deceleration: d
+            .quick_stop_deceleration
+            .unwrap_or(p.quick_stop_deceleration),
+        quick_stop_option,
+        following_error_window: d.following_error_window.unwrap_or(p.following_error_window),
+        zero_pulse_offset: d.zero_pulse_offset.unwrap_or(p.zero_pulse_offset),
+        ..p
+    })
+}
+
+/// `[axes.<name>.drive]` of every axis: the simulated drive, or a CiA 402 drive of the axis's
+/// node, bound to one axis only, with its encoder and mechanics.
+pub(super) fn drives(
+    cx: Ctx<'_>,
+    raw: &CellFile,
+    axes: &mut [AxisEntry],
+    devices: &[DeviceEntry],
+) -> Result<(), ConfigError> {
+    let mut taken: Vec<Option<usize>> = vec![None; devices.len()];
+    for (i, (entry, (name, a))) in axes.iter_mut().zip(raw.axes.iter()).enumerate() {
+        let at = |key: &[&str], p: Problem| {
+            let mut path = vec!["axes", name.as_str()];
+            path.extend_from_slice(key);
+            cx.at_or_table(&path, p)
+        };
+        let kinds = [("simulation", false), ("cia402", true)];
+        let cia402 = pick("drive.type", &a.drive.kind, &kinds)
+            .map_err(|(_, p)| at(&["drive", "type"], p))?;
+        if !cia402 {
+            only_with_a_drive(a).map_err(|k| at(k, Problem::OnlyWithDrive))?;
+            continue;
+        }
+        if a.virtual_axis {
+            return Err(at(&["virtual"], Problem::VirtualWithDrive));
+        }
+        let dev_name = a
+            .drive
+            .device
+            .as_deref()
+            .ok_or_else(|| at(&["drive"], Problem::Missing("device")))?;
+        let k = devices
+            .iter()
+            .position(|d| d.name == dev_name)
+            .ok_or_else(|| {
+                let known = devices.iter().map(|d| d.name.clone()).collect();
+                at(
+                    &["drive", "device"],
+                    Problem::Unknown {
+                        what: "device",
+                        name: dev_name.into(),
+                        known: Some(known),
+                    },
+                )
+            })?;
+        let dev = &devices[k];
+        if dev.node != entry.node {
+            return Err(at(
+                &["drive", "device"],
+                Problem::DeviceNode {
+                    device: dev.name.clone(),
+                    axis_node: entry.node,
+                    device_node: dev.node,
+                },
+            ));
+        }
+        if let Some(other) = taken[k] {
+            return Err(at(
+                &["drive", "device"],
+                Problem::DeviceTaken {
+                    device: dev.name.clone(),
+                    axis: raw.axes.keys().nth(other).cloned().unwrap_or_default(),
+                },
+            ));
+        }
+        taken[k] = Some(i);
+        let timeout = a.drive.enable_timeout.unwrap_or(ENABLE_TIMEOUT_S);
+        if !(timeout.is_finite() && timeout > 0.0 && timeout <= 60.0) {
+            return Err(at(
+                &["drive", "enable_timeout"],
+                Problem::Invalid("must be greater than 0 and at most 60 s"),
+            ));
+        }
+        if let EncoderSpec::Table(t) = &a.encoder {
+            pick("encoder.mounting", &t.mounting, &MOUNTINGS)
+                .map_err(|(_, p)| at(&["encoder", "mounting"], p))?;
+        }
+        let scaling = scaling(a, dev).map_err(|(key, e)| at(&key, Problem::Mechanics(e)))?;
+        entry.drive = DriveConnection::Cia402(Cia402Connection {
+            device: DeviceIndex(k),
+            enable_timeout_ns: (timeout * 1e9).round() as i64,
+            scaling,
+        });
+    }
+    Ok(())
+}
+
+/// On a simulated drive the keys of a drive of the process image are refused: the key path of
+/// the first one given.
+fn only_with_a_drive(a: &AxisSection) -> Result<(), &'static [&'static str]> {
+    if a.drive.device.is_some() {
+        return Err(&["drive", "device"]);
+    }
+    if a.drive.enable_timeout.is_some() {
+        return Err(&["drive", "enable_timeout"]);
+    }
+    if matches!(a.encoder, EncoderSpec::Table(_)) {
+        return Err(&["encoder"]);
+    }
+    if a.mechanics.is_some() {
+        return Err(&["mechanics"]);
+    }
+    Ok(())
+}
+
+/// The axis's encoder and mechanics on drive `dev`, validated; an error names the key.
+fn scaling(
+    a: &AxisSection,
+    dev: &DeviceEntry,
+) -> Result<Scaling, (Vec<&'static str>, MechanicsError)> {
+    let DeviceKind::SimServo(servo) = &dev.kind;
+    let default_table;
+    let table = match &a.encoder {
+        EncoderSpec::Table(t) => t,
+        EncoderSpec::Type(kind) => {
+            default_table = EncoderTable::of_drive(kind);
+            &default_table
+        }
+    };
+    let kind = table.encoder_kind();
+    let mounting = match table.mounting.as_str() {
+        "load_side" => Mounting::LoadSide,
+        "external" => Mounting::External {
+            // Checked by `Scaling::new` (finite, > 0); a missing value is refused there too.
+            distance_per_revolution: table.distance_per_revolution.unwrap_or(f64::NAN),
+        },
+        _ => Mounting::MotorShaft,
+    };
+    let encoder = EncoderConfig {
+        kind,
+        steps_per_revolution: table
+            .steps_per_revolution
+            .unwrap_or(servo.increments_per_revolution),
+        fine_resolution_bits: table.fine_resolution_bits,
+        determinable_revolutions: table.determinable_revolutions,
+        raw_bits: table.raw_bits,
+        inverse: table.inverse,
+        mounting,
+    };
+    let m = a.mechanics.as_ref();
+    let mechanics = Mechanics {
+        load_gear_numerator: m.map_or(1, |m| m.load_gear[0]),
+        load_gear_denominator: m.map_or(1, |m| m.load_gear[1]),
+        leadscrew_pitch: m.and_then(|m| m.leadscrew_pitch),
+        inverse_drive: m.is_some_and(|m| m.inverse_drive),
+        efficiency: m.map_or(1.0, |m| m.efficiency),
+        drive_increments_per_revolution: Some(servo.increments_per_revolution),
+    };
+    Scaling::new(&encoder, &mechanics).map_err(|e| (field_key(e.field), e))
+}
+
+/// The key path of a mechanics field under `[axes.<name>]`.
+fn field_key(f: MechanicsField) -> Vec<&'static str> {
+    let key = match f {
+        MechanicsField::StepsPerRevolution => "steps_per_revolution",
+        MechanicsField::FineResolutionBits => "fine_resolution_bits",
+        MechanicsField::DeterminableRevolutions => "determinable_revolutions",
+        MechanicsField::RawBits => "raw_bits",
+        MechanicsField::DistancePerRevolution => "distance_per_revolution",
+        MechanicsField::LoadGearNumerator | MechanicsField::LoadGearDenominator => {
+            return vec!["mechanics", "load_gear"]
+        }
+        MechanicsField::LeadscrewPitch => return vec!["mechanics", "leadscrew_pitch"],
+        MechanicsField::Efficiency => return vec!["mechanics", "efficiency"],
+        MechanicsField::DriveIncrementsPerRevolution => return vec!["drive", "device"],
+    };
+    vec!["encoder", key]
+}
