@@ -150,7 +150,7 @@ pub enum DriveConnection {
     #[default]
     Simulation,
     /// `cia402`: a CiA 402 drive of the node's process image.
-    Cia402(Cia402Connection),
+    Cia402(Box<Cia402Connection>),
 }
 
 /// An axis on a CiA 402 drive of the process image.

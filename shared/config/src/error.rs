@@ -188,9 +188,9 @@ pub enum Problem {
         axis: String,
     },
     /// Encoder or mechanics values that cannot convert increments to units.
-    Mechanics(tandem_motion::plant::mechanics::MechanicsError),
+    Mechanics(Box<tandem_motion::plant::mechanics::MechanicsError>),
     /// Parameters of a simulated servo drive that the model refuses.
-    Servo(tandem_motion::plant::servo::ServoParamsError),
+    Servo(Box<tandem_motion::plant::servo::ServoParamsError>),
 }
 
 /// A leading-value delay shorter than the link from a leader to a follower on another node

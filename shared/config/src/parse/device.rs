@@ -36,7 +36,10 @@ pub(super) fn devices(
         let params = servo_params(d, nodes[node].cycle_ns)
             .map_err(|(k, p)| cx.at(&["devices", name, k], p))?;
         SimServo::new(params).map_err(|e| {
-            cx.at_or_table(&["devices", name, servo_key(e.field)], Problem::Servo(e))
+            cx.at_or_table(
+                &["devices", name, servo_key(e.field)],
+                Problem::Servo(Box::new(e)),
+            )
         })?;
         out.push(DeviceEntry {
             name: name.clone(),
@@ -172,12 +175,13 @@ pub(super) fn drives(
             pick("encoder.mounting", &t.mounting, &MOUNTINGS)
                 .map_err(|(_, p)| at(&["encoder", "mounting"], p))?;
         }
-        let scaling = scaling(a, dev).map_err(|(key, e)| at(&key, Problem::Mechanics(e)))?;
-        entry.drive = DriveConnection::Cia402(Cia402Connection {
+        let scaling =
+            scaling(a, dev).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+        entry.drive = DriveConnection::Cia402(Box::new(Cia402Connection {
             device: DeviceIndex(k),
             enable_timeout_ns: (timeout * 1e9).round() as i64,
             scaling,
-        });
+        }));
     }
     Ok(())
 }
