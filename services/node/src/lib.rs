@@ -326,6 +326,11 @@ pub(crate) fn owns(cell: &Cell, n: usize, target: &str, action: &Action) -> bool
     let axis_node = |a: AxisIndex| cell.axis(a).map(|x| x.node);
     let node = match action {
         Action::InterpolateCam { .. } => return true,
+        Action::DriveFault { .. } => cell
+            .devices
+            .iter()
+            .find(|d| d.name == target)
+            .map(|d| d.node),
         Action::Command(_) => cell
             .axes
             .iter()

@@ -19,6 +19,9 @@
 //! `MC_CamTrack` (`enable`, `mode`, `invert_output`), `MC_MeasuringInput` and
 //! `MC_MeasuringInputCyclic` (`mode`, `measuring_range`, `start_position`, `end_position`),
 //! `MC_AbortMeasuringInput`, and `InputEdge` (`rising`): an input edge at the entry's `t`.
+//! A simulated drive (`[devices.<name>]`) takes `DriveFault` (`code`): a fault with that CiA 402
+//! error code (0x603F, e.g. `code = 0x2310`) from the entry's `t`, or with `code = 0` its cause
+//! removed (a fault reset then succeeds).
 //! Use [`parse_cell`] to address them.
 
 use crate::command::{self, CommandError, Expected, Value};
@@ -34,6 +37,8 @@ pub struct ObjectNames<'a> {
     pub cam_tracks: Vec<&'a str>,
     /// `[[measuring_inputs]]`.
     pub measuring_inputs: Vec<&'a str>,
+    /// `[devices.<name>]`.
+    pub devices: Vec<&'a str>,
 }
 
 /// One timed command.
@@ -93,12 +98,14 @@ pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, C
             .iter()
             .map(|c| c.name.as_str())
             .collect(),
+        devices: cell.devices.iter().map(|d| d.name.as_str()).collect(),
     };
     parse_with(file, src, &names, &cams, &objects)
 }
 
-/// The instructions of output cams, cam tracks and measuring inputs: name, the kind of object
-/// it addresses (0 output cam, 1 cam track, 2 measuring input) and parameters with defaults.
+/// The instructions of output cams, cam tracks, measuring inputs and simulated devices: name,
+/// the kind of object it addresses (0 output cam, 1 cam track, 2 measuring input, 3 device) and
+/// parameters with defaults.
 type ObjectInstruction = (&'static str, u8, &'static [(&'static str, Value)]);
 
 const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
@@ -145,6 +152,7 @@ const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
     ),
     ("MC_AbortMeasuringInput", 2, &[]),
     ("InputEdge", 2, &[("rising", Value::Bool(true))]),
+    ("DriveFault", 3, &[("code", Value::Num(0.0))]),
 ];
 
 /// An entry for an output cam, cam track or measuring input.
@@ -207,6 +215,12 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
             window: b(1).then(|| (x(2), x(3))),
         },
         "MC_AbortMeasuringInput" => Action::AbortMeasuringInput,
+        "DriveFault" => {
+            let c = code(0)?;
+            Action::DriveFault {
+                code: u16::try_from(c).map_err(|_| wrong("code", Expected::Integer))?,
+            }
+        }
         _ => Action::InputEdge { rising: b(0) },
     })
 }
@@ -337,7 +351,8 @@ fn object_instruction<'t>(
     let (list, what) = match spec.1 {
         0 => (&objects.output_cams, "output cam"),
         1 => (&objects.cam_tracks, "cam track"),
-        _ => (&objects.measuring_inputs, "measuring input"),
+        2 => (&objects.measuring_inputs, "measuring input"),
+        _ => (&objects.devices, "device"),
     };
     if !list.contains(&target) {
         return Err(CommandError::UnknownObject {

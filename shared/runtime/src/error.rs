@@ -32,6 +32,15 @@ pub enum ExecError {
         /// The engine's reason.
         reason: tandem_motion::objects::measuring::MeasuringConfigError,
     },
+    /// A simulated device whose parameters the model refuses.
+    Device {
+        /// Its name.
+        name: String,
+        /// The model's reason.
+        reason: tandem_motion::plant::servo::ServoParamsError,
+    },
+    /// A drive's enable timeout that is not positive.
+    EnableTimeout(tandem_motion::plant::cia402::InvalidEnableTimeout),
 }
 
 impl fmt::Display for ExecError {
@@ -40,6 +49,8 @@ impl fmt::Display for ExecError {
             ExecError::Axis { name, reason } => write!(f, "axis {name}: {reason}"),
             ExecError::Encoder { name, reason } => write!(f, "encoder {name}: {reason}"),
             ExecError::Object { kind, name, reason } => write!(f, "{kind} {name}: {reason}"),
+            ExecError::Device { name, reason } => write!(f, "device {name}: {reason}"),
+            ExecError::EnableTimeout(e) => write!(f, "{e}"),
         }
     }
 }

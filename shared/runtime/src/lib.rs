@@ -50,6 +50,7 @@
 //! assert!(trace.starts_with("time_s,x.state,x.position"));
 //! ```
 
+mod drives;
 mod error;
 pub mod exec;
 mod notes;

@@ -609,6 +609,7 @@ impl Objects {
         action: Action,
     ) -> Result<(), ErrorId> {
         match action {
+            Action::DriveFault { .. } => Err(ErrorId::IllegalObject),
             Action::OutputCam {
                 enable,
                 on_position,

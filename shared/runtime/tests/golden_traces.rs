@@ -25,6 +25,7 @@ const EXAMPLES: &[&str] = &[
     "glue-dot",
     "print-mark-registration",
     "press",
+    "servo",
 ];
 
 fn root() -> PathBuf {

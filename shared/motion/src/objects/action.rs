@@ -65,4 +65,10 @@ pub enum Action {
         /// Rising (true) or falling edge.
         rising: bool,
     },
+    /// A fault of the simulated drive named by the entry, with its CiA 402 error code (0x603F),
+    /// from the entry's time; code 0 removes the cause again.
+    DriveFault {
+        /// The error code, or 0.
+        code: u16,
+    },
 }

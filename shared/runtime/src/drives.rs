@@ -1,0 +1,336 @@
+//! The drives of a node's process image: the devices with their process data (the CiA 402
+//! RxPDO and TxPDO of each drive), the stage that exchanges them at the cycle boundary, and the
+//! link between an axis (its [`DriveInputs`] and [`DriveOutputs`]) and its CiA 402 drive.
+//!
+//! The order within one step at `t` (docs/io.md, "The cycle"):
+//! 1. every device of a node whose cycle falls on `t` runs the last cycle to `t` with the
+//!    command it latched at the previous boundary, and its inputs are sampled at `t` (the
+//!    simulated plant sets the drive's digital inputs, limit switches and home switch, first);
+//! 2. each device latches the command the previous step wrote (the outputs are written at the
+//!    boundary after the step that computed them);
+//! 3. each axis on a drive reads the sample of `t` ([`DriveLink::inputs`]): actual values
+//!    through its encoder and mechanics, the drive's state through the enable sequence;
+//! 4. the axes step;
+//! 5. each axis's outputs become its drive's command ([`DriveLink::command`]), latched at
+//!    `t + cycle`.
+//!
+//! So a setpoint computed at `t` acts from `t + cycle` and shows in the actual values read at
+//! `t + 2 cycles`: two cycles of transport delay, what the following error is formed against.
+
+use tandem_config::{Cell, Cia402Connection, DeviceKind, DriveConnection};
+use tandem_motion::plant::cia402::{
+    digital_inputs, DriveCommand, DriveFeedback, EnableSequence, EnableStatus, EnableStep,
+    ModeOfOperation, PowerRequest,
+};
+use tandem_motion::plant::drive::{Actual, Plant};
+use tandem_motion::plant::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
+use tandem_motion::plant::mechanics::{RawCounter, Scaling};
+use tandem_motion::plant::servo::{ServoParams, SimServo, SimServoError};
+
+use crate::error::ExecError;
+
+/// Cycles between a setpoint and the actual value that shows it (see the module's order).
+const TRANSPORT_CYCLES: usize = 2;
+
+/// A device of the process image.
+#[derive(Debug)]
+enum Device {
+    /// A simulated CiA 402 servo drive.
+    SimServo(Box<SimServo>),
+}
+
+/// One device with its process data.
+#[derive(Debug)]
+struct Slot {
+    device: Device,
+    /// Its node's cycle (ns).
+    cycle_ns: i64,
+    /// The command written by the last step, latched at the next boundary.
+    command: DriveCommand,
+    /// The inputs sampled at the last boundary.
+    feedback: DriveFeedback,
+    /// Whether the device has been sampled once (the first boundary has no cycle before it).
+    started: bool,
+}
+
+/// The link of one axis to its CiA 402 drive.
+#[derive(Debug)]
+pub(crate) struct DriveLink {
+    /// The axis (index in the cell).
+    pub(crate) axis: usize,
+    /// The device (index in the cell).
+    device: usize,
+    scaling: Scaling,
+    enable: EnableSequence,
+    /// The raw position word extended, from the first sample on.
+    counter: Option<RawCounter>,
+    /// The controlword decided with this cycle's inputs, sent with this cycle's command.
+    controlword: u16,
+    /// The axis's request of the last cycle (enable, fault reset).
+    request: PowerRequest,
+    /// The position setpoints of the last [`TRANSPORT_CYCLES`] cycles (physical), newest at
+    /// `head`: at the next cycle the oldest is the one the actual value shows.
+    setpoints: [f64; TRANSPORT_CYCLES],
+    head: usize,
+    /// The simulated plant around the drive (limit switches, reference cam), physical.
+    plant: Plant,
+}
+
+/// The devices of the process image and the links of the axes on them.
+#[derive(Debug, Default)]
+pub(crate) struct Drives {
+    /// Per device of the cell; `None` for devices of other nodes.
+    slots: Vec<Option<Slot>>,
+    /// The owned axes on a drive.
+    pub(crate) links: Vec<DriveLink>,
+}
+
+/// The drive's enable step as [`DriveState`] numbers it (the supplement of alarm 421).
+fn step_number(step: EnableStep) -> u8 {
+    match step {
+        EnableStep::LeaveFault => 0,
+        EnableStep::Shutdown => 1,
+        EnableStep::SwitchOn => 2,
+        EnableStep::EnableOperation => 3,
+    }
+}
+
+impl Drives {
+    /// The devices of the owned nodes and the links of the owned axes (`owned[i]`) on them.
+    pub(crate) fn new(cell: &Cell, owned: &[bool]) -> Result<Self, ExecError> {
+        let mut slots: Vec<Option<Slot>> = cell.devices.iter().map(|_| None).collect();
+        let mut links = Vec::new();
+        for (i, a) in cell.axes.iter().enumerate() {
+            let DriveConnection::Cia402(c) = &a.drive else {
+                continue;
+            };
+            if !owned.get(i).copied().unwrap_or(false) {
+                continue;
+            }
+            let Some(dev) = cell.devices.get(c.device.0) else {
+                continue;
+            };
+            let DeviceKind::SimServo(params) = &dev.kind;
+            // The motor starts where the axis's initial position puts it.
+            let start = f64::from(c.scaling.drive_increments(a.config.initial_position));
+            let servo = SimServo::new(ServoParams {
+                initial_position: start,
+                ..*params
+            })
+            .map_err(|reason| ExecError::Device {
+                name: dev.name.clone(),
+                reason,
+            })?;
+            if let Some(slot) = slots.get_mut(c.device.0) {
+                *slot = Some(Slot {
+                    device: Device::SimServo(Box::new(servo)),
+                    cycle_ns: cell.nodes[dev.node].cycle_ns,
+                    command: DriveCommand::default(),
+                    feedback: DriveFeedback::default(),
+                    started: false,
+                });
+            }
+            links.push(DriveLink::new(
+                i,
+                c,
+                a.config.plant,
+                a.config.initial_position,
+            )?);
+        }
+        Ok(Self { slots, links })
+    }
+
+    /// Whether any axis is on a drive of the process image.
+    pub(crate) fn any(&self) -> bool {
+        !self.links.is_empty()
+    }
+
+    /// Steps 1 and 2 of the order: every due device runs to `t`, is sampled, and latches the
+    /// command written by the previous step.
+    pub(crate) fn exchange(&mut self, t: i64) {
+        for link in &self.links {
+            let Some(Some(slot)) = self.slots.get_mut(link.device) else {
+                continue;
+            };
+            if t % slot.cycle_ns != 0 {
+                continue;
+            }
+            let Device::SimServo(servo) = &mut slot.device;
+            if slot.started {
+                servo.advance(slot.cycle_ns);
+            }
+            slot.started = true;
+            servo.set_digital_inputs(link.plant_inputs(servo.position()));
+            slot.feedback = servo.feedback();
+            // The transition taken is the drive's own business; its state is in the statusword.
+            let _ = servo.exchange(&slot.command);
+        }
+    }
+
+    /// The sample of `t` for link `k`'s axis (step 3), or `None` when its drive's node is not
+    /// due.
+    pub(crate) fn inputs(&mut self, k: usize, t: i64) -> Option<DriveInputs> {
+        let link = self.links.get_mut(k)?;
+        let slot = self.slots.get(link.device)?.as_ref()?;
+        if t % slot.cycle_ns != 0 {
+            return None;
+        }
+        Some(link.inputs(t, &slot.feedback))
+    }
+
+    /// Step 5: the outputs of link `k`'s axis become its drive's command.
+    pub(crate) fn command(&mut self, k: usize, t: i64, out: &DriveOutputs) {
+        let Some(link) = self.links.get_mut(k) else {
+            return;
+        };
+        let Some(Some(slot)) = self.slots.get_mut(link.device) else {
+            return;
+        };
+        if t % slot.cycle_ns == 0 {
+            slot.command = link.command(out);
+        }
+    }
+
+    /// Whether this executive runs device `device`.
+    pub(crate) fn runs(&self, device: usize) -> bool {
+        matches!(self.slots.get(device), Some(Some(_)))
+    }
+
+    /// Injects a fault with error code `code` into device `device` (a simulated drive), or
+    /// removes its cause with `code == 0`.
+    pub(crate) fn inject_fault(&mut self, device: usize, code: u16) -> Result<(), SimServoError> {
+        let Some(Some(slot)) = self.slots.get_mut(device) else {
+            return Ok(());
+        };
+        let Device::SimServo(servo) = &mut slot.device;
+        if code == 0 {
+            servo.clear_fault_cause();
+            Ok(())
+        } else {
+            servo.inject_fault(code)
+        }
+    }
+
+    /// The last feedback of device `device` (for traces and tests).
+    pub(crate) fn feedback(&self, device: usize) -> Option<&DriveFeedback> {
+        self.slots.get(device)?.as_ref().map(|s| &s.feedback)
+    }
+}
+
+impl DriveLink {
+    fn new(axis: usize, c: &Cia402Connection, plant: Plant, p0: f64) -> Result<Self, ExecError> {
+        let enable = EnableSequence::new(c.enable_timeout_ns).map_err(ExecError::EnableTimeout)?;
+        Ok(Self {
+            axis,
+            device: c.device.0,
+            scaling: c.scaling,
+            enable,
+            counter: None,
+            controlword: 0,
+            request: PowerRequest::default(),
+            setpoints: [p0; TRANSPORT_CYCLES],
+            head: 0,
+            plant,
+        })
+    }
+
+    /// The drive's digital inputs 0x60FD as the simulated plant's switches see the load at
+    /// motor position `increments`.
+    fn plant_inputs(&self, increments: f64) -> u32 {
+        let p = self.scaling.drive_position(increments.round() as i64);
+        let mut bits = 0;
+        if self.plant.hw_limit_min.is_some_and(|x| p <= x) {
+            bits |= digital_inputs::NEGATIVE_LIMIT;
+        }
+        if self.plant.hw_limit_max.is_some_and(|x| p >= x) {
+            bits |= digital_inputs::POSITIVE_LIMIT;
+        }
+        if self
+            .plant
+            .reference_cam
+            .is_some_and(|(lo, hi)| p >= lo && p <= hi)
+        {
+            bits |= digital_inputs::HOME_SWITCH;
+        }
+        bits
+    }
+
+    /// What the axis reads of its drive at `t`: the position actual value 0x6064 and the
+    /// velocity actual value 0x606C in the drive's increments (those of its target 0x607A)
+    /// through the mechanics, the balanced setpoint (the setpoint of [`TRANSPORT_CYCLES`]
+    /// ago), the switches of 0x60FD, and the state of the enable sequence, stepped here with
+    /// the axis's last request.
+    fn inputs(&mut self, t: i64, fb: &DriveFeedback) -> DriveInputs {
+        let raw = fb.position_actual as u32;
+        let count = match &mut self.counter {
+            Some(c) => c.update(raw),
+            None => {
+                // 0x6064 is an INT32: its first value read as signed.
+                let c = RawCounter::new_signed(32, raw).ok();
+                let n = c.map_or(i64::from(fb.position_actual), |c| c.count());
+                self.counter = c;
+                n
+            }
+        };
+        let out = self.enable.step(t, self.request, fb.statusword);
+        self.controlword = out.controlword;
+        let state = match out.status {
+            EnableStatus::Enabled => DriveState::Operational,
+            EnableStatus::Enabling { step } => DriveState::Enabling {
+                step: step_number(step),
+            },
+            EnableStatus::TimedOut { step, .. } => DriveState::EnableTimedOut {
+                step: step_number(step),
+            },
+            EnableStatus::Fault => DriveState::Fault {
+                code: fb.error_code,
+            },
+            EnableStatus::Disabled
+            | EnableStatus::Disabling
+            | EnableStatus::QuickStopping
+            | EnableStatus::Lost { .. } => DriveState::Disabled,
+        };
+        let oldest = self.setpoints[(self.head + 1) % self.setpoints.len()];
+        let di = fb.digital_inputs;
+        DriveInputs {
+            actual: Actual {
+                p: self.scaling.drive_position(count),
+                v: self.scaling.drive_position(i64::from(fb.velocity_actual)),
+                balanced: oldest,
+            },
+            signals: AxisSignals {
+                limit_negative: di & digital_inputs::NEGATIVE_LIMIT != 0,
+                limit_positive: di & digital_inputs::POSITIVE_LIMIT != 0,
+                reference_cam: di & digital_inputs::HOME_SWITCH != 0,
+                reference_cam_left: None,
+                zero_mark: None,
+            },
+            state,
+        }
+    }
+
+    /// The drive's command for the axis's outputs: CSP with the position setpoint and the
+    /// velocity as feedforward (0x60B1), the controlword of the enable sequence.
+    fn command(&mut self, out: &DriveOutputs) -> DriveCommand {
+        self.request = PowerRequest {
+            enable: out.enable,
+            quick_stop: false,
+            fault_reset: out.fault_reset,
+        };
+        self.head = (self.head + 1) % self.setpoints.len();
+        if let Some(s) = self.setpoints.get_mut(self.head) {
+            *s = out.position;
+        }
+        let v = self
+            .scaling
+            .drive_increments_per_second(out.velocity)
+            .round();
+        DriveCommand {
+            controlword: self.controlword,
+            mode: ModeOfOperation::CyclicSynchronousPosition as i8,
+            target_position: self.scaling.drive_increments(out.position),
+            velocity_offset: v.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32,
+            ..DriveCommand::default()
+        }
+    }
+}
