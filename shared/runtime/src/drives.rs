@@ -8,10 +8,10 @@
 //!    simulated plant sets the drive's digital inputs, limit switches and home switch, first);
 //! 2. each device latches the command the previous step wrote (the outputs are written at the
 //!    boundary after the step that computed them);
-//! 3. each axis on a drive reads the sample of `t` ([`DriveLink::inputs`]): actual values
+//! 3. each axis on a drive reads the sample of `t` ([`Cia402Link::inputs`]): actual values
 //!    through its encoder and mechanics, the drive's state through the enable sequence;
 //! 4. the axes step;
-//! 5. each axis's outputs become its drive's command ([`DriveLink::command`]), latched at
+//! 5. each axis's outputs become its drive's command ([`Cia402Link::command`]), latched at
 //!    `t + cycle`.
 //!
 //! So a setpoint computed at `t` acts from `t + cycle` and shows in the actual values read at
@@ -53,11 +53,12 @@ struct Slot {
     started: bool,
 }
 
-/// The link of one axis to its CiA 402 drive.
+/// The link of one axis to its CiA 402 drive: between the axis's [`DriveInputs`] /
+/// [`DriveOutputs`] and the drive's TxPDO / RxPDO.
 #[derive(Debug)]
-pub(crate) struct DriveLink {
+pub struct Cia402Link {
     /// The axis (index in the cell).
-    pub(crate) axis: usize,
+    pub axis: usize,
     /// The device (index in the cell).
     device: usize,
     scaling: Scaling,
@@ -82,7 +83,7 @@ pub(crate) struct Drives {
     /// Per device of the cell; `None` for devices of other nodes.
     slots: Vec<Option<Slot>>,
     /// The owned axes on a drive.
-    pub(crate) links: Vec<DriveLink>,
+    pub(crate) links: Vec<Cia402Link>,
 }
 
 /// The drive's enable step as [`DriveState`] numbers it (the supplement of alarm 421).
@@ -130,7 +131,7 @@ impl Drives {
                     started: false,
                 });
             }
-            links.push(DriveLink::new(
+            links.push(Cia402Link::new(
                 i,
                 c,
                 a.config.plant,
@@ -217,8 +218,15 @@ impl Drives {
     }
 }
 
-impl DriveLink {
-    fn new(axis: usize, c: &Cia402Connection, plant: Plant, p0: f64) -> Result<Self, ExecError> {
+impl Cia402Link {
+    /// The link of axis `axis` (its index in the cell) over connection `c`, with the simulated
+    /// plant's switches `plant` and the axis's initial physical position `p0`.
+    pub fn new(
+        axis: usize,
+        c: &Cia402Connection,
+        plant: Plant,
+        p0: f64,
+    ) -> Result<Self, ExecError> {
         let enable = EnableSequence::new(c.enable_timeout_ns).map_err(ExecError::EnableTimeout)?;
         Ok(Self {
             axis,
@@ -260,7 +268,7 @@ impl DriveLink {
     /// through the mechanics, the balanced setpoint (the setpoint of [`TRANSPORT_CYCLES`]
     /// ago), the switches of 0x60FD, and the state of the enable sequence, stepped here with
     /// the axis's last request.
-    fn inputs(&mut self, t: i64, fb: &DriveFeedback) -> DriveInputs {
+    pub fn inputs(&mut self, t: i64, fb: &DriveFeedback) -> DriveInputs {
         let raw = fb.position_actual as u32;
         let count = match &mut self.counter {
             Some(c) => c.update(raw),
@@ -311,7 +319,7 @@ impl DriveLink {
 
     /// The drive's command for the axis's outputs: CSP with the position setpoint and the
     /// velocity as feedforward (0x60B1), the controlword of the enable sequence.
-    fn command(&mut self, out: &DriveOutputs) -> DriveCommand {
+    pub fn command(&mut self, out: &DriveOutputs) -> DriveCommand {
         self.request = PowerRequest {
             enable: out.enable,
             quick_stop: false,

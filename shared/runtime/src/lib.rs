@@ -50,7 +50,7 @@
 //! assert!(trace.starts_with("time_s,x.state,x.position"));
 //! ```
 
-mod drives;
+pub mod drives;
 mod error;
 pub mod exec;
 mod notes;
