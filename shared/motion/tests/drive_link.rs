@@ -14,7 +14,7 @@ use tandem_motion::objects::axis::{
     Axis, AxisConfig, AxisState, Command, StartMode, StopMode, VelocityDirection,
 };
 use tandem_motion::objects::job::{Instruction, JobEvent, JobEventKind};
-use tandem_motion::plant::drive::Actual;
+use tandem_motion::plant::drive::{Actual, ZeroMark};
 use tandem_motion::plant::link::{DriveInputs, DriveOutputs, DriveState};
 use tandem_testkit::rig::dynamics;
 
@@ -305,4 +305,45 @@ fn in_simulation_the_outputs_are_those_applied_to_the_simulated_drive() {
     let o = axis.drive_outputs();
     assert!(o.enable && o.position_controlled && !o.fault_reset);
     assert_eq!(o.position, axis.status().position);
+}
+
+#[test]
+fn homing_that_needs_a_mark_is_refused_on_a_connected_drive() {
+    // A plant with a reference cam and zero marks: in simulation active and passive homing
+    // are accepted; on a drive of the process image (no homing mark from it yet) they are
+    // refused with 16#800A, and direct homing works.
+    let mut cfg = AxisConfig::example(0.001);
+    cfg.plant.reference_cam = Some((10.0, 20.0));
+    cfg.plant.zero_mark = Some(ZeroMark {
+        period: 5.0,
+        offset: 1.0,
+    });
+    let home = |mode| Command::Home {
+        mode,
+        position: 0.0,
+    };
+    let mut sim = Axis::new(cfg.clone()).unwrap();
+    sim.step(0);
+    sim.command(&Command::Power {
+        enable: true,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Emergency,
+    })
+    .unwrap();
+    sim.step(MS);
+    for mode in [2u8, 3] {
+        assert!(sim.command(&home(mode)).is_ok(), "simulation, mode {mode}");
+    }
+    let mut b = Bench::new();
+    b.axis = Axis::new(cfg).unwrap();
+    b.axis.connect_drive();
+    b.step(1);
+    let p = b.power(true);
+    b.inputs.state = DriveState::Operational;
+    b.step(1);
+    assert!(b.status_true(p));
+    for mode in [2u8, 3, 5, 8, 10] {
+        assert_eq!(b.cmd(home(mode)), Err(ErrorId::IllegalMode), "mode {mode}");
+    }
+    assert!(b.cmd(home(0)).is_ok());
 }

@@ -1508,9 +1508,17 @@ impl Axis {
             _ => None,
         };
         if let Some(mark) = mark {
-            let plant = &self.cfg.plant;
-            let cam_ok = plant.reference_cam.is_some() || mark == HomingMark::ZeroMark;
-            let zero_ok = plant.zero_mark.is_some() || mark == HomingMark::DigitalInput;
+            // A drive of the process image gives no homing mark yet (its touch probe is not
+            // connected to homing): modes that need one are refused (docs/io.md, deviations).
+            let (cam, zero) = match self.link {
+                DriveLink::Simulation(_) => (
+                    self.cfg.plant.reference_cam.is_some(),
+                    self.cfg.plant.zero_mark.is_some(),
+                ),
+                DriveLink::Connected { .. } => (false, false),
+            };
+            let cam_ok = cam || mark == HomingMark::ZeroMark;
+            let zero_ok = zero || mark == HomingMark::DigitalInput;
             if !(cam_ok && zero_ok) {
                 return Err(ErrorId::IllegalMode);
             }
