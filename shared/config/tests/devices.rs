@@ -202,3 +202,17 @@ fn servo_parameters_the_model_refuses_name_their_key() {
     assert_eq!(key, "devices.servo1.kind");
     assert!(p.to_string().contains("sim_servo"), "{p}");
 }
+
+#[test]
+fn a_sensor_in_front_of_a_drive_touch_probe_is_on_the_inputs_own_axis() {
+    let base = CELL.replace("[axes.x]", "[axes.v]\nnode = \"n\"\nvirtual = true\n\n[axes.v.dynamics]\nmax_velocity = 100.0\nmax_acceleration = 1000.0\nmax_deceleration = 1000.0\nmax_jerk = 10000.0\nvelocity = 50.0\nacceleration = 500.0\ndeceleration = 500.0\njerk = 5000.0\nemergency_deceleration = 2000.0\n\n[axes.x]");
+    let probe = |sensor_axis: &str| {
+        format!(
+            "{base}\n[[measuring_inputs]]\nname = \"p\"\naxis = \"x\"\nroute = \"profidrive\"\n\n[measuring_inputs.sensor]\naxis = \"{sensor_axis}\"\nposition = 1.0\nwidth = 1.0\n"
+        )
+    };
+    assert!(parse("cell.toml", &probe("x")).is_ok());
+    let (_, key, p) = refused(&probe("v"));
+    assert_eq!(key, "measuring_inputs[0].sensor.axis");
+    assert!(p.to_string().contains("touch probe"), "{p}");
+}

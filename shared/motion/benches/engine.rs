@@ -921,10 +921,12 @@ mod cams_and_measuring {
                 InputEdge {
                     time_ns: t0 + 200_000,
                     rising: true,
+                    latched: None,
                 },
                 InputEdge {
                     time_ns: t0 + 700_000,
                     rising: false,
+                    latched: None,
                 },
             ];
             mi.step(&m, black_box(&two));

@@ -40,6 +40,7 @@ fn rise(t: i64) -> InputEdge {
     InputEdge {
         time_ns: t,
         rising: true,
+        latched: None,
     }
 }
 
@@ -47,6 +48,7 @@ fn fall(t: i64) -> InputEdge {
     InputEdge {
         time_ns: t,
         rising: false,
+        latched: None,
     }
 }
 
@@ -167,6 +169,7 @@ fn burst(k: i64, n: i64, rising: bool) -> Vec<InputEdge> {
         .map(|i| InputEdge {
             time_ns: k * MS + 1 + i * (MS / 20),
             rising,
+            latched: None,
         })
         .collect()
 }
@@ -754,7 +757,7 @@ proptest! {
         let (mut c1, mut c2, mut l1, mut l2) = (0u32, 0u32, 0u8, 0u8);
         for (k, edges) in cycles.iter().enumerate() {
             let k = k as i64;
-            let list: Vec<InputEdge> = edges.iter().map(|&(t, r)| InputEdge { time_ns: k * MS + t, rising: r }).collect();
+            let list: Vec<InputEdge> = edges.iter().map(|&(t, r)| InputEdge { time_ns: k * MS + t, rising: r, latched: None }).collect();
             mi.step(&linear(k, 0.0, 10_000.0), &list);
             let mut sorted = list.clone();
             sorted.sort_by_key(|e| e.time_ns);

@@ -129,10 +129,12 @@ fn ten_thousand_cycles_without_allocation() {
             InputEdge {
                 time_ns: t0 + 200_000,
                 rising: true,
+                latched: None,
             },
             InputEdge {
                 time_ns: t0 + 700_000,
                 rising: true,
+                latched: None,
             },
         ];
         mi.step(&motion, &two);

@@ -18,9 +18,10 @@
 //! `t + 2 cycles`: two cycles of transport delay, what the following error is formed against.
 
 use tandem_config::{Cell, Cia402Connection, DeviceKind, DriveConnection};
+use tandem_motion::objects::measuring::MeasuringRoute;
 use tandem_motion::plant::cia402::{
-    digital_inputs, DriveCommand, DriveFeedback, EnableSequence, EnableStatus, EnableStep,
-    ModeOfOperation, PowerRequest,
+    digital_inputs, touch_probe, DriveCommand, DriveFeedback, EnableSequence, EnableStatus,
+    EnableStep, ModeOfOperation, PowerRequest,
 };
 use tandem_motion::plant::drive::{Actual, Plant};
 use tandem_motion::plant::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
@@ -75,6 +76,30 @@ pub struct Cia402Link {
     head: usize,
     /// The simulated plant around the drive (limit switches, reference cam), physical.
     plant: Plant,
+    /// The measuring input on the drive's touch probe 1 (index in the cell), if any.
+    pub probe_input: Option<usize>,
+    /// Arm touch probe 1 with the next command.
+    probe_armed: bool,
+    /// The touch probe status of the last sample (0x60B9), to see new values.
+    probe_status: u16,
+}
+
+/// Whether measuring input `m` measures through its axis's drive's touch probe: route
+/// PROFIdrive ("the drive latches the position") on an axis with a CiA 402 drive.
+pub fn on_touch_probe(cell: &Cell, m: &tandem_config::MeasuringInputEntry) -> bool {
+    m.config.route == MeasuringRoute::Profidrive
+        && cell
+            .axis(m.axis)
+            .is_some_and(|a| matches!(a.drive, DriveConnection::Cia402(_)))
+}
+
+/// A latch of touch probe 1, for the measuring input on it.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct ProbeLatch {
+    /// Rising (0x60BA) or falling (0x60BB) edge.
+    pub rising: bool,
+    /// The latched position (physical, units).
+    pub position: f64,
 }
 
 /// The devices of the process image and the links of the axes on them.
@@ -131,12 +156,24 @@ impl Drives {
                     started: false,
                 });
             }
-            links.push(Cia402Link::new(
-                i,
-                c,
-                a.config.plant,
-                a.config.initial_position,
-            )?);
+            let mut link = Cia402Link::new(i, c, a.config.plant, a.config.initial_position)?;
+            link.probe_input = cell
+                .measuring_inputs
+                .iter()
+                .position(|m| m.axis.0 == i && on_touch_probe(cell, m));
+            if let (Some(m), Some(Some(slot))) = (
+                link.probe_input.and_then(|k| cell.measuring_inputs.get(k)),
+                slots.get_mut(c.device.0),
+            ) {
+                if let (Some(sensor), Device::SimServo(servo)) = (m.sensor, &mut slot.device) {
+                    // The mark at its physical position (the axis's coordinate at start).
+                    let at = |x: f64| f64::from(c.scaling.drive_increments(x));
+                    let (lo, hi) = (at(sensor.position), at(sensor.position + sensor.width));
+                    // Probe 1 exists: refused only for another probe number.
+                    let _ = servo.set_probe_mark(1, Some((lo.min(hi), lo.max(hi))));
+                }
+            }
+            links.push(link);
         }
         Ok(Self { slots, links })
     }
@@ -177,6 +214,17 @@ impl Drives {
             return None;
         }
         Some(link.inputs(t, &slot.feedback))
+    }
+
+    /// The new touch probe 1 values of link `k`'s drive in the sample of `t`.
+    pub(crate) fn probe_latches(&mut self, k: usize, t: i64) -> [Option<ProbeLatch>; 2] {
+        let Some(link) = self.links.get_mut(k) else {
+            return [None; 2];
+        };
+        match self.slots.get(link.device) {
+            Some(Some(slot)) if t % slot.cycle_ns == 0 => link.probe_latches(&slot.feedback),
+            _ => [None; 2],
+        }
     }
 
     /// Step 5: the outputs of link `k`'s axis become its drive's command.
@@ -239,7 +287,45 @@ impl Cia402Link {
             setpoints: [p0; TRANSPORT_CYCLES],
             head: 0,
             plant,
+            probe_input: None,
+            probe_armed: false,
+            probe_status: 0,
         })
+    }
+
+    /// Arms (or disarms) touch probe 1 with the next command: enabled on the probe input,
+    /// first event, both edges. A new arming after a disarmed cycle clears what it stored.
+    pub fn arm_probe(&mut self, armed: bool) {
+        self.probe_armed = armed;
+    }
+
+    /// The new values of touch probe 1 in sample `fb` (positive edge first), as physical
+    /// positions; call once per sample, after [`Cia402Link::inputs`].
+    pub fn probe_latches(&mut self, fb: &DriveFeedback) -> [Option<ProbeLatch>; 2] {
+        let status = fb.touch_probe_status;
+        let previous = self.probe_status;
+        let new = |bit: u16| status & bit != 0 && previous & bit == 0;
+        let (pos, neg) = (
+            new(touch_probe::STATUS_POSITIVE_STORED),
+            new(touch_probe::STATUS_NEGATIVE_STORED),
+        );
+        self.probe_status = status;
+        let at = |raw: i32| {
+            let count = self
+                .counter
+                .map_or(i64::from(raw), |c| c.nearest(raw as u32));
+            self.scaling.drive_position(count)
+        };
+        [
+            pos.then(|| ProbeLatch {
+                rising: true,
+                position: at(fb.touch_probe_1_positive),
+            }),
+            neg.then(|| ProbeLatch {
+                rising: false,
+                position: at(fb.touch_probe_1_negative),
+            }),
+        ]
     }
 
     /// The drive's digital inputs 0x60FD as the simulated plant's switches see the load at
@@ -333,11 +419,20 @@ impl Cia402Link {
             .scaling
             .drive_increments_per_second(out.velocity)
             .round();
+        let probe = if self.probe_armed {
+            touch_probe::ENABLE
+                | touch_probe::SOURCE_INPUT
+                | touch_probe::SAMPLE_POSITIVE
+                | touch_probe::SAMPLE_NEGATIVE
+        } else {
+            0
+        };
         DriveCommand {
             controlword: self.controlword,
             mode: ModeOfOperation::CyclicSynchronousPosition as i8,
             target_position: self.scaling.drive_increments(out.position),
             velocity_offset: v.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32,
+            touch_probe_function: probe,
             ..DriveCommand::default()
         }
     }

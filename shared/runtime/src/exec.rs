@@ -32,6 +32,7 @@ use tandem_motion::objects::job::{Instruction, JobEvent, JobId};
 use tandem_motion::objects::leading::{
     LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
+use tandem_motion::plant::sensor::InputEdge;
 
 fn gcd(a: i64, b: i64) -> i64 {
     if b == 0 {
@@ -873,13 +874,32 @@ impl<'c> Executive<'c> {
             if let (Some(inputs), Some(a)) = (self.drives.inputs(k, t), self.axes.get_mut(axis)) {
                 a.set_drive_inputs(&inputs);
             }
+            let Some(m) = self.drives.links[k].probe_input else {
+                continue;
+            };
+            // A touch probe value: the measuring input's edge, at the position the drive
+            // latched, in the axis's coordinate.
+            let offset = self.axes.get(axis).map_or(0.0, Axis::position_offset);
+            for latch in self.drives.probe_latches(k, t).into_iter().flatten() {
+                let edge = InputEdge {
+                    time_ns: t,
+                    rising: latch.rising,
+                    latched: Some(latch.position + offset),
+                };
+                self.objects.push_edge(m, edge);
+            }
         }
     }
 
-    /// The outputs of the axes on drives become the drives' commands.
+    /// The outputs of the axes on drives become the drives' commands, with touch probe 1
+    /// armed while its measuring input has a job.
     fn drive_outputs(&mut self, t: i64) {
         for k in 0..self.drives.links.len() {
-            let axis = self.drives.links[k].axis;
+            let link = &mut self.drives.links[k];
+            let axis = link.axis;
+            if let Some(m) = link.probe_input {
+                link.arm_probe(self.objects.measuring(m));
+            }
             if let Some(a) = self.axes.get(axis) {
                 let out = a.drive_outputs();
                 self.drives.command(k, t, &out);

@@ -555,10 +555,13 @@ impl Objects {
             cell.output_cams.len() + cell.cam_tracks.len() + cell.measuring_inputs.len();
         let mut inputs = Vec::new();
         for m in &cell.measuring_inputs {
+            // On a drive's touch probe the sensor is a mark in front of the drive's probe
+            // input (crate::drives), not evaluated here.
+            let on_probe = crate::drives::on_touch_probe(cell, m);
             inputs.push(SimInput {
                 input: MeasuringInput::new(m.config)
                     .map_err(refused("measuring input", &m.name))?,
-                sensor: m.sensor.map(|s| s.sensor()),
+                sensor: m.sensor.filter(|_| !on_probe).map(|s| s.sensor()),
                 edges: InputEdges::default(),
                 job: None,
                 logged: (0, 0, 0, 0, false),
@@ -578,6 +581,21 @@ impl Objects {
                 alarms: vec![None; n_objects],
             },
         })
+    }
+
+    /// Whether measuring input `i` has a job waiting for edges.
+    pub(crate) fn measuring(&self, i: usize) -> bool {
+        self.inputs
+            .get(i)
+            .is_some_and(|x| x.input.active_job().is_some())
+    }
+
+    /// An edge for measuring input `i` (a drive's touch probe latch), evaluated in its next
+    /// step. Dropped (and counted by the input) when its list is full.
+    pub(crate) fn push_edge(&mut self, i: usize, edge: InputEdge) {
+        if let Some(x) = self.inputs.get_mut(i) {
+            x.edges.push(edge);
+        }
     }
 
     pub(crate) fn header(cell: &Cell, out: &mut impl Write) -> io::Result<()> {
@@ -665,6 +683,7 @@ impl Objects {
                 self.inputs[i].edges.push(InputEdge {
                     time_ns: t_ns,
                     rising,
+                    latched: None,
                 });
                 Ok(())
             }

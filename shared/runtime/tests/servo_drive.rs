@@ -258,3 +258,76 @@ fn a_hardware_limit_switch_read_through_the_drive_stops_the_axis() {
         r.exec.status()[0].actual_velocity == 0.0
     });
 }
+
+/// A measuring input on the drive's touch probe (route PROFIdrive, "the drive latches the
+/// position"): the mark sensor sits in front of the drive's probe input; MC_MeasuringInput
+/// arms touch probe 1 (0x60B8), the drive latches the exact crossing (0x60BA/0x60BB), and the
+/// measured values are those positions in the axis's coordinate.
+#[test]
+fn a_touch_probe_latch_gives_the_measuring_input_the_exact_position() {
+    // The mark from 50 to 55 mm: 15·2^20 and 16.5·2^20 increments exactly (3 motor turns per
+    // 10 mm), so the latched counter values are the mark's edges without rounding.
+    let cell = cell(|s| {
+        s + r#"
+[[measuring_inputs]]
+name = "probe"
+axis = "slide"
+route = "profidrive"
+
+[measuring_inputs.sensor]
+position = 50.0
+width = 5.0
+"#
+    });
+    let mut r = Run::new(&cell);
+    r.enabled();
+    // Home to 100 at the start: the measured values are axis positions (physical + 100).
+    r.cmd(Command::Home {
+        mode: 0,
+        position: 100.0,
+    });
+    // A PROFIdrive measuring job is refused in the cycle of a homing job (16#80A3).
+    r.step();
+    r.apply(
+        "probe",
+        Action::MeasuringInput {
+            cyclic: false,
+            mode: 3,
+            window: None,
+        },
+    );
+    r.move_to(200.0);
+    r.until(2000, "both edges measured", |r| {
+        r.log().contains("MC_MeasuringInput job") && r.log().contains(": Done")
+    });
+    let values: Vec<f64> = r
+        .log()
+        .lines()
+        .filter(|l| l.contains("probe MeasuredValue"))
+        .map(|l| {
+            l.split(" = ")
+                .nth(1)
+                .unwrap()
+                .split(' ')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(values.len(), 2, "{}", r.log());
+    assert!(
+        (values[0] - 150.0).abs() < 1e-9,
+        "rising edge at {}",
+        values[0]
+    );
+    assert!(
+        (values[1] - 155.0).abs() < 1e-9,
+        "falling edge at {}",
+        values[1]
+    );
+    // The drive's own registers hold the same edges in increments.
+    let fb = r.exec.drive_feedback(0).unwrap();
+    assert_eq!(fb.touch_probe_1_positive, 15 << 20);
+    assert_eq!(fb.touch_probe_1_negative, 33 << 19);
+}

@@ -1,5 +1,7 @@
 //! A counting global allocator for the zero-allocation tests: every allocation made by a thread
 //! that armed it is counted, the rest of the program (the test harness, other threads) is not.
+//! The counts are per thread, so tests that count at the same time in one binary (the test
+//! harness runs them on parallel threads) do not see each other's allocations.
 //!
 //! The allocator of a program is chosen once, at the top of its binary, so each test binary that
 //! counts installs it itself, with [`counting_allocator!`](crate::counting_allocator) (or by hand:
@@ -25,27 +27,31 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Allocations (alloc, alloc_zeroed, realloc) made by an armed thread.
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-/// Deallocations made by an armed thread (for reports only).
-static DEALLOCS: AtomicU64 = AtomicU64::new(0);
+use std::thread::LocalKey;
 
 thread_local! {
     /// Counting is armed on this thread. Const-initialised and without destructor, so reading
-    /// it inside the allocator never allocates or recurses.
+    /// it inside the allocator never allocates or recurses (as the counters below).
     static ARMED: Cell<bool> = const { Cell::new(false) };
+    /// Allocations (alloc, alloc_zeroed, realloc) made by this thread while armed.
+    static ALLOCS: Cell<u64> = const { Cell::new(0) };
+    /// Deallocations made by this thread while armed (for reports only).
+    static DEALLOCS: Cell<u64> = const { Cell::new(0) };
 }
 
 fn armed() -> bool {
     ARMED.try_with(Cell::get).unwrap_or(false)
 }
 
-fn count(counter: &AtomicU64) {
+fn count(counter: &'static LocalKey<Cell<u64>>) {
     if armed() {
-        counter.fetch_add(1, Ordering::Relaxed);
+        // During thread teardown the counter may be gone: nothing to count then.
+        let _ = counter.try_with(|c| c.set(c.get() + 1));
     }
+}
+
+fn read(counter: &'static LocalKey<Cell<u64>>) -> u64 {
+    counter.try_with(Cell::get).unwrap_or(0)
 }
 
 /// The counting allocator: forwards to [`System`], counting what an armed thread does.
@@ -108,11 +114,11 @@ pub struct Counts {
 /// ```
 pub fn arm() {
     ARMED.with(|a| a.set(true));
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let before = read(&ALLOCS);
     drop(std::hint::black_box(Box::new(0u64)));
-    let installed = ALLOCS.load(Ordering::SeqCst) > before;
-    ALLOCS.store(0, Ordering::SeqCst);
-    DEALLOCS.store(0, Ordering::SeqCst);
+    let installed = read(&ALLOCS) > before;
+    ALLOCS.with(|c| c.set(0));
+    DEALLOCS.with(|c| c.set(0));
     if !installed {
         ARMED.with(|a| a.set(false));
         panic!(
@@ -125,10 +131,7 @@ pub fn arm() {
 /// Disarms the counter; returns (allocations, deallocations) since [`arm`].
 pub fn disarm() -> (u64, u64) {
     ARMED.with(|a| a.set(false));
-    (
-        ALLOCS.load(Ordering::SeqCst),
-        DEALLOCS.load(Ordering::SeqCst),
-    )
+    (read(&ALLOCS), read(&DEALLOCS))
 }
 
 /// Runs `f` armed on this thread and returns what it allocated and freed.

@@ -334,6 +334,19 @@ fn measuring_input(
         None => None,
         Some(x) => Some(sensor(s, i, axis, &m.axis, x)?),
     };
+    // Through a drive's touch probe the sensor is a mark in front of that drive's probe input.
+    let on_drive = matches!(s.axes[axis].drive, crate::cell::DriveConnection::Cia402(_));
+    if on_drive
+        && config.route == MeasuringRoute::Profidrive
+        && sensor.is_some_and(|x| x.axis != axis)
+    {
+        return Err(f((
+            "sensor.axis",
+            Problem::Invalid(
+                "a sensor in front of a drive's touch probe is on the input's own axis",
+            ),
+        )));
+    }
     let registration = match &m.registration {
         None => None,
         Some(r) => Some(registration(s, i, r)?),

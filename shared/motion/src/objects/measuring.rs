@@ -19,7 +19,9 @@
 //! [`MeasuringInput::step`] in the cycle that contains them (an edge later than `t1_ns` is kept
 //! and evaluated in the next cycle). The measured position is the axis position at
 //! `t* = t_edge - CorrectionTime` on the interpolated curve of the cycle that contains `t*`; the
-//! object keeps the motion of the last [`HISTORY`] cycles for that. Values on modulo axes are
+//! object keeps the motion of the last [`HISTORY`] cycles for that. An edge that carries the
+//! position the hardware latched ([`InputEdge::latched`], a drive's touch probe: route
+//! PROFIdrive, the drive latches the position) is measured at that position. Values on modulo axes are
 //! reported reduced into the modulo range.
 //!
 //! Jobs (one active per object; a new one aborts the running one, S7-1500T Measuring input and cam
@@ -765,7 +767,8 @@ impl MeasuringInput {
         if e.time_ns < self.effective_from_ns {
             return None;
         }
-        let Some(p) = self.position_at(motion, e.time_ns) else {
+        // A position latched by the hardware (a drive's touch probe) is the measured value.
+        let Some(p) = e.latched.or_else(|| self.position_at(motion, e.time_ns)) else {
             self.status.edges_not_evaluated += 1;
             self.status.alarm = Some(AlarmInstance::new(
                 AlarmId::MeasuringEdgeNotEvaluated,

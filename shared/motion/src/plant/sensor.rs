@@ -6,12 +6,16 @@ use crate::kinematics::cycle_motion::AxisMotion;
 use crate::kinematics::timed_list::{Timed, TimedList};
 
 /// One timestamped edge of a digital input.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
 pub struct InputEdge {
     /// Time of the edge (ns, cell clock).
     pub time_ns: i64,
     /// Rising (`true`) or falling edge.
     pub rising: bool,
+    /// The axis position the hardware latched at the edge (a drive's touch probe), in the
+    /// axis's coordinate; `None`: the measuring input takes the position at `time_ns` from the
+    /// axis's motion.
+    pub latched: Option<f64>,
 }
 
 /// Capacity of an [`InputEdges`] buffer.
@@ -126,6 +130,7 @@ impl SimulatedSensor {
                 crossings.push(InputEdge {
                     time_ns: motion.ns(t),
                     rising: entering,
+                    latched: None,
                 });
                 true
             });
@@ -135,6 +140,7 @@ impl SimulatedSensor {
             self.pending.push(InputEdge {
                 time_ns: e.time_ns + j,
                 rising: e.rising,
+                latched: None,
             });
         }
         self.pending.sort();

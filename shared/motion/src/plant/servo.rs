@@ -575,6 +575,9 @@ pub struct SimServo {
     digital_inputs: u32,
     probes: [Probe; 2],
     edges: [Option<PendingEdge>; PROBE_EDGE_CAPACITY],
+    /// Marks on the load that switch the probe inputs: input `k` is high while the position
+    /// (increments) is within `marks[k]`.
+    marks: [Option<(f64, f64)>; 2],
 }
 
 impl SimServo {
@@ -608,7 +611,26 @@ impl SimServo {
             digital_inputs: 0,
             probes: [Probe::default(); 2],
             edges: [None; PROBE_EDGE_CAPACITY],
+            marks: [None; 2],
         })
+    }
+
+    /// Puts a mark on the load in front of touch probe input `probe` (1 or 2): the input is
+    /// high while the motor position is within `[low, high]` increments (a mark sensor), so
+    /// the input's edges are the crossings of `low` and `high`, latched at the exact crossing
+    /// (the counter value of the boundary). `None` removes it.
+    pub fn set_probe_mark(
+        &mut self,
+        probe: u8,
+        mark: Option<(f64, f64)>,
+    ) -> Result<(), SimServoError> {
+        let slot = match probe {
+            1 => &mut self.marks[0],
+            2 => &mut self.marks[1],
+            _ => return Err(SimServoError::NoSuchProbe { probe }),
+        };
+        *slot = mark.filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo <= hi);
+        Ok(())
     }
 
     /// The parameters.
@@ -812,11 +834,49 @@ impl SimServo {
                 let turn = from + d * self.counts_per_rad;
                 self.zero_pulses(from, turn);
                 self.zero_pulses(turn, to);
+                self.mark_edges(from, turn);
+                self.mark_edges(turn, to);
             }
-            None => self.zero_pulses(from, to),
+            None => {
+                self.zero_pulses(from, to);
+                self.mark_edges(from, to);
+            }
         }
         self.position = to;
         self.omega = e.omega;
+    }
+
+    /// Latches the edges of the probe inputs' marks crossed moving monotonically from `from`
+    /// to `to`, in the order they are crossed: entering a mark is the rising edge, leaving it
+    /// the falling one; the value is the counter value of the boundary crossed.
+    fn mark_edges(&mut self, from: f64, to: f64) {
+        if from == to {
+            return;
+        }
+        let inside = |m: (f64, f64), x: f64| x >= m.0 && x <= m.1;
+        for k in 0..2 {
+            let (Some(m), Some(probe)) = (self.marks[k], self.probes.get_mut(k)) else {
+                continue;
+            };
+            if !probe.enabled || probe.source() != touch_probe::SOURCE_INPUT {
+                continue;
+            }
+            let (was, is) = (inside(m, from), inside(m, to));
+            // Crossed boundaries in the order of travel.
+            let (first, second) = if to > from { (m.0, m.1) } else { (m.1, m.0) };
+            if !was && !is {
+                // Passed over the whole mark within the motion.
+                let over = (from < m.0 && to > m.1) || (from > m.1 && to < m.0);
+                if over {
+                    probe.latch(true, counter(first));
+                    probe.latch(false, counter(second));
+                }
+            } else if !was && is {
+                probe.latch(true, counter(first));
+            } else if was && !is {
+                probe.latch(false, counter(second));
+            }
+        }
     }
 
     /// Latches the zero pulses crossed moving monotonically from `from` to `to` (a pulse at

@@ -1653,6 +1653,11 @@ impl Axis {
         }
     }
 
+    /// The homing offset: axis position = physical position + this.
+    pub fn position_offset(&self) -> f64 {
+        self.offset
+    }
+
     /// Connects the axis to a drive behind the process image instead of its simulated drive.
     /// The drive's inputs are then set before each cycle ([`Axis::set_drive_inputs`]) and its
     /// outputs read after it ([`Axis::drive_outputs`]).
