@@ -602,7 +602,10 @@ impl Cell {
 
     /// The signal named `name`.
     pub fn signal(&self, name: &str) -> Option<SignalIndex> {
-        self.signals.iter().position(|s| s.name == name).map(SignalIndex)
+        self.signals
+            .iter()
+            .position(|s| s.name == name)
+            .map(SignalIndex)
     }
 
     /// The index of the measuring input named `name`.

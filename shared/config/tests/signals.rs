@@ -168,7 +168,11 @@ fn a_channel_bound_to_two_signals_is_refused_at_the_second() {
 
 #[test]
 fn a_channel_out_of_range_is_refused() {
-    for (channel, text) in [(5, "channel = 5"), (0, "channel = 0"), (300, "channel = 300")] {
+    for (channel, text) in [
+        (5, "channel = 5"),
+        (0, "channel = 0"),
+        (300, "channel = 300"),
+    ] {
         let src = with("channel = 1", text);
         let (line, key, problem) = refused(&src);
         assert_eq!(key, "signals.valve.channel");
@@ -250,7 +254,13 @@ fn a_signal_on_a_drive_and_a_drive_on_an_output_are_refused() {
     assert_eq!(key, "signals.mark.device");
     assert_eq!(line, Some(line_of(&src, "device = \"servo\"", 0)));
     assert!(
-        matches!(&problem, Problem::DeviceKind { kind: "sim_servo", .. }),
+        matches!(
+            &problem,
+            Problem::DeviceKind {
+                kind: "sim_servo",
+                ..
+            }
+        ),
         "{problem:?}"
     );
     let src = with(

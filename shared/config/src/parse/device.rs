@@ -50,8 +50,7 @@ pub(super) fn devices(
                 if let Some(k) = output_key_given(d) {
                     return Err(at(k, Problem::NotForKind("sim_servo")));
                 }
-                let params =
-                    servo_params(d, nodes[node].cycle_ns).map_err(|(k, p)| at(k, p))?;
+                let params = servo_params(d, nodes[node].cycle_ns).map_err(|(k, p)| at(k, p))?;
                 SimServo::new(params).map_err(|e| {
                     cx.at_or_table(
                         &["devices", name, servo_key(e.field)],
@@ -64,9 +63,9 @@ pub(super) fn devices(
                 if let Some(k) = servo_key_given(d) {
                     return Err(at(k, Problem::NotForKind("sim_digital_output")));
                 }
-                DeviceKind::SimDigitalOutput(output_params(d).map_err(|(k, p)| {
-                    cx.at_or_table(&["devices", name, k], p)
-                })?)
+                DeviceKind::SimDigitalOutput(
+                    output_params(d).map_err(|(k, p)| cx.at_or_table(&["devices", name, k], p))?,
+                )
             }
         };
         out.push(DeviceEntry {
@@ -81,7 +80,9 @@ pub(super) fn devices(
 /// The parameters of a simulated digital output: `channels` (required, 1 to
 /// [`MAX_CHANNELS`]) and `timestamped` (default `false`).
 fn output_params(d: &DeviceSection) -> Result<DigitalOutputParams, super::FieldError> {
-    let n = d.channels.ok_or(("channels", Problem::Missing("channels")))?;
+    let n = d
+        .channels
+        .ok_or(("channels", Problem::Missing("channels")))?;
     let channels = u8::try_from(n)
         .ok()
         .filter(|n| (1..=MAX_CHANNELS).contains(n))
@@ -106,7 +107,10 @@ fn output_key_given(d: &DeviceSection) -> Option<&'static str> {
 /// The first key of a servo drive given on another kind of device.
 fn servo_key_given(d: &DeviceSection) -> Option<&'static str> {
     [
-        ("increments_per_revolution", d.increments_per_revolution.is_some()),
+        (
+            "increments_per_revolution",
+            d.increments_per_revolution.is_some(),
+        ),
         ("rated_torque", d.rated_torque.is_some()),
         ("max_torque", d.max_torque.is_some()),
         ("inertia", d.inertia.is_some()),
@@ -115,7 +119,10 @@ fn servo_key_given(d: &DeviceSection) -> Option<&'static str> {
         ("kv", d.kv.is_some()),
         ("velocity_gain", d.velocity_gain.is_some()),
         ("velocity_integral_time", d.velocity_integral_time.is_some()),
-        ("quick_stop_deceleration", d.quick_stop_deceleration.is_some()),
+        (
+            "quick_stop_deceleration",
+            d.quick_stop_deceleration.is_some(),
+        ),
         ("quick_stop_option", d.quick_stop_option.is_some()),
         ("following_error_window", d.following_error_window.is_some()),
         ("zero_pulse_offset", d.zero_pulse_offset.is_some()),

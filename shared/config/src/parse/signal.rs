@@ -104,13 +104,17 @@ impl Bindings<'_> {
         by: &mut [Option<String>],
     ) -> Result<SignalIndex, ConfigError> {
         let at = |p| cx.in_array(array, i, "output", p);
-        let k = self.signals.iter().position(|s| s.name == name).ok_or_else(|| {
-            at(Problem::Unknown {
-                what: "signal",
-                name: name.into(),
-                known: Some(self.signals.iter().map(|s| s.name.clone()).collect()),
-            })
-        })?;
+        let k = self
+            .signals
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| {
+                at(Problem::Unknown {
+                    what: "signal",
+                    name: name.into(),
+                    known: Some(self.signals.iter().map(|s| s.name.clone()).collect()),
+                })
+            })?;
         let device_node = self
             .signals
             .get(k)
