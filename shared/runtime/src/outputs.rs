@@ -18,7 +18,7 @@
 //! signal. With `e >= t - T - c`, `e + Λ >= t + T`: no edge is ever due before the boundary it
 //! is written at. The two cycles are the S7-1500T rule that switching times are computed two
 //! position-control cycles before the output (S7-1500T Measuring input and cam functions V5.0
-//! function manual, 3.2 'Output cam technology object'; 6 'Timing and accuracy'); they are also
+//! function manual, 3.2 'Output cam technology object'); they are also
 //! the two cycles of transport delay from a setpoint to the load on a drive of the process
 //! image ([`crate::drives`]), so an uncompensated setpoint cam switches when the load passes
 //! its position. Inferred: tandem has no trajectory prediction, so a compensation lengthens
@@ -39,7 +39,7 @@
 //!    - a plain device writes every edge due at or before `t`: each channel switches at `t` to
 //!      the level of its last edge; a channel whose edges cancel within the cycle does not
 //!      switch (the last one written wins, S7-1500T Measuring input and cam functions V5.0
-//!      function manual, 4.6 'Output limits', DQ module).
+//!      function manual, 3.3 'Cam track technology object', DQ module).
 //! 2. The step's edges join their devices' pending events, due at `e + Λ`.
 //!
 //! Every switch is recorded ([`OutputSwitch`]) with the instant the channel changed, for tests
