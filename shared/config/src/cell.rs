@@ -141,6 +141,58 @@ pub struct DeviceEntry {
 pub enum DeviceKind {
     /// A simulated CiA 402 servo drive (`kind = "sim_servo"`).
     SimServo(tandem_motion::plant::servo::ServoParams),
+    /// A simulated digital output terminal (`kind = "sim_digital_output"`).
+    SimDigitalOutput(DigitalOutputParams),
+}
+
+impl DeviceKind {
+    /// The kind's name in the cell file.
+    pub fn name(&self) -> &'static str {
+        match self {
+            DeviceKind::SimServo(_) => "sim_servo",
+            DeviceKind::SimDigitalOutput(_) => "sim_digital_output",
+        }
+    }
+}
+
+/// Most channels of a digital output device.
+pub const MAX_CHANNELS: u8 = 32;
+
+/// A simulated digital output terminal: `channels` outputs, switched at a given time
+/// (`timestamped`, like an EL2252 of the EtherCAT terminal range, its `StartTime`) or at the
+/// cycle boundary (like an EL2008).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct DigitalOutputParams {
+    /// Number of channels, 1 to [`MAX_CHANNELS`].
+    pub channels: u8,
+    /// The channels switch at a given time (one switching event per cycle and terminal).
+    pub timestamped: bool,
+}
+
+/// Index of a signal in [`Cell::signals`].
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SignalIndex(pub usize);
+
+/// The type of a signal, given by its channel.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum SignalType {
+    /// A digital output switched at the cycle boundary.
+    Bool,
+    /// A digital output switched at a given time (the edge time goes with it).
+    TimestampedBool,
+}
+
+/// A named signal of the cell (`[signals.<name>]`), bound to one channel of one device.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SignalEntry {
+    /// Name (unique among signals).
+    pub name: String,
+    /// The device.
+    pub device: DeviceIndex,
+    /// The channel, 1-based.
+    pub channel: u8,
+    /// Its type, from the channel.
+    pub signal_type: SignalType,
 }
 
 /// How an axis reaches its drive (`[axes.<name>.drive] type`).
@@ -265,6 +317,8 @@ pub struct OutputCamEntry {
     pub axis: AxisIndex,
     /// Engine configuration.
     pub config: tandem_motion::objects::output_cam::OutputCamConfig,
+    /// The digital output signal it drives, if any.
+    pub output: Option<SignalIndex>,
 }
 
 /// A cam track of the cell (`[[cam_tracks]]`).
@@ -278,6 +332,8 @@ pub struct CamTrackEntry {
     pub config: tandem_motion::objects::cam_track::CamTrackConfig,
     /// Track data (reference, length, cams).
     pub data: tandem_motion::objects::cam_track::CamTrackData,
+    /// The digital output signal its track output drives, if any.
+    pub output: Option<SignalIndex>,
 }
 
 /// A simulated mark sensor on a measuring input.
@@ -376,6 +432,8 @@ pub struct Cell {
     pub measuring_inputs: Vec<MeasuringInputEntry>,
     /// The devices of the nodes' process images, in name order.
     pub devices: Vec<DeviceEntry>,
+    /// The named signals, in name order.
+    pub signals: Vec<SignalEntry>,
 }
 
 impl Cell {
@@ -540,6 +598,14 @@ impl Cell {
     /// The index of the cam track named `name`.
     pub fn cam_track(&self, name: &str) -> Option<usize> {
         self.cam_tracks.iter().position(|c| c.name == name)
+    }
+
+    /// The signal named `name`.
+    pub fn signal(&self, name: &str) -> Option<SignalIndex> {
+        self.signals
+            .iter()
+            .position(|s| s.name == name)
+            .map(SignalIndex)
     }
 
     /// The index of the measuring input named `name`.

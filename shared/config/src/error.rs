@@ -191,6 +191,51 @@ pub enum Problem {
     Mechanics(Box<tandem_motion::plant::mechanics::MechanicsError>),
     /// Parameters of a simulated servo drive that the model refuses.
     Servo(Box<tandem_motion::plant::servo::ServoParamsError>),
+    /// A key of `[devices.<name>]` that the device's kind does not have.
+    NotForKind(&'static str),
+    /// A device of the wrong kind for what refers to it.
+    DeviceKind {
+        /// The device.
+        device: String,
+        /// Its kind.
+        kind: &'static str,
+        /// What the key needs (`a drive (sim_servo)`).
+        needs: &'static str,
+    },
+    /// A signal's channel that the device does not have.
+    ChannelRange {
+        /// The device.
+        device: String,
+        /// The channel given.
+        channel: u32,
+        /// The device's channels (1 to this).
+        channels: u8,
+    },
+    /// A channel already bound to another signal.
+    ChannelTaken {
+        /// The device.
+        device: String,
+        /// The channel.
+        channel: u8,
+        /// The signal it is bound to.
+        signal: String,
+    },
+    /// An object driving a signal of another node's process image.
+    SignalNode {
+        /// The signal.
+        signal: String,
+        /// The node of the signal's device.
+        signal_node: String,
+        /// The node of the object's axis.
+        object_node: String,
+    },
+    /// A signal already driven by another object.
+    SignalDriven {
+        /// The signal.
+        signal: String,
+        /// The object that drives it.
+        by: String,
+    },
 }
 
 /// A leading-value delay shorter than the link from a leader to a follower on another node
@@ -295,6 +340,40 @@ impl fmt::Display for Problem {
             ),
             Problem::DeviceTaken { device, axis } => {
                 write!(f, "device `{device}` already drives axis `{axis}`")
+            }
+            Problem::NotForKind(kind) => write!(f, "not a key of a `{kind}` device"),
+            Problem::DeviceKind {
+                device,
+                kind,
+                needs,
+            } => write!(f, "device `{device}` is a `{kind}`; this needs {needs}"),
+            Problem::ChannelRange {
+                device,
+                channel,
+                channels,
+            } => write!(
+                f,
+                "channel {channel} of device `{device}`: it has channels 1 to {channels}"
+            ),
+            Problem::ChannelTaken {
+                device,
+                channel,
+                signal,
+            } => write!(
+                f,
+                "channel {channel} of device `{device}` is already bound to signal `{signal}`"
+            ),
+            Problem::SignalNode {
+                signal,
+                signal_node,
+                object_node,
+            } => write!(
+                f,
+                "signal `{signal}` is in the process image of node `{signal_node}`, the object \
+                 runs on node `{object_node}`: an object drives only signals of its own node"
+            ),
+            Problem::SignalDriven { signal, by } => {
+                write!(f, "signal `{signal}` is already driven by `{by}`")
             }
             Problem::Mechanics(e) => write!(f, "{e}"),
             Problem::Servo(e) => write!(f, "{e}"),

@@ -54,9 +54,9 @@ pub mod script;
 
 pub use cell::{
     AxisEntry, AxisIndex, CamEntry, CamTrackEntry, Cell, Cia402Connection, Coupling, DeviceEntry,
-    DeviceIndex, DeviceKind, DriveConnection, EncoderEntry, EncoderIndex, EncoderSource, Leader,
-    LeadingValueConfig, MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration,
-    SensorEntry, LEADING_BUFFER,
+    DeviceIndex, DeviceKind, DigitalOutputParams, DriveConnection, EncoderEntry, EncoderIndex,
+    EncoderSource, Leader, LeadingValueConfig, MeasuringInputEntry, Node, OutputCamEntry, Realtime,
+    Registration, SensorEntry, SignalEntry, SignalIndex, SignalType, LEADING_BUFFER, MAX_CHANNELS,
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};

@@ -37,6 +37,9 @@ pub struct CellFile {
     /// `[devices.<name>]`: the devices of the nodes' process images.
     #[serde(default)]
     pub devices: BTreeMap<String, DeviceSection>,
+    /// `[signals.<name>]`: named signals, each bound to a channel of a device.
+    #[serde(default)]
+    pub signals: BTreeMap<String, SignalSection>,
 }
 
 /// `[devices.<name>]`: a device in a node's process image. Its kind says which keys it has;
@@ -46,7 +49,8 @@ pub struct CellFile {
 pub struct DeviceSection {
     /// The node whose process image holds it.
     pub node: String,
-    /// `sim_servo`: a simulated CiA 402 servo drive.
+    /// `sim_servo`: a simulated CiA 402 servo drive; `sim_digital_output`: a simulated digital
+    /// output terminal.
     pub kind: String,
     /// sim_servo: increments per motor revolution of its position actual value (0x6064).
     pub increments_per_revolution: Option<u32>,
@@ -75,6 +79,22 @@ pub struct DeviceSection {
     pub following_error_window: Option<u32>,
     /// sim_servo: increment offset of the encoder zero pulse within a revolution.
     pub zero_pulse_offset: Option<u32>,
+    /// sim_digital_output: the number of channels, 1 to 32 (required).
+    pub channels: Option<u32>,
+    /// sim_digital_output: `true` switches each channel at a given time (a timestamped output
+    /// like an EL2252, one switching event per cycle); `false` (default) at the cycle boundary.
+    pub timestamped: Option<bool>,
+}
+
+/// `[signals.<name>]`: a named signal on a channel of a device. Its type comes from the
+/// channel: `bool` on a plain digital output, `timestamped bool` on a timestamped one.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SignalSection {
+    /// The device (`[devices.<name>]`).
+    pub device: String,
+    /// The channel, 1-based.
+    pub channel: u32,
 }
 
 /// `encoder`: the encoder type alone (`encoder = "absolute"`), or the table
@@ -253,6 +273,8 @@ pub struct OutputCamSection {
     /// Time cams: cycles after the enable before a start crossing switches (default 2).
     #[serde(default = "d_arming")]
     pub arming_cycles: u32,
+    /// The digital output signal it drives (`[signals.<name>]`), if any.
+    pub output: Option<String>,
 }
 
 fn d_software() -> String {
@@ -301,6 +323,8 @@ pub struct CamTrackSection {
     /// The cams (up to 32), relative to the track start.
     #[serde(default)]
     pub cams: Vec<TrackCamSection>,
+    /// The digital output signal its track output drives (`[signals.<name>]`), if any.
+    pub output: Option<String>,
 }
 
 /// One cam of a track.

@@ -69,7 +69,9 @@ fn an_axis_on_a_simulated_cia402_drive_with_its_mechanics() {
     let c = parse("cell.toml", CELL).unwrap();
     assert_eq!(c.devices.len(), 2);
     assert_eq!(c.devices[0].name, "servo1");
-    let DeviceKind::SimServo(p) = &c.devices[0].kind;
+    let DeviceKind::SimServo(p) = &c.devices[0].kind else {
+        panic!("{:?}", c.devices[0].kind);
+    };
     assert_eq!(p.increments_per_revolution, 1 << 20);
     assert_eq!(p.cycle_ns, 1_000_000, "the node's cycle");
     let DriveConnection::Cia402(d) = &c.axes[0].drive else {

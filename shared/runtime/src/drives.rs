@@ -136,7 +136,10 @@ impl Drives {
             let Some(dev) = cell.devices.get(c.device.0) else {
                 continue;
             };
-            let DeviceKind::SimServo(params) = &dev.kind;
+            let DeviceKind::SimServo(params) = &dev.kind else {
+                // Refused by the configuration: an axis's drive is a servo.
+                continue;
+            };
             // The motor starts where the axis's initial position puts it.
             let start = f64::from(c.scaling.drive_increments(a.config.initial_position));
             let servo = SimServo::new(ServoParams {

@@ -15,9 +15,11 @@
 use crate::drives::Drives;
 use crate::error::ExecError;
 pub use crate::notes::{seconds, Describe, IoNote, JobNote, Secs, NOTES};
+pub use crate::outputs::{OutputDeviceStatus, OutputSwitch, LOOK_AHEAD_CYCLES, SWITCHES};
 
 use crate::notes::keep;
 use crate::objects::{cycle_motion, CycleMotion, Objects};
+use crate::outputs::Outputs;
 use std::io::{self, Write};
 use std::sync::Arc;
 use tandem_config::{
@@ -466,6 +468,8 @@ pub struct Executive<'c> {
     pub rejected: usize,
     /// The drives of the process image and the axes on them.
     drives: Drives,
+    /// The digital outputs of the process image and the objects driving them.
+    outputs: Outputs,
 }
 
 impl<'c> Executive<'c> {
@@ -500,6 +504,7 @@ impl<'c> Executive<'c> {
         let encoder_status = encoders.iter().map(|e| *e.status()).collect();
         Ok(Self {
             drives,
+            outputs: Outputs::new(cell, node),
             cell,
             objects: Objects::new(cell)?,
             owned,
@@ -845,8 +850,9 @@ impl<'c> Executive<'c> {
 
     /// One step at time `t` (a multiple of [`Executive::tick_ns`]): encoders, then axes in
     /// dependency order (leaders first), then the objects of each axis with the motion of its
-    /// cycle, then register corrections. Job events, alarms, output edges and measured values
-    /// are written to `log`.
+    /// cycle, then the output stage (the objects' edges to their digital outputs), then
+    /// register corrections. Job events, alarms, output edges and measured values are written
+    /// to `log`.
     pub fn step(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         self.step_encoders(t, log)?;
         self.record_samples(t, true);
@@ -861,6 +867,7 @@ impl<'c> Executive<'c> {
         self.log_missing(t, log)?;
         self.axis_events(t, log)?;
         self.step_objects(t, log)?;
+        self.outputs.step(t, &mut self.objects.out.output_edges);
         self.register_corrections(t, log)
     }
 
@@ -924,6 +931,20 @@ impl<'c> Executive<'c> {
         device: usize,
     ) -> Option<&tandem_motion::plant::cia402::DriveFeedback> {
         self.drives.feedback(device)
+    }
+
+    /// The state of simulated digital output device `device` (index in [`Cell::devices`]), if
+    /// this executive runs it: its channels' levels, the task it holds, its look-ahead and
+    /// counters.
+    pub fn output_device(&self, device: usize) -> Option<&OutputDeviceStatus> {
+        self.outputs.status(device)
+    }
+
+    /// Hands each switch of an output device's channel since the last call to `f` (what the
+    /// device physically did, in order of the boundaries that processed them), then forgets
+    /// them.
+    pub fn drain_output_switches(&mut self, f: impl FnMut(&OutputSwitch)) {
+        self.outputs.drain(f);
     }
 
     /// External encoders first: they lead and follow nothing. An encoder on an axis reads that

@@ -55,6 +55,7 @@ mod error;
 pub mod exec;
 mod notes;
 mod objects;
+mod outputs;
 pub mod sim;
 
 pub use error::{ExecError, SimError};

@@ -157,11 +157,24 @@ pub(crate) struct SimInput {
     logged: (u32, i64, u32, i64, bool),
 }
 
+/// An output edge of an output cam or cam track, for the output stage
+/// ([`crate::outputs`]).
+#[derive(Copy, Clone, Debug)]
+pub(crate) struct ObjectEdge {
+    /// The object, numbered as [`IoNote::object`] (output cams, then cam tracks).
+    pub(crate) object: usize,
+    /// The edge, with its exact time.
+    pub(crate) edge: tandem_motion::objects::output_cam::Edge,
+}
+
 /// What the objects' steps produce besides the log, shared by all objects of a step.
 #[derive(Debug)]
 pub(crate) struct StepOutput {
     /// The edges of the output cam or cam track being stepped.
     edges: CamEdges,
+    /// The output edges of every object stepped since the output stage last took them (room
+    /// for one step of every output cam and cam track).
+    pub(crate) output_edges: Vec<ObjectEdge>,
     /// Output edges and measured values of the current step.
     pub(crate) notes: Vec<IoNote>,
     /// Notes dropped (more than [`NOTES`] in one step).
@@ -503,6 +516,7 @@ fn step_kind<T: CycleObject>(
         if T::axis(e) != c.axis {
             continue;
         }
+        out.edges.clear();
         let t_alarm = o.step(e, motion, c.motions, &mut out.edges);
         if let Some(last) = out.alarms.get_mut(first + k) {
             log_alarm(log, t_alarm, T::name(e), last, o.alarm())?;
@@ -518,6 +532,13 @@ fn step_kind<T: CycleObject>(
             corrections: &mut out.corrections,
         };
         o.report(e, &mut r, log)?;
+        // The edges go to the output stage; there is room for one step of every object.
+        for &edge in out.edges.as_slice() {
+            if out.output_edges.len() < out.output_edges.capacity() {
+                let object = first + k;
+                out.output_edges.push(ObjectEdge { object, edge });
+            }
+        }
     }
     Ok(())
 }
@@ -575,6 +596,10 @@ impl Objects {
             row: String::new(),
             out: StepOutput {
                 edges: CamEdges::default(),
+                output_edges: Vec::with_capacity(
+                    (cell.output_cams.len() + cell.cam_tracks.len())
+                        * tandem_motion::objects::output_cam::EDGE_CAPACITY,
+                ),
                 corrections: Vec::with_capacity(cell.measuring_inputs.len()),
                 notes: Vec::with_capacity(NOTES),
                 notes_dropped: 0,

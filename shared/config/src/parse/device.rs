@@ -1,10 +1,12 @@
-//! `[devices.<name>]` and the drive connection of each axis (`[axes.<name>.drive]`,
-//! `[axes.<name>.encoder]`, `[axes.<name>.mechanics]`): which device of which node's process
-//! image drives the axis, and how the drive's increments become the axis's units.
+//! `[devices.<name>]` (simulated servo drives and digital outputs) and the drive connection of
+//! each axis (`[axes.<name>.drive]`, `[axes.<name>.encoder]`, `[axes.<name>.mechanics]`): which
+//! device of which node's process image drives the axis, and how the drive's increments become
+//! the axis's units.
 
 use super::{node_named, pick, Ctx};
 use crate::cell::{
-    AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind, DriveConnection, Node,
+    AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind, DigitalOutputParams,
+    DriveConnection, Node, MAX_CHANNELS,
 };
 use crate::error::{ConfigError, Problem};
 use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
@@ -14,8 +16,18 @@ use tandem_motion::plant::mechanics::{
 };
 use tandem_motion::plant::servo::{ServoParams, SimServo};
 
+/// The kinds of device.
+#[derive(Copy, Clone)]
+enum Kind {
+    Servo,
+    DigitalOutput,
+}
+
 /// The device kinds by name.
-const DEVICE_KINDS: [(&str, ()); 1] = [("sim_servo", ())];
+const DEVICE_KINDS: [(&str, Kind); 2] = [
+    ("sim_servo", Kind::Servo),
+    ("sim_digital_output", Kind::DigitalOutput),
+];
 
 /// The encoder mountings by name (S7 `Sensor[n].MountingMode` 0, 1, 2).
 const MOUNTINGS: [(&str, ()); 3] = [("motor_shaft", ()), ("load_side", ()), ("external", ())];
@@ -32,22 +44,92 @@ pub(super) fn devices(
     let mut out = Vec::new();
     for (name, d) in &raw.devices {
         let node = node_named(cx, nodes, &d.node, &["devices", name, "node"])?;
-        pick("kind", &d.kind, &DEVICE_KINDS).map_err(|(k, p)| cx.at(&["devices", name, k], p))?;
-        let params = servo_params(d, nodes[node].cycle_ns)
-            .map_err(|(k, p)| cx.at(&["devices", name, k], p))?;
-        SimServo::new(params).map_err(|e| {
-            cx.at_or_table(
-                &["devices", name, servo_key(e.field)],
-                Problem::Servo(Box::new(e)),
-            )
-        })?;
+        let at = |k: &str, p| cx.at(&["devices", name, k], p);
+        let kind = match pick("kind", &d.kind, &DEVICE_KINDS).map_err(|(k, p)| at(k, p))? {
+            Kind::Servo => {
+                if let Some(k) = output_key_given(d) {
+                    return Err(at(k, Problem::NotForKind("sim_servo")));
+                }
+                let params = servo_params(d, nodes[node].cycle_ns).map_err(|(k, p)| at(k, p))?;
+                SimServo::new(params).map_err(|e| {
+                    cx.at_or_table(
+                        &["devices", name, servo_key(e.field)],
+                        Problem::Servo(Box::new(e)),
+                    )
+                })?;
+                DeviceKind::SimServo(params)
+            }
+            Kind::DigitalOutput => {
+                if let Some(k) = servo_key_given(d) {
+                    return Err(at(k, Problem::NotForKind("sim_digital_output")));
+                }
+                DeviceKind::SimDigitalOutput(
+                    output_params(d).map_err(|(k, p)| cx.at_or_table(&["devices", name, k], p))?,
+                )
+            }
+        };
         out.push(DeviceEntry {
             name: name.clone(),
             node,
-            kind: DeviceKind::SimServo(params),
+            kind,
         });
     }
     Ok(out)
+}
+
+/// The parameters of a simulated digital output: `channels` (required, 1 to
+/// [`MAX_CHANNELS`]) and `timestamped` (default `false`).
+fn output_params(d: &DeviceSection) -> Result<DigitalOutputParams, super::FieldError> {
+    let n = d
+        .channels
+        .ok_or(("channels", Problem::Missing("channels")))?;
+    let channels = u8::try_from(n)
+        .ok()
+        .filter(|n| (1..=MAX_CHANNELS).contains(n))
+        .ok_or(("channels", Problem::Invalid("must be 1 to 32")))?;
+    Ok(DigitalOutputParams {
+        channels,
+        timestamped: d.timestamped.unwrap_or(false),
+    })
+}
+
+/// The first key of a digital output given on a servo drive.
+fn output_key_given(d: &DeviceSection) -> Option<&'static str> {
+    if d.channels.is_some() {
+        Some("channels")
+    } else if d.timestamped.is_some() {
+        Some("timestamped")
+    } else {
+        None
+    }
+}
+
+/// The first key of a servo drive given on another kind of device.
+fn servo_key_given(d: &DeviceSection) -> Option<&'static str> {
+    [
+        (
+            "increments_per_revolution",
+            d.increments_per_revolution.is_some(),
+        ),
+        ("rated_torque", d.rated_torque.is_some()),
+        ("max_torque", d.max_torque.is_some()),
+        ("inertia", d.inertia.is_some()),
+        ("viscous_friction", d.viscous_friction.is_some()),
+        ("coulomb_friction", d.coulomb_friction.is_some()),
+        ("kv", d.kv.is_some()),
+        ("velocity_gain", d.velocity_gain.is_some()),
+        ("velocity_integral_time", d.velocity_integral_time.is_some()),
+        (
+            "quick_stop_deceleration",
+            d.quick_stop_deceleration.is_some(),
+        ),
+        ("quick_stop_option", d.quick_stop_option.is_some()),
+        ("following_error_window", d.following_error_window.is_some()),
+        ("zero_pulse_offset", d.zero_pulse_offset.is_some()),
+    ]
+    .into_iter()
+    .find(|(_, given)| *given)
+    .map(|(k, _)| k)
 }
 
 /// The key of `[devices.<name>]` that sets a [`ServoParams`] field.
@@ -144,6 +226,16 @@ pub(super) fn drives(
                 )
             })?;
         let dev = &devices[k];
+        let DeviceKind::SimServo(servo) = &dev.kind else {
+            return Err(at(
+                &["drive", "device"],
+                Problem::DeviceKind {
+                    device: dev.name.clone(),
+                    kind: dev.kind.name(),
+                    needs: "a drive (`sim_servo`)",
+                },
+            ));
+        };
         if dev.node != entry.node {
             return Err(at(
                 &["drive", "device"],
@@ -176,7 +268,7 @@ pub(super) fn drives(
                 .map_err(|(_, p)| at(&["encoder", "mounting"], p))?;
         }
         let scaling =
-            scaling(a, dev).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+            scaling(a, servo).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
         entry.drive = DriveConnection::Cia402(Box::new(Cia402Connection {
             device: DeviceIndex(k),
             enable_timeout_ns: (timeout * 1e9).round() as i64,
@@ -204,12 +296,12 @@ fn only_with_a_drive(a: &AxisSection) -> Result<(), &'static [&'static str]> {
     Ok(())
 }
 
-/// The axis's encoder and mechanics on drive `dev`, validated; an error names the key.
+/// The axis's encoder and mechanics on the drive with parameters `servo`, validated; an error
+/// names the key.
 fn scaling(
     a: &AxisSection,
-    dev: &DeviceEntry,
+    servo: &ServoParams,
 ) -> Result<Scaling, (Vec<&'static str>, MechanicsError)> {
-    let DeviceKind::SimServo(servo) = &dev.kind;
     let default_table;
     let table = match &a.encoder {
         EncoderSpec::Table(t) => t,

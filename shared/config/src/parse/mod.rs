@@ -1,12 +1,13 @@
 //! The cell file to a validated [`Cell`]: one function per section of the file, in the order
 //! the sections depend on each other (cell, hosts, nodes, axes, leaders, encoders, cams,
-//! leading values, output cams, cam tracks, measuring inputs).
+//! leading values, output cams, cam tracks, measuring inputs, the signals they drive).
 
 mod axis;
 mod cam;
 mod device;
 mod encoder;
 mod objects;
+mod signal;
 
 use crate::cell::{
     AxisEntry, AxisIndex, Cell, Coupling, DriveConnection, Leader, LeadingValueConfig, Node,
@@ -164,7 +165,21 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     let mut encoders = encoder::encoders(cx, &raw, &axes, &nodes)?;
     let cams = cam::cams(cx, &raw, dir)?;
     leading_values(cx, &raw, &mut axes, &mut encoders, &nodes)?;
-    let objects = objects::objects(cx, &raw, &axes, &nodes)?;
+    let signals = signal::signals(cx, &raw, &devices)?;
+    let mut objects = objects::objects(cx, &raw, &axes, &nodes)?;
+    let bindings = signal::Bindings {
+        nodes: &nodes,
+        axes: &axes,
+        devices: &devices,
+        signals: &signals,
+    };
+    signal::outputs(
+        cx,
+        &raw,
+        &bindings,
+        &mut objects.output_cams,
+        &mut objects.cam_tracks,
+    )?;
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: raw.cell.base_tick_us as i64 * 1000,
@@ -186,6 +201,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         cam_tracks: objects.cam_tracks,
         measuring_inputs: objects.measuring_inputs,
         devices,
+        signals,
     })
 }
 

@@ -189,6 +189,7 @@ fn output_cam(
         name: c.name.clone(),
         axis,
         config,
+        output: None,
     })
 }
 
@@ -256,6 +257,7 @@ fn cam_track(
         axis,
         config,
         data,
+        output: None,
     })
 }
 
