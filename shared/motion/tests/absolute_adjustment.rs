@@ -57,7 +57,7 @@ impl Bench {
         self.axis.status().status_word & status_bit::HOMING_DONE != 0
     }
 
-    fn position(&self) -> f64 {
+    fn actual(&self) -> f64 {
         self.axis.status().actual_position
     }
 
@@ -106,10 +106,10 @@ fn a_restored_adjustment_homes_the_axis_at_the_retained_offset() {
     );
     // Shown at once (the status between cycles) and from the first cycle on.
     assert!(b.homed());
-    assert_eq!(b.position(), PHYS + 100.0);
+    assert_eq!(b.actual(), PHYS + 100.0);
     b.step(3);
     assert!(b.homed());
-    assert_eq!(b.position(), PHYS + 100.0);
+    assert_eq!(b.actual(), PHYS + 100.0);
     assert_eq!(
         b.axis.status().position,
         PHYS + 100.0,
@@ -118,7 +118,7 @@ fn a_restored_adjustment_homes_the_axis_at_the_retained_offset() {
     // A restart keeps a retained adjustment (S7: Homed of an absolute encoder survives it).
     b.restart();
     assert!(b.homed());
-    assert_eq!(b.position(), PHYS + 100.0);
+    assert_eq!(b.actual(), PHYS + 100.0);
     assert_eq!(b.axis.absolute_offset(), after, "a restart changes nothing");
 }
 
@@ -134,7 +134,7 @@ fn nothing_retained_leaves_the_axis_not_homed_across_restarts() {
     assert!(!a.adjusted && a.offset == 0.0 && a.changes == 1, "{a:?}");
     b.step(2);
     assert!(!b.homed());
-    assert_eq!(b.position(), PHYS);
+    assert_eq!(b.actual(), PHYS);
     b.restart();
     assert!(
         !b.homed(),
@@ -144,12 +144,12 @@ fn nothing_retained_leaves_the_axis_not_homed_across_restarts() {
     b.power(true);
     b.home(0, 3.0).unwrap();
     assert!(b.homed());
-    assert_eq!(b.position(), 3.0);
+    assert_eq!(b.actual(), 3.0);
     assert_eq!(b.axis.absolute_offset(), a, "mode 0 is not retained");
     b.power(false);
     b.restart();
     assert!(!b.homed());
-    assert_eq!(b.position(), PHYS);
+    assert_eq!(b.actual(), PHYS);
 }
 
 #[test]
@@ -166,15 +166,15 @@ fn mc_home_6_and_7_change_the_adjustment_and_count_each_change() {
     // Known answer: the drive stands at 12.5, the axis is to read 40.
     assert_eq!((a.offset, a.adjusted, a.changes), (27.5, true, 2));
     assert!(b.homed());
-    assert_eq!(b.position(), 40.0);
+    assert_eq!(b.actual(), 40.0);
     b.home(6, -2.5).unwrap();
     let a = b.axis.absolute_offset();
     assert_eq!((a.offset, a.adjusted, a.changes), (25.0, true, 3));
-    assert_eq!(b.position(), 37.5);
+    assert_eq!(b.actual(), 37.5);
     // Modes 0 and 1 shift the axis but leave the adjustment (and its counter) alone.
     b.home(0, 1.0).unwrap();
     b.home(1, 1.0).unwrap();
-    assert_eq!(b.position(), 2.0);
+    assert_eq!(b.actual(), 2.0);
     assert_eq!(b.axis.absolute_offset(), a);
     // The same position again is still a change (the runtime stores it again).
     b.home(7, 37.5).unwrap();
@@ -184,7 +184,7 @@ fn mc_home_6_and_7_change_the_adjustment_and_count_each_change() {
     b.power(false);
     b.restart();
     assert!(b.homed());
-    assert_eq!(b.position(), 37.5);
+    assert_eq!(b.actual(), 37.5);
 }
 
 #[test]
@@ -215,7 +215,7 @@ fn a_restore_is_refused_and_changes_nothing_when_it_cannot_apply() {
     );
     assert_eq!(b.axis.absolute_offset(), a);
     assert!(b.homed());
-    assert_eq!(b.position(), PHYS + 5.0);
+    assert_eq!(b.actual(), PHYS + 5.0);
     for e in [
         RestoreOffsetError::Incremental,
         RestoreOffsetError::Enabled,
