@@ -7,7 +7,7 @@
 //! node's health ([`NodeHealth`]), never dropped unseen.
 
 use crate::commands::{Done, Queued};
-use crate::logring::{DiagRecord, LogRing, TextWriter};
+use crate::logring::{DiagRecord, LogRing, Record, TextWriter};
 use crate::owns;
 use crate::ports::Ports;
 use crate::report::{cpu_time_ns, Report};
@@ -43,8 +43,9 @@ pub(crate) struct Links {
     pub(crate) commands: Receiver<Queued>,
     /// Their results, back to the command thread.
     pub(crate) done: SyncSender<Done>,
-    /// Log lines and job events, to the recorder thread (which emits them through `tracing`).
-    pub(crate) diag: SyncSender<DiagRecord>,
+    /// Log lines and job events, to the recorder thread (which emits them through `tracing`),
+    /// and changed retained data (which it stores).
+    pub(crate) diag: SyncSender<Record>,
     /// Trace rows, when a trace is written.
     pub(crate) rows: Option<RowPool>,
 }
@@ -201,6 +202,7 @@ impl<'c> NodeCycle<'c> {
             // The end state for observers, whatever the telemetry rate.
             self.telemetry();
         }
+        self.hand_over_last_adjustments();
         self.report.wall_ns = rt::now_ns() - started;
         if let Some((process, thread)) = cpu0 {
             self.report.cpu_ns = cpu_time_ns() - process;
@@ -260,7 +262,8 @@ impl<'c> NodeCycle<'c> {
     }
 
     /// Publish: leading values, the published event, output edges and measured values, job
-    /// events and log lines (these two also to the recorder).
+    /// events and log lines (these two also to the recorder), changed retained data (to the
+    /// recorder).
     fn publish(&mut self, t: i64) {
         let mut failed = 0u64;
         for x in &mut self.ports.leaders_out {
@@ -300,6 +303,28 @@ impl<'c> NodeCycle<'c> {
         self.health.diag_dropped += dropped;
         self.hand_over_jobs();
         self.hand_over_log(t);
+        self.hand_over_adjustments();
+    }
+
+    /// Hands the axes' changed retained data (absolute encoder adjustments) to the recorder,
+    /// which stores it. A change the full channel refuses is counted and offered again the
+    /// next cycle, so the newest is always stored in the end.
+    fn hand_over_adjustments(&mut self) {
+        let (diag, dropped) = (&self.links.diag, &mut self.health.diag_dropped);
+        self.exec.take_adjustments(|c| {
+            let sent = diag.try_send(Record::Retain(c)).is_ok();
+            *dropped += u64::from(!sent);
+            sent
+        });
+    }
+
+    /// After the last cycle (off the cyclic path): hands over what the last cycles could not,
+    /// waiting for room; the recorder drains the channel until the node stops.
+    fn hand_over_last_adjustments(&mut self) {
+        let diag = &self.links.diag;
+        // `send` fails only when the recorder is gone: then nothing can store it.
+        self.exec
+            .take_adjustments(|c| diag.send(Record::Retain(c)).is_ok());
     }
 
     /// Hands this cycle's job events to the recorder, each with its axis' pending alarm.
@@ -312,7 +337,7 @@ impl<'c> NodeCycle<'c> {
             if self
                 .links
                 .diag
-                .try_send(DiagRecord { event, alarm })
+                .try_send(Record::Diag(DiagRecord { event, alarm }))
                 .is_err()
             {
                 self.health.diag_dropped += 1;
@@ -338,7 +363,7 @@ impl<'c> NodeCycle<'c> {
             if self
                 .links
                 .diag
-                .try_send(DiagRecord { event, alarm: 0 })
+                .try_send(Record::Diag(DiagRecord { event, alarm: 0 }))
                 .is_err()
             {
                 self.health.diag_dropped += 1;

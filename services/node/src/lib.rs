@@ -9,8 +9,9 @@
 //! there allocates, locks, logs or blocks: commands arrive through a bounded queue from the
 //! command thread ([`commands`]), log lines and job events go to the recorder thread
 //! ([`recorder`]) as fixed-size records, which it writes and emits through `tracing`, trace
-//! rows go to it through a fixed pool. Every iceoryx2 port of the cycle is opened in one place
-//! ([`ports`]).
+//! rows go to it through a fixed pool, changed absolute encoder adjustments go to it through
+//! the records' channel and it stores them as retained data ([`retain`]; restored before the
+//! first cycle). Every iceoryx2 port of the cycle is opened in one place ([`ports`]).
 //!
 //! ```no_run
 //! // Runs node `press` of a cell for 2 s of engine time.
@@ -33,13 +34,14 @@ mod logring;
 mod ports;
 mod recorder;
 mod report;
+mod retain;
 
 pub use error::NodeError;
 pub use report::{Histogram, Report, Stages};
 
 use commands::{command_thread, CommandLinks, Done, Queued};
 use cycle::{Clock, CycleParts, Links, NodeCycle, Row, RowPool};
-use logring::{DiagRecord, DIAG_RECORDS};
+use logring::{Record, DIAG_RECORDS};
 use ports::{PortPlan, Ports};
 use recorder::{recorder_thread, RecorderPlan};
 use std::path::PathBuf;
@@ -52,6 +54,7 @@ use tandem_config::{AxisIndex, Cell, Coupling, Leader};
 use tandem_motion::objects::action::Action;
 use tandem_protocol::ipc;
 use tandem_rt as rt;
+use tandem_rt::retain::RetainStore;
 use tandem_runtime::exec::{Executive, Secs};
 use tracing::{error, info, info_span, warn, Span};
 
@@ -88,19 +91,19 @@ pub fn run(o: &Options) -> Result<Report, NodeError> {
         nodes: cell.nodes.iter().map(|x| x.name.clone()).collect(),
     })?;
     let script = load_script(o, &cell)?;
-    let end_ns = o
-        .duration_s
-        .map(|d| (d * 1e9) as i64)
-        .or(script.as_ref().map(|s| s.duration_ns));
     rt::install_termination_handler();
     prepare_process(&cell, n);
     let owned: Vec<usize> = (0..cell.axes.len())
         .filter(|i| cell.axes[*i].node == n)
         .collect();
     let stop = Arc::new(AtomicBool::new(false));
-    let (threads, links) = start_threads(&cell, o, &owned, &stop)?;
-    let entries = script.as_ref().map_or(&[][..], |s| s.entries.as_slice());
-    let result = cyclic(&cell, n, o, entries, end_ns, owned, links);
+    let retained = retain::open(&cell, n);
+    let (threads, links) = start_threads(&cell, o, &owned, &stop, retained.clone())?;
+    let start = Start {
+        script: script.as_ref(),
+        retained: retained.as_deref(),
+    };
+    let result = cyclic(&cell, n, o, start, owned, links);
     stop.store(true, Ordering::SeqCst);
     for (name, t) in threads {
         if t.join().is_err() {
@@ -156,16 +159,18 @@ fn spawn(name: &'static str, f: impl FnOnce() + Send + 'static) -> Result<Thread
         })
 }
 
-/// Starts the command and recorder threads; returns them and the cyclic thread's links.
+/// Starts the command and recorder threads (the recorder stores the retained data into
+/// `retained`); returns them and the cyclic thread's links.
 fn start_threads(
     cell: &Arc<Cell>,
     o: &Options,
     owned: &[usize],
     stop: &Arc<AtomicBool>,
+    retained: Option<Arc<RetainStore>>,
 ) -> Result<(Vec<Thread>, Links), NodeError> {
     let (cmd_tx, cmd_rx) = sync_channel::<Queued>(32);
     let (done_tx, done_rx) = sync_channel::<Done>(64);
-    let (diag_tx, diag_rx) = sync_channel::<DiagRecord>(DIAG_RECORDS);
+    let (diag_tx, diag_rx) = sync_channel::<Record>(DIAG_RECORDS);
     let (free_tx, free_rx) = sync_channel::<Row>(TRACE_ROWS);
     let (row_tx, row_rx) = sync_channel::<Row>(TRACE_ROWS);
     // Trace rows only when a trace is written; the pool's channel holds them all.
@@ -193,6 +198,7 @@ fn start_threads(
         owned: owned.to_vec(),
         rows: (row_rx, free_tx),
         diag: diag_rx,
+        retained,
     };
     let (c, s) = (Arc::clone(cell), Arc::clone(stop));
     threads.push(spawn("recorder", move || recorder_thread(&c, &plan, &s))?);
@@ -240,17 +246,31 @@ fn telemetry_every(cell: &Cell, n: usize) -> u64 {
     }
 }
 
-/// Opens the ports, then runs the cyclic executive on this thread.
+/// What the cyclic executive starts from besides the cell: the script, the retained data.
+struct Start<'a> {
+    /// The script, if any.
+    script: Option<&'a Script>,
+    /// The node's retained data, if it has any.
+    retained: Option<&'a RetainStore>,
+}
+
+/// Restores the retained data, opens the ports, then runs the cyclic executive on this
+/// thread until the end of the duration (`o`'s, else the script's) or a signal.
 fn cyclic(
     cell: &Cell,
     n: usize,
     o: &Options,
-    script: &[tandem_config::script::ScriptEntry],
-    end_ns: Option<i64>,
+    start: Start<'_>,
     owned: Vec<usize>,
     links: Links,
 ) -> Result<Report, NodeError> {
-    let exec = Executive::new(cell, Some(n)).map_err(|e| NodeError::Engine(e.into()))?;
+    let end_ns = o
+        .duration_s
+        .map(|d| (d * 1e9) as i64)
+        .or(start.script.map(|s| s.duration_ns));
+    let script = start.script.map_or(&[][..], |s| s.entries.as_slice());
+    let mut exec = Executive::new(cell, Some(n)).map_err(|e| NodeError::Engine(e.into()))?;
+    retain::restore(&mut exec, cell, start.retained);
     let remote: Vec<(Leader, Coupling)> = exec.remote_leaders().collect();
     let ports = Ports::open(PortPlan {
         cell,

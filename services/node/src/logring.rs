@@ -1,6 +1,7 @@
 //! The cyclic thread's diagnostics: the log ring its step writes lines into, and the
-//! fixed-size records it hands to the recorder thread, which emits them through `tracing`.
-//! Nothing here formats for `tracing` or allocates on the cyclic thread.
+//! fixed-size records it hands to the recorder thread, which emits them through `tracing`
+//! (and stores the changed retained data, [`crate::retain`]). Nothing here formats for
+//! `tracing` or allocates on the cyclic thread.
 
 use std::collections::VecDeque;
 use std::io::{self, Write};
@@ -9,7 +10,7 @@ use tandem_protocol::wire::{Event, Text};
 /// Lines the log ring holds between two cycles.
 pub(crate) const LOG_LINES: usize = 128;
 
-/// Diagnostic records the channel to the recorder thread holds (about 20 cycles of a full log
+/// Records the channel to the recorder thread holds (about 20 cycles of a full log
 /// ring; the recorder drains it every 5 ms).
 pub(crate) const DIAG_RECORDS: usize = 4096;
 
@@ -54,6 +55,18 @@ impl Write for LogRing {
     fn flush(&mut self) -> io::Result<()> {
         Ok(())
     }
+}
+
+/// What the cyclic thread hands to the recorder thread, through one bounded channel.
+// The records are the channel's fixed slots: boxing the large variant would allocate on the
+// cyclic thread; a retained-data record costs a diagnostic record's slot, as before.
+#[allow(clippy::large_enum_variant)]
+#[derive(Copy, Clone, Debug)]
+pub(crate) enum Record {
+    /// A log line or a job event, to emit (and write to the log file).
+    Diag(DiagRecord),
+    /// An axis's retained data changed: to store.
+    Retain(tandem_runtime::exec::AdjustmentChange),
 }
 
 /// One diagnostic record of the cyclic thread: a log line or a job event as published, with

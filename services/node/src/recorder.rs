@@ -1,14 +1,17 @@
-//! The recorder thread: writes the trace rows and the log file, and emits the cyclic thread's
+//! The recorder thread: writes the trace rows and the log file, emits the cyclic thread's
 //! diagnostic records (log lines, job events) as `tracing` events — the cyclic thread itself
-//! never calls `tracing`.
+//! never calls `tracing` — and stores the changed retained data ([`crate::retain`]), which
+//! waits for the disk.
 
 use crate::cycle::Row;
-use crate::logring::DiagRecord;
+use crate::logring::{DiagRecord, Record};
+use crate::retain::Retainer;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender};
+use std::sync::Arc;
 use std::time::Duration;
 use tandem_config::Cell;
 use tandem_protocol::json::error_id_text;
@@ -28,8 +31,10 @@ pub(crate) struct RecorderPlan {
     pub(crate) owned: Vec<usize>,
     /// Filled trace rows, and the pool to give them back to.
     pub(crate) rows: (Receiver<Row>, SyncSender<Row>),
-    /// The cyclic thread's diagnostic records.
-    pub(crate) diag: Receiver<DiagRecord>,
+    /// The cyclic thread's diagnostic records and changed retained data.
+    pub(crate) diag: Receiver<Record>,
+    /// Where the retained data is stored, if the node has any.
+    pub(crate) retained: Option<Arc<tandem_rt::retain::RetainStore>>,
 }
 
 /// Runs until `stop`, then drains what is left.
@@ -91,6 +96,7 @@ fn record(cell: &Cell, plan: &RecorderPlan, stop: &AtomicBool) -> io::Result<()>
         header(w, cell, &plan.owned)?;
     }
     let names = cell.object_names();
+    let mut retainer = Retainer::new(plan.retained.clone());
     let (rows, free) = &plan.rows;
     loop {
         let stopping = stop.load(Ordering::SeqCst);
@@ -102,11 +108,19 @@ fn record(cell: &Cell, plan: &RecorderPlan, stop: &AtomicBool) -> io::Result<()>
             let _ = free.try_send((t, row));
         }
         while let Ok(r) = plan.diag.try_recv() {
+            let r = match r {
+                Record::Diag(r) => r,
+                Record::Retain(change) => {
+                    retainer.push(change);
+                    continue;
+                }
+            };
             emit(&names, &r);
             if let (Some(w), EVENT_LOG) = (log.as_mut(), r.event.kind) {
                 writeln!(w, "{}", r.event.message.as_str())?;
             }
         }
+        retainer.flush(cell);
         if stopping {
             break;
         }

@@ -416,6 +416,10 @@ pub struct Cell {
     pub telemetry_hz: f64,
     /// Clock-offset warning threshold, as a share of the smallest cross-host delay.
     pub clock_warning_fraction: f64,
+    /// The directory of the retained data: `[cell] retain_dir` (default `retain`), relative to
+    /// the cell file's directory (to the current directory for a cell parsed from text).
+    /// A node's records are in [`Cell::node_retain_dir`].
+    pub retain_dir: std::path::PathBuf,
     /// Nodes.
     pub nodes: Vec<Node>,
     /// Axes, in name order.
@@ -437,6 +441,13 @@ pub struct Cell {
 }
 
 impl Cell {
+    /// The directory of node `node`'s retained data (the absolute encoder adjustments of its
+    /// axes): `<retain_dir>/<cell name>/<node name>/`, if the cell has the node.
+    pub fn node_retain_dir(&self, node: usize) -> Option<std::path::PathBuf> {
+        let n = self.nodes.get(node)?;
+        Some(self.retain_dir.join(&self.name).join(&n.name))
+    }
+
     /// The axis `i`, if the cell has it.
     pub fn axis(&self, i: AxisIndex) -> Option<&AxisEntry> {
         self.axes.get(i.0)

@@ -537,6 +537,10 @@ pub struct CellSection {
     /// smallest leading-value delay of a coupling between them.
     #[serde(default = "default_clock_warning")]
     pub clock_warning_fraction: f64,
+    /// The directory of the retained data (docs/io.md, "Retained data"), relative to the cell
+    /// file's directory; default `retain`. Each node keeps its records in
+    /// `<retain_dir>/<cell name>/<node name>/`.
+    pub retain_dir: Option<String>,
 }
 
 fn default_telemetry_hz() -> f64 {

@@ -25,7 +25,7 @@ use tandem_motion::plant::cia402::{
 };
 use tandem_motion::plant::drive::{Actual, Plant};
 use tandem_motion::plant::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
-use tandem_motion::plant::mechanics::{RawCounter, Scaling};
+use tandem_motion::plant::mechanics::{EncoderKind, RawCounter, Scaling};
 use tandem_motion::plant::servo::{ServoParams, SimServo, SimServoError};
 
 use crate::error::ExecError;
@@ -82,6 +82,8 @@ pub struct Cia402Link {
     probe_armed: bool,
     /// The touch probe status of the last sample (0x60B9), to see new values.
     probe_status: u16,
+    /// What is retained of the axis, if its encoder is absolute or cyclic absolute.
+    pub(crate) retention: Option<Retention>,
 }
 
 /// Whether measuring input `m` measures through its axis's drive's touch probe: route
@@ -100,6 +102,67 @@ pub struct ProbeLatch {
     pub rising: bool,
     /// The latched position (physical, units).
     pub position: f64,
+}
+
+/// What is retained of an axis on a drive with an absolute or cyclic absolute encoder (its
+/// absolute encoder adjustment and, for a cyclic absolute encoder, the count of traversed
+/// ranges; S7-1500T Motion Control V4.0 function manual, 'Drive and encoder connection', actual
+/// value types), and what was last handed over to be retained ([`crate::exec::AdjustmentChange`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Retention {
+    /// A cyclic absolute encoder: its count is retained too, and resumed after a restart.
+    pub(crate) cyclic: bool,
+    /// The fingerprint an adjustment of this link is made under ([`adjustment_fingerprint`]).
+    pub(crate) fingerprint: u64,
+    /// The axis's `AbsoluteOffset::changes` last handed over (or restored).
+    pub(crate) changes: u32,
+    /// The count last handed over (or restored).
+    pub(crate) count: i64,
+    /// The retained count a cyclic absolute encoder's counter resumes from at the first sample.
+    pub(crate) resume: Option<i64>,
+}
+
+/// The fingerprint of the configuration an absolute encoder adjustment on a drive of the
+/// process image is made under: the encoder's ([`Scaling::fingerprint`]: kind, raw word,
+/// multiturn range, inversion, counts to units) and the drive's increments to units (its
+/// increments per revolution, the load gear, the leadscrew, `Actor.InverseDirection`), since
+/// the axis reads its actual position in the drive's increments. Inferred: S7 voids the
+/// adjustment on an encoder configuration change ('When Homed is lost'); a change of the
+/// mechanics between the encoder and the load moves the axis's coordinate just as much. FNV-1a
+/// over the encoder's fingerprint and the drive's fields.
+pub(crate) fn adjustment_fingerprint(s: &Scaling) -> u64 {
+    let m = s.mechanics();
+    let words = [
+        s.fingerprint(),
+        m.drive_increments_per_revolution.map_or(0, u64::from),
+        u64::from(m.load_gear_numerator),
+        u64::from(m.load_gear_denominator),
+        m.leadscrew_pitch.map_or(0, f64::to_bits),
+        u64::from(m.inverse_drive),
+    ];
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in words.iter().flat_map(|w| w.to_le_bytes()) {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+impl Retention {
+    /// The retention of an axis on connection `c`: `None` for an incremental encoder.
+    fn of(c: &Cia402Connection) -> Option<Self> {
+        let cyclic = match c.scaling.encoder().kind {
+            EncoderKind::Incremental => return None,
+            EncoderKind::Absolute => false,
+            EncoderKind::CyclicAbsolute => true,
+        };
+        Some(Self {
+            cyclic,
+            fingerprint: adjustment_fingerprint(&c.scaling),
+            changes: 0,
+            count: 0,
+            resume: None,
+        })
+    }
 }
 
 /// The devices of the process image and the links of the axes on them.
@@ -293,6 +356,7 @@ impl Cia402Link {
             probe_input: None,
             probe_armed: false,
             probe_status: 0,
+            retention: Retention::of(c),
         })
     }
 
@@ -362,8 +426,7 @@ impl Cia402Link {
         let count = match &mut self.counter {
             Some(c) => c.update(raw),
             None => {
-                // 0x6064 is an INT32: its first value read as signed.
-                let c = RawCounter::new_signed(32, raw).ok();
+                let c = self.first_counter(raw);
                 let n = c.map_or(i64::from(fb.position_actual), |c| c.count());
                 self.counter = c;
                 n
@@ -404,6 +467,43 @@ impl Cia402Link {
             },
             state,
         }
+    }
+
+    /// The counter of the first sample: 0x6064 (an INT32) read as signed; for a cyclic absolute
+    /// encoder its raw word of `raw_bits`, resumed from the retained count if one was restored
+    /// (the count moves from it by the shortest path to the raw value now).
+    fn first_counter(&self, raw: u32) -> Option<RawCounter> {
+        match self.retention {
+            Some(Retention {
+                cyclic: true,
+                resume,
+                ..
+            }) => {
+                let bits = self.scaling.encoder().raw_bits;
+                match resume {
+                    Some(retained) => RawCounter::resume(bits, retained, raw),
+                    None => RawCounter::new_signed(bits, raw),
+                }
+                .ok()
+            }
+            _ => RawCounter::new_signed(32, raw).ok(),
+        }
+    }
+
+    /// Whether the drive was sampled (the axis has run on it).
+    pub(crate) fn started(&self) -> bool {
+        self.counter.is_some()
+    }
+
+    /// The extended count of the drive's position, from the first sample on.
+    pub(crate) fn count(&self) -> Option<i64> {
+        self.counter.map(|c| c.count())
+    }
+
+    /// Whether the count moved far enough from `retained` to be retained again
+    /// ([`RawCounter::retain_due`]).
+    pub(crate) fn count_due(&self, retained: i64) -> bool {
+        self.counter.is_some_and(|c| c.retain_due(retained))
     }
 
     /// The drive's command for the axis's outputs: CSP with the position setpoint and the

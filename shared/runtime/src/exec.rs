@@ -12,10 +12,13 @@
 //! After [`Executive::new`], nothing here allocates: the log lines are formatted into the
 //! caller's writer (a fixed ring in a node).
 
+mod retain;
+
 use crate::drives::Drives;
 use crate::error::ExecError;
 pub use crate::notes::{seconds, Describe, IoNote, JobNote, Secs, NOTES};
 pub use crate::outputs::{OutputDeviceStatus, OutputSwitch, LOOK_AHEAD_CYCLES, SWITCHES};
+pub use retain::{AdjustmentChange, RestoreError, Restored};
 
 use crate::notes::keep;
 use crate::objects::{cycle_motion, CycleMotion, Objects};

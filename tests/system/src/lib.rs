@@ -12,6 +12,9 @@
 //! - `tests/processes.rs`: the process set of one host, `tandem up` with three nodes over
 //!   iceoryx2, against `tandem sim`; a killed node and its recovery; refused configurations
 //!   and commands.
+//! - `tests/retain.rs`: a node's retained absolute encoder adjustment, killed with SIGKILL
+//!   while it stores, restarted: homed at the last completed adjustment, never a torn one; a
+//!   changed mechanics configuration voids it, a damaged record is reported and not used.
 //! - `tests/hosts.rs`: two and three hosts in network namespaces (root needed), over Zenoh
 //!   through the gateways; the Python observer `tests/python/observe.py`; a cut link and a
 //!   killed gateway.

@@ -64,6 +64,9 @@ impl Ctx<'_> {
     }
 }
 
+/// The directory of the retained data, relative to the cell file's, without `[cell] retain_dir`.
+const DEFAULT_RETAIN_DIR: &str = "retain";
+
 /// A name that can stand in a file name, an iceoryx2 service name and a Zenoh key expression.
 fn plain_name(s: &str) -> bool {
     !s.is_empty()
@@ -192,6 +195,9 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         },
         telemetry_hz: raw.cell.telemetry_hz,
         clock_warning_fraction: raw.cell.clock_warning_fraction,
+        retain_dir: dir
+            .unwrap_or(Path::new(""))
+            .join(raw.cell.retain_dir.as_deref().unwrap_or(DEFAULT_RETAIN_DIR)),
         hosts,
         nodes,
         axes,
@@ -205,7 +211,8 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     })
 }
 
-/// `[cell]`: the base tick, the telemetry rate and the clock warning threshold.
+/// `[cell]`: the base tick, the telemetry rate, the clock warning threshold and the retained
+/// data's directory.
 fn check_cell_section(cx: Ctx<'_>, raw: &CellFile) -> Result<(), ConfigError> {
     let c = &raw.cell;
     if c.base_tick_us == 0 {
@@ -224,6 +231,12 @@ fn check_cell_section(cx: Ctx<'_>, raw: &CellFile) -> Result<(), ConfigError> {
         return Err(cx.at(
             &["cell", "clock_warning_fraction"],
             Problem::Invalid("must be a share above 0 and at most 1"),
+        ));
+    }
+    if c.retain_dir.as_deref().is_some_and(|d| d.trim().is_empty()) {
+        return Err(cx.at(
+            &["cell", "retain_dir"],
+            Problem::Invalid("must name a directory"),
         ));
     }
     Ok(())

@@ -6,11 +6,13 @@
 //!
 //! Positions are kept continuous (unwrapped) inside; modulo positions are what the status shows.
 
+mod adjustment;
 mod command;
 mod config;
 mod step;
 mod sync;
 
+pub use adjustment::{AbsoluteOffset, RestoreOffsetError};
 pub use command::{
     ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
     SyncProfileReference, VelocityDirection,
@@ -267,7 +269,8 @@ pub struct Axis {
     pos_ctrl: bool,
     /// Axis position = physical position + offset.
     offset: f64,
-    abs_encoder_offset: f64,
+    /// The absolute encoder adjustment (MC_Home 6/7), retained by the runtime.
+    absolute: AbsoluteOffset,
     homed: bool,
     basic: State,
     sup: State,
@@ -339,7 +342,7 @@ impl Axis {
             cfg.initial_position,
         ));
         let p0 = cfg.initial_position;
-        let homed = cfg.encoder == EncoderType::Absolute;
+        let absolute = AbsoluteOffset::initial(cfg.encoder);
         let mut axis = Self {
             link,
             signals: AxisSignals::default(),
@@ -356,8 +359,8 @@ impl Axis {
             enabled: false,
             pos_ctrl: false,
             offset: 0.0,
-            abs_encoder_offset: 0.0,
-            homed,
+            absolute,
+            homed: absolute.adjusted,
             basic: State::rest(p0),
             sup: State::default(),
             goal: Goal::Track,
@@ -1213,12 +1216,8 @@ impl Axis {
             self.abort_pending(JobEventKind::CommandAborted);
             self.alarms = [None; MAX_ALARMS];
             self.alarm_pending = false;
-            self.homed = self.cfg.encoder == EncoderType::Absolute;
-            self.offset = if self.homed {
-                self.abs_encoder_offset
-            } else {
-                0.0
-            };
+            self.homed = self.absolute.adjusted;
+            self.offset = self.absolute.offset;
             self.override_pct = 100.0;
             self.hw_trigger = None;
             self.sw_active = None;
@@ -1531,7 +1530,7 @@ impl Axis {
     fn home_directly(&mut self, id: JobId, delta: f64, absolute: bool) {
         self.shift(delta);
         if absolute {
-            self.abs_encoder_offset = self.offset;
+            self.note_absolute_adjustment();
         }
         self.homed = true;
         self.emit(id, Instruction::Home, JobEventKind::Done);
