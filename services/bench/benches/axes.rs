@@ -412,16 +412,40 @@ fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<Eng
     })
 }
 
-fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome, String> {
+/// Writes the cell and the script of `n` axes into `dir`: (cell name, cell path, script path).
+fn generate(n: usize, seconds: f64, dir: &Path) -> Result<(String, PathBuf, PathBuf), String> {
     let mix = Mix::of(n);
     let cell_name = format!("bench-axes-{n}");
     let cell_path = dir.join(format!("cell-{n}.toml"));
     let script_path = dir.join(format!("script-{n}.toml"));
-    let log_path = dir.join(format!("node-{n}.log"));
     let write =
         |p: &PathBuf, s: String| std::fs::write(p, s).map_err(|e| format!("{}: {e}", p.display()));
     write(&cell_path, cell_toml(&cell_name, &mix))?;
     write(&script_path, script_toml(&mix, seconds))?;
+    Ok((cell_name, cell_path, script_path))
+}
+
+/// `--engine-only`: the engine alone on the cell and script of `n` axes, printed; no node (for
+/// instruction counts under `valgrind --tool=callgrind`, which the node's real clock defeats).
+fn engine_alone(n: usize, seconds: f64, dir: &Path) -> Result<(), String> {
+    let (_, cell_path, script_path) = generate(n, seconds, dir)?;
+    let e = engine_only(&cell_path, &script_path, seconds)?;
+    println!(
+        "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
+         CPU {:.1} µs per cycle ({:.1} % of a core)",
+        e.cycles,
+        e.mean_us,
+        e.p50_us,
+        e.cpu_us,
+        e.percent()
+    );
+    Ok(())
+}
+
+fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome, String> {
+    let mix = Mix::of(n);
+    let (cell_name, cell_path, script_path) = generate(n, seconds, dir)?;
+    let log_path = dir.join(format!("node-{n}.log"));
 
     // Validate as the node will load them, and time it: the node does the same before its
     // first cycle, so the epoch leaves room for it.
@@ -770,6 +794,15 @@ fn main() -> ExitCode {
                 ),
         )
         .arg(
+            Arg::new("engine-only")
+                .long("engine-only")
+                .action(ArgAction::SetTrue)
+                .help(
+                    "Run only the engine alone (Executive::step in a tight loop), not the node: \
+                     for instruction counts under valgrind --tool=callgrind",
+                ),
+        )
+        .arg(
             Arg::new("keep")
                 .long("keep")
                 .action(ArgAction::SetTrue)
@@ -800,6 +833,18 @@ fn main() -> ExitCode {
     }
     let mut outcomes = Vec::new();
     let mut failed = false;
+    if m.get_flag("engine-only") {
+        let mut code = ExitCode::SUCCESS;
+        for n in sizes {
+            if let Err(e) = engine_alone(n, seconds, &dir) {
+                eprintln!("tandem-bench-axes: {n} axes: error: {e}");
+                code = ExitCode::FAILURE;
+            }
+        }
+        // Cleanup of a scratch directory: one already gone is fine.
+        let _ = std::fs::remove_dir_all(&dir);
+        return code;
+    }
     for n in sizes {
         match run_one(n, seconds, &dir, with_log) {
             Ok(o) => {

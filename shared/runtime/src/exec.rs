@@ -447,7 +447,11 @@ pub struct Executive<'c> {
     object_axes: Vec<usize>,
     motions: Vec<Option<CycleMotion>>,
     alarms_seen: Vec<[(u16, u16); 8]>,
+    /// Per axis: its status after the last step, copied from the axis when first read (most
+    /// steps nobody reads most of them).
     status: Vec<AxisStatus>,
+    /// Per axis: `status` is older than the axis' last step (see [`Executive::snapshot`]).
+    stale: Vec<bool>,
     encoder_status: Vec<EncoderStatus>,
     /// The status at each axis' previous cycle (the start of its objects' motion).
     last_cycle: Vec<AxisStatus>,
@@ -504,6 +508,7 @@ impl<'c> Executive<'c> {
             alarms_seen: vec![[(0, 0); 8]; axes.len()],
             last_cycle: status.clone(),
             status,
+            stale: vec![false; cell.axes.len()],
             encoder_status,
             plan: StepPlan::with_capacity(axes.len()),
             cycles,
@@ -531,9 +536,32 @@ impl<'c> Executive<'c> {
         self.owned.axis(i)
     }
 
-    /// The status of every axis of the cell (meaningful for the owned ones).
-    pub fn status(&self) -> &[AxisStatus] {
+    /// The status of every axis of the cell after the last step (meaningful for the owned
+    /// ones).
+    pub fn status(&mut self) -> &[AxisStatus] {
+        for i in 0..self.stale.len() {
+            self.snapshot(i);
+        }
         &self.status
+    }
+
+    /// The status of axis `i` after the last step, as [`Executive::status`] has it.
+    pub fn axis_status(&mut self, i: AxisIndex) -> Option<&AxisStatus> {
+        self.snapshot(i.0);
+        self.status.get(i.0)
+    }
+
+    /// Copies the status of axis `i` after the last step, unless that is done: when it is read,
+    /// and before a command changes the axis.
+    fn snapshot(&mut self, i: usize) {
+        if let (Some(stale @ true), Some(axis), Some(s)) = (
+            self.stale.get_mut(i),
+            self.axes.get(i),
+            self.status.get_mut(i),
+        ) {
+            *s = *axis.status();
+            *stale = false;
+        }
     }
 
     /// The status of every encoder of the cell (meaningful for the owned ones).
@@ -729,7 +757,11 @@ impl<'c> Executive<'c> {
             }
             // The leader must be one of the follower's configured leaders.
             Some(Some(m)) if cell.coupling(i, m).is_none() => Err(ErrorId::IllegalObject),
-            _ => self.axes[i.0].command(&command).map(Some),
+            _ => {
+                // The status of the last step stays what it was until the next step.
+                self.snapshot(i.0);
+                self.axes[i.0].command(&command).map(Some)
+            }
         };
         if let (Ok(_), Command::Home { mode, .. }) = (&result, command) {
             self.objects.homing_started(cell, i, mode);
@@ -946,7 +978,7 @@ impl<'c> Executive<'c> {
         self.plan = plan;
     }
 
-    /// The job events and new alarms of the owned axes, and their status.
+    /// The job events and new alarms of the owned axes; their status is copied when read.
     fn axis_events(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
         for (i, axis) in self.axes.iter_mut().enumerate() {
@@ -958,8 +990,9 @@ impl<'c> Executive<'c> {
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
             }
             // Without a pending alarm, nor one seen last step, there is nothing new to log.
+            // Its status is copied when read.
+            self.stale[i] = true;
             if !axis.alarm_pending() && self.alarms_seen[i].iter().all(|&(n, s)| n | s == 0) {
-                self.status[i] = *axis.status();
                 continue;
             }
             let mut now = [(0u16, 0u16); 8];
@@ -979,7 +1012,6 @@ impl<'c> Executive<'c> {
                 }
             }
             self.alarms_seen[i] = now;
-            self.status[i] = *axis.status();
         }
         Ok(())
     }
@@ -990,7 +1022,9 @@ impl<'c> Executive<'c> {
         let cell = self.cell;
         // Only the axes whose motion is needed have one (the others' stay `None`); their
         // previous cycle's status is kept for it.
-        for &i in &self.motion_axes {
+        for k in 0..self.motion_axes.len() {
+            let i = self.motion_axes[k];
+            self.snapshot(i);
             self.motions[i] = (t % self.cycles[i] == 0).then(|| {
                 cycle_motion(
                     &self.last_cycle[i],
@@ -1040,6 +1074,8 @@ impl<'c> Executive<'c> {
                 cell.axes[a].name,
                 distance
             )?;
+            // The status of this step stays what it was before the correction.
+            self.snapshot(a.0);
             if let Err(id) = self.axes[a.0].command(&command) {
                 self.rejected += 1;
                 writeln!(

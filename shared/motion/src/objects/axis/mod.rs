@@ -31,6 +31,7 @@ use crate::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, 
 use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
 use crate::objects::leading::LeadingValue;
 use crate::plant::link::{AxisSignals, DriveInputs, DriveLink, DriveOutputs, SimPlant};
+use std::cell::OnceCell;
 
 /// PLCopen axis states (S7-1500T Motion Control V4.0 function manual, A.2.35 'StatusWord tag' (the
 /// manual draws no state diagram), PLCopen Motion Control part 1, axis state diagram).
@@ -314,7 +315,10 @@ pub struct Axis {
     events: EventQueue,
     next_id: JobId,
     now: i64,
-    status: AxisStatus,
+    /// The status after the last cycle or command, computed when first read (most cycles
+    /// nobody reads it): emptied by [`Axis::step`] and [`Axis::command`], pinned before a
+    /// change between them that must not show until then ([`Axis::raise`]).
+    status: OnceCell<AxisStatus>,
 }
 
 fn sign(x: f64) -> f64 {
@@ -340,7 +344,7 @@ impl Axis {
         ));
         let p0 = cfg.initial_position;
         let homed = cfg.encoder == EncoderType::Absolute;
-        let mut axis = Self {
+        Ok(Self {
             link,
             signals: AxisSignals::default(),
             power: Power {
@@ -394,33 +398,9 @@ impl Axis {
             events: EventQueue::default(),
             next_id: 1,
             now: 0,
-            status: AxisStatus {
-                time_ns: 0,
-                state: AxisState::Disabled,
-                status_word: 0,
-                error_word: 0,
-                warning_word: 0,
-                error_detail: ErrorDetail::NONE,
-                position: p0,
-                velocity: 0.0,
-                acceleration: 0.0,
-                actual_position: p0,
-                actual_velocity: 0.0,
-                following_error: 0.0,
-                override_velocity: 100.0,
-                position_unwrapped: p0,
-                actual_position_unwrapped: p0,
-                motion_job: None,
-                superimposed_job: None,
-                sync_job: None,
-                sync_function: sync_function::NONE,
-                sync_status_word: 0,
-                phase_shift: 0.0,
-            },
+            status: OnceCell::new(),
             cfg,
-        };
-        axis.refresh_status();
-        Ok(axis)
+        })
     }
 
     /// The configuration.
@@ -430,7 +410,7 @@ impl Axis {
 
     /// The status after the last cycle (or command).
     pub fn status(&self) -> &AxisStatus {
-        &self.status
+        self.status.get_or_init(|| self.current_status())
     }
 
     /// Takes the oldest pending job event.
@@ -455,11 +435,20 @@ impl Axis {
 
     /// This axis as a leader with setpoint coupling: its total setpoint (continuous position).
     pub fn setpoint_leading_value(&self) -> LeadingValue {
-        let s = &self.status;
+        // The total setpoint as the status shows it, without building the status: unless the
+        // status was pinned, the setpoint has not changed since the last cycle or command.
+        let s = match self.status.get() {
+            Some(s) => State {
+                p: s.position_unwrapped,
+                v: s.velocity,
+                a: s.acceleration,
+            },
+            None => self.total(),
+        };
         LeadingValue {
-            p: s.position_unwrapped,
-            v: s.velocity,
-            a: s.acceleration,
+            p: s.p,
+            v: s.v,
+            a: s.a,
             modulo: self.cfg.modulo,
         }
     }
@@ -571,13 +560,13 @@ impl Axis {
 
     fn warn_clamped(&mut self, c: Clamped) {
         if c.velocity {
-            self.raise(AlarmId::VelocityLimited, supplement::NONE);
+            self.raise_alarm(AlarmId::VelocityLimited, supplement::NONE);
         }
         if c.acceleration {
-            self.raise(AlarmId::AccelerationLimited, supplement::NONE);
+            self.raise_alarm(AlarmId::AccelerationLimited, supplement::NONE);
         }
         if c.jerk {
-            self.raise(AlarmId::JerkLimited, supplement::NONE);
+            self.raise_alarm(AlarmId::JerkLimited, supplement::NONE);
         }
     }
 
@@ -721,8 +710,15 @@ impl Axis {
     }
 
     /// Raises a technology alarm and applies its reaction (S7-1500T Motion Control V4.0 function
-    /// manual, 9.3 'Technology alarms').
+    /// manual, 9.3 'Technology alarms'). Between cycles the status shows it from the next cycle
+    /// or command on, as before.
     pub fn raise(&mut self, id: AlarmId, supp: u16) {
+        self.status();
+        self.raise_alarm(id, supp);
+    }
+
+    /// [`Axis::raise`] within a cycle or command (whose end empties the status).
+    fn raise_alarm(&mut self, id: AlarmId, supp: u16) {
         if self.alarms().any(|a| a.id == id && a.supplement == supp) {
             return;
         }
@@ -859,7 +855,7 @@ impl Axis {
     /// continues from there, so nothing jumps.
     pub fn command(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
         let r = self.apply(cmd);
-        self.refresh_status();
+        self.status = OnceCell::new();
         r
     }
 

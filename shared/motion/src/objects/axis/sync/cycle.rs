@@ -85,7 +85,7 @@ impl Axis {
             return true;
         };
         let Some(lv) = self.lead[1] else {
-            self.raise(AlarmId::LeaderMissing, supplement::NONE);
+            self.raise_alarm(AlarmId::LeaderMissing, supplement::NONE);
             return false;
         };
         let Some(started) = self.pending_start(&mut p, lv) else {
@@ -132,7 +132,7 @@ impl Axis {
                 a: b.a,
             };
         }
-        self.raise(AlarmId::LeaderMissing, supplement::NONE);
+        self.raise_alarm(AlarmId::LeaderMissing, supplement::NONE);
     }
 
     /// MC_PhasingAbsolute/Relative: the phase shift of the leading value follows its profile;
@@ -249,7 +249,7 @@ impl Axis {
                 if x.v * *lead_dir < 0.0 {
                     // The leading value reversed during synchronization (alarm 608).
                     self.sync = Some(*job);
-                    self.raise(AlarmId::SynchronizationError, supplement::NONE);
+                    self.raise_alarm(AlarmId::SynchronizationError, supplement::NONE);
                     return None;
                 }
                 if let Some(q) = quintic {
