@@ -39,6 +39,8 @@ const STROKE: f64 = 200.0;
 const MASTER_VELOCITY: f64 = 1000.0;
 /// Length of the cam's master range (one knife turn per 500 mm).
 const CAM_LENGTH: f64 = 500.0;
+/// Cycles between two telemetry snapshots of the node (at the default `telemetry_hz`, 50).
+const TELEMETRY_EVERY: i64 = 10;
 /// Targets.
 const CPU_TARGET_AXES: usize = 256;
 const CPU_TARGET_PERCENT: f64 = 20.0;
@@ -375,8 +377,20 @@ impl EngineOnly {
     }
 }
 
-/// Runs [`EngineOnly`] for `seconds` of engine time.
-fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<EngineOnly, String> {
+/// Reads the status of every axis (a function of its own, for callgrind's `--toggle-collect`).
+#[inline(never)]
+fn read_statuses(exec: &mut Executive) {
+    std::hint::black_box(exec.status());
+}
+
+/// Runs [`EngineOnly`] for `seconds` of engine time; with `read_status`, reads the status of
+/// every axis every that many cycles, as the node's telemetry does.
+fn engine_only(
+    cell_path: &Path,
+    script_path: &Path,
+    seconds: f64,
+    read_status: Option<i64>,
+) -> Result<EngineOnly, String> {
     let cell = tandem_config::load(cell_path).map_err(|e| e.to_string())?;
     let src = std::fs::read_to_string(script_path)
         .map_err(|e| format!("{}: {e}", script_path.display()))?;
@@ -400,6 +414,9 @@ fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<Eng
         exec.step(t, &mut log).map_err(|e| e.to_string())?;
         exec.drain_job_notes(|_| {});
         exec.drain_io_notes(|_| {});
+        if read_status.is_some_and(|n| k % n.max(1) == 0) {
+            read_statuses(&mut exec);
+        }
         hist.record(rt::now_ns() - t0);
     }
     let (cpu, wall) = (rt::thread_cpu_ns() - cpu0, rt::now_ns() - wall0);
@@ -425,11 +442,12 @@ fn generate(n: usize, seconds: f64, dir: &Path) -> Result<(String, PathBuf, Path
     Ok((cell_name, cell_path, script_path))
 }
 
-/// `--engine-only`: the engine alone on the cell and script of `n` axes, printed; no node (for
+/// `--engine-only`: the engine alone on the cell and script of `n` axes, reading every axis'
+/// status every [`TELEMETRY_EVERY`] cycles as the node's telemetry does, printed; no node (for
 /// instruction counts under `valgrind --tool=callgrind`, which the node's real clock defeats).
 fn engine_alone(n: usize, seconds: f64, dir: &Path) -> Result<(), String> {
     let (_, cell_path, script_path) = generate(n, seconds, dir)?;
-    let e = engine_only(&cell_path, &script_path, seconds)?;
+    let e = engine_only(&cell_path, &script_path, seconds, Some(TELEMETRY_EVERY))?;
     println!(
         "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
          CPU {:.1} µs per cycle ({:.1} % of a core)",
@@ -479,7 +497,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         (validate - load).as_secs_f64() * 1e3
     );
 
-    let engine = engine_only(&cell_path, &script_path, seconds)?;
+    let engine = engine_only(&cell_path, &script_path, seconds, None)?;
     eprintln!(
         "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
          CPU {:.1} µs per cycle ({:.1} % of a core)",
@@ -798,7 +816,8 @@ fn main() -> ExitCode {
                 .long("engine-only")
                 .action(ArgAction::SetTrue)
                 .help(
-                    "Run only the engine alone (Executive::step in a tight loop), not the node: \
+                    "Run only the engine alone (Executive::step in a tight loop, reading every \
+                     axis' status every 10th cycle as the node's telemetry does), not the node: \
                      for instruction counts under valgrind --tool=callgrind",
                 ),
         )

@@ -151,7 +151,7 @@ struct LeaderBuffer {
 
 /// How a follower reads one leader: the coupling, and the buffer of samples if it reads it
 /// delayed or from another node.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct LeaderSource {
     leader: Leader,
     coupling: Coupling,
@@ -185,7 +185,8 @@ struct StepPlan {
     unreached: Vec<usize>,
     /// Per axis: taken into `order` (while planning).
     taken: Vec<bool>,
-    /// A plan was made.
+    /// A plan was made and every owned axis still has the leaders it was planned with (an
+    /// axis' leaders change only when it steps or takes a command: [`StepPlan::note`]).
     valid: bool,
 }
 
@@ -201,14 +202,17 @@ impl StepPlan {
         }
     }
 
-    /// Whether the plan still holds: every owned axis has the leaders it was planned with.
-    fn holds(&self, axes: &[Axis], owned: &[bool]) -> bool {
-        self.valid
-            && axes
-                .iter()
-                .zip(&self.leaders)
-                .zip(owned)
-                .all(|((a, l), o)| !o || a.leaders() == *l)
+    /// Whether axis `i` still has the leaders it was planned with.
+    fn planned_with(&self, i: usize, axis: &Axis) -> bool {
+        self.leaders.get(i) == Some(&axis.leaders())
+    }
+
+    /// Notes the leaders of axis `i` after it stepped or took a command: the plan no longer
+    /// holds when they are not those it was planned with.
+    fn note(&mut self, i: usize, axis: &Axis) {
+        if !self.planned_with(i, axis) {
+            self.valid = false;
+        }
     }
 }
 
@@ -760,7 +764,9 @@ impl<'c> Executive<'c> {
             _ => {
                 // The status of the last step stays what it was until the next step.
                 self.snapshot(i.0);
-                self.axes[i.0].command(&command).map(Some)
+                let r = self.axes[i.0].command(&command).map(Some);
+                self.plan.note(i.0, &self.axes[i.0]);
+                r
             }
         };
         if let (Ok(_), Command::Home { mode, .. }) = (&result, command) {
@@ -901,17 +907,31 @@ impl<'c> Executive<'c> {
     /// needs has, with the leading values of this step. The order is planned again when an
     /// axis' leaders changed since the last step.
     fn step_axes(&mut self, t: i64) {
-        if !self.plan.holds(&self.axes, &self.owned.axes) {
+        if !self.plan.valid {
             self.replan();
         }
         // Which nodes' cycles fall on `t` (one division per node, not per axis).
         for (due, node) in self.due.iter_mut().zip(&self.cell.nodes) {
             *due = t % node.cycle_ns == 0;
         }
-        for k in 0..self.plan.order.len() {
-            let Planned { axis: i, reads } = self.plan.order[k];
-            for read in reads.into_iter().flatten() {
+        // The plan is read in place while the axes step (taken out, put back below).
+        let mut plan = std::mem::take(&mut self.plan);
+        // The last leader read directly (without a buffer) and its value: the followers of one
+        // leader come one after another, and the value changes only when the leader steps.
+        let mut last: Option<(LeaderSource, Option<LeadingValue>)> = None;
+        let mut holds = true;
+        for p in &plan.order {
+            let i = p.axis;
+            for read in p.reads.iter().flatten() {
                 let lv = match read.source {
+                    Some(src) if src.buffer.is_none() => match last {
+                        Some((s, v)) if s == src => v,
+                        _ => {
+                            let v = self.leading_value(src, t);
+                            last = Some((src, v));
+                            v
+                        }
+                    },
                     Some(src) => self.leading_value(src, t),
                     None => None,
                 };
@@ -919,16 +939,22 @@ impl<'c> Executive<'c> {
             }
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
+                holds &= plan.planned_with(i, &self.axes[i]);
+                if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
+                    last = None;
+                }
             }
         }
         // Not empty only with a coupling loop, which commands cannot create (16#8019): the
         // axis then runs without its leading value and raises "leader missing".
-        for k in 0..self.plan.unreached.len() {
-            let i = self.plan.unreached[k];
+        for &i in &plan.unreached {
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
+                holds &= plan.planned_with(i, &self.axes[i]);
             }
         }
+        plan.valid &= holds;
+        self.plan = plan;
     }
 
     /// Plans the order of the owned axes from their current leaders: passes over the axes in
@@ -992,7 +1018,8 @@ impl<'c> Executive<'c> {
             // Without a pending alarm, nor one seen last step, there is nothing new to log.
             // Its status is copied when read.
             self.stale[i] = true;
-            if !axis.alarm_pending() && self.alarms_seen[i].iter().all(|&(n, s)| n | s == 0) {
+            // (The slots are filled from the first: all are empty when the first is.)
+            if !axis.alarm_pending() && self.alarms_seen[i][0] == (0, 0) {
                 continue;
             }
             let mut now = [(0u16, 0u16); 8];
@@ -1076,7 +1103,9 @@ impl<'c> Executive<'c> {
             )?;
             // The status of this step stays what it was before the correction.
             self.snapshot(a.0);
-            if let Err(id) = self.axes[a.0].command(&command) {
+            let r = self.axes[a.0].command(&command);
+            self.plan.note(a.0, &self.axes[a.0]);
+            if let Err(id) = r {
                 self.rejected += 1;
                 writeln!(
                     log,
