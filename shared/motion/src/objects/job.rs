@@ -142,12 +142,15 @@ pub struct JobEvent {
 pub const EVENT_CAPACITY: usize = 64;
 
 /// Fixed-capacity FIFO of job events; when full the oldest event is dropped and counted.
+///
+/// The counts come first (`repr(C)`): the cycle reads them every time, the slots seldom.
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct EventQueue {
-    buf: [Option<JobEvent>; EVENT_CAPACITY],
     head: usize,
     len: usize,
     dropped: u64,
+    buf: [Option<JobEvent>; EVENT_CAPACITY],
 }
 
 impl Default for EventQueue {

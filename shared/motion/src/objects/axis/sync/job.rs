@@ -19,18 +19,20 @@ pub(in crate::objects::axis) enum SyncPhase {
     Synchronous,
 }
 
-/// A synchronous operation job.
+/// A synchronous operation job. The small fields first (`repr(C)`): an axis' cycle looks at
+/// whether it has one and in which phase.
 #[derive(Copy, Clone, Debug, PartialEq)]
+#[repr(C)]
 pub(in crate::objects::axis) struct SyncJob {
     pub id: JobId,
     pub instr: Instruction,
+    pub phase: SyncPhase,
+    /// The law has been set up from the first leading value.
+    pub ready: bool,
     pub master: LeaderId,
     pub ratio: f64,
     pub lim: Limits,
-    pub phase: SyncPhase,
     pub law: SyncLaw,
-    /// The law has been set up from the first leading value.
-    pub ready: bool,
 }
 
 impl SyncJob {
@@ -40,13 +42,15 @@ impl SyncJob {
     }
 }
 
-/// A phasing job: a profile of the phase shift (leading value units).
+/// A phasing job: a profile of the phase shift (leading value units). The small fields first
+/// (`repr(C)`): an axis' cycle looks at whether it has one.
 #[derive(Copy, Clone, Debug, PartialEq)]
+#[repr(C)]
 pub(in crate::objects::axis) struct PhasingJob {
     pub id: JobId,
     pub instr: Instruction,
-    pub prof: Profile,
     pub t0: i64,
+    pub prof: Profile,
 }
 
 /// The inputs shared by the absolute synchronizations (MC_GearInPos, MC_CamIn): the leader, where
