@@ -563,7 +563,7 @@ impl<'c> Executive<'c> {
             self.axes.get(i),
             self.status.get_mut(i),
         ) {
-            *s = *axis.status();
+            *s = axis.status_value();
             *stale = false;
         }
     }

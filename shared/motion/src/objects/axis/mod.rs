@@ -420,6 +420,15 @@ impl Axis {
         self.status.get_or_init(|| self.current_status())
     }
 
+    /// The status after the last cycle (or command), as [`Axis::status`] has it, by value:
+    /// for a caller that keeps its own copy (it is not kept here too).
+    pub fn status_value(&self) -> AxisStatus {
+        match self.status.get() {
+            Some(s) => *s,
+            None => self.current_status(),
+        }
+    }
+
     /// Takes the oldest pending job event.
     pub fn pop_event(&mut self) -> Option<JobEvent> {
         self.events.pop()

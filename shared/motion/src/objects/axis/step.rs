@@ -314,6 +314,10 @@ impl Axis {
     }
 
     fn active_homing(&mut self, prev: f64, phys: f64) {
+        // (Looked at in place first: the job is copied only while it homes.)
+        if self.main.as_ref().is_none_or(|m| m.homing.is_none()) {
+            return;
+        }
         let Some(job) = self.main else {
             return;
         };
@@ -479,6 +483,10 @@ impl Axis {
         }
         if self.power.disabling && finished {
             self.remove_enable();
+            return;
+        }
+        // Every case below waits for the end of the profile (and the job is not copied before).
+        if !finished {
             return;
         }
         let Some(mut m) = self.main else {
