@@ -229,12 +229,12 @@ struct PosMon {
     entered_ns: Option<i64>,
 }
 
+/// A superimposed job: its profile (kept apart in the axis, read only while the job runs)
+/// starts at `t0`.
 #[derive(Copy, Clone, Debug, PartialEq)]
-#[repr(C)]
 struct SupJob {
     id: JobId,
     t0: i64,
-    prof: Profile,
 }
 
 const MAX_ALARMS: usize = 12;
@@ -299,6 +299,9 @@ pub struct Axis {
     /// The input signals of the last cycle.
     signals: AxisSignals,
     passive: Option<PassiveHoming>,
+    sup_job: Option<SupJob>,
+    phasing: Option<sync::PhasingJob>,
+    offset_job: Option<sync::PhasingJob>,
     main: Option<MotionJob>,
     /// Leading values for this cycle: of the active and of the pending job's leader.
     lead: [Option<crate::objects::leading::LeadingValue>; 2],
@@ -313,9 +316,10 @@ pub struct Axis {
     /// Cams of the active and the pending CamIn, with their mappings.
     cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
     cam_maps: [Option<sync::CamMap>; 2],
-    sup_job: Option<SupJob>,
-    phasing: Option<sync::PhasingJob>,
-    offset_job: Option<sync::PhasingJob>,
+    /// The profiles of `sup_job`, `phasing` and `offset_job` (meaningful while they run).
+    sup_prof: Profile,
+    phasing_prof: Profile,
+    offset_prof: Profile,
     cfg: AxisConfig,
     link: DriveLink,
     /// The actual value prepared for actual-value coupling (run only while a follower may use
@@ -384,6 +388,9 @@ impl Axis {
             phasing: None,
             phase: State::default(),
             offset_job: None,
+            sup_prof: Profile::hold(State::default()),
+            phasing_prof: Profile::hold(State::default()),
+            offset_prof: Profile::hold(State::default()),
             sync_sim: None,
             cams: [None, None],
             cam_maps: [None; 2],
@@ -1045,11 +1052,8 @@ impl Axis {
         let prof =
             plan_position(s, s.p + distance, &r.limits).map_err(|_| ErrorId::IllegalDistance)?;
         let id = self.new_id();
-        self.sup_job = Some(SupJob {
-            id,
-            prof,
-            t0: self.now,
-        });
+        self.sup_job = Some(SupJob { id, t0: self.now });
+        self.sup_prof = prof;
         self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Busy);
         Ok(id)
     }

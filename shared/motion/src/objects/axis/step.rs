@@ -130,7 +130,7 @@ impl Axis {
             _ => self.prof.at(self.elapsed(self.t0) + dt),
         };
         let sup = match &self.sup_job {
-            Some(j) => j.prof.at(self.elapsed(j.t0) + dt),
+            Some(j) => self.sup_prof.at(self.elapsed(j.t0) + dt),
             None => self.sup,
         };
         State {
@@ -171,7 +171,7 @@ impl Axis {
             _ => self.basic = self.prof.at(self.elapsed(self.t0)),
         }
         if let Some(j) = &self.sup_job {
-            self.sup = j.prof.at(self.elapsed(j.t0));
+            self.sup = self.sup_prof.at(self.elapsed(j.t0));
         }
     }
 
@@ -474,8 +474,8 @@ impl Axis {
         let sup_done = self
             .sup_job
             .as_ref()
-            .filter(|j| self.elapsed(j.t0) >= j.prof.duration())
-            .map(|j| (j.id, j.prof.end()));
+            .filter(|j| self.elapsed(j.t0) >= self.sup_prof.duration())
+            .map(|j| (j.id, self.sup_prof.end()));
         if let Some((id, end)) = sup_done {
             self.sup = end;
             self.sup_job = None;

@@ -152,9 +152,10 @@ impl Axis {
     /// the job is done at the profile's end.
     fn advance_phasing(&mut self) {
         if let Some(ph) = self.phasing {
-            self.phase = ph.prof.at(self.elapsed(ph.t0));
-            if self.elapsed(ph.t0) >= ph.prof.duration() {
-                self.phase = ph.prof.end();
+            let prof = &self.phasing_prof;
+            self.phase = prof.at(self.elapsed(ph.t0));
+            if self.elapsed(ph.t0) >= prof.duration() {
+                self.phase = prof.end();
                 self.phasing = None;
                 self.emit(ph.id, ph.instr, JobEventKind::Done);
             }
@@ -338,8 +339,9 @@ impl Axis {
         let offset_done = match &self.offset_job {
             Some(o) => {
                 let e = self.elapsed(o.t0);
-                self.shift_out = o.prof.at(e);
-                (e >= o.prof.duration()).then_some((o.id, o.instr, o.prof.end()))
+                let prof = &self.offset_prof;
+                self.shift_out = prof.at(e);
+                (e >= prof.duration()).then_some((o.id, o.instr, prof.end()))
             }
             None => None,
         };

@@ -3,7 +3,7 @@
 
 use super::law::SyncLaw;
 use crate::kinematics::dynamics::Dynamics;
-use crate::kinematics::profile::{Limits, Profile};
+use crate::kinematics::profile::Limits;
 use crate::objects::axis::{SyncDirection, SyncProfileReference};
 use crate::objects::job::{Instruction, JobId};
 use crate::objects::leading::LeaderId;
@@ -42,15 +42,14 @@ impl SyncJob {
     }
 }
 
-/// A phasing job: a profile of the phase shift (leading value units). The small fields first
-/// (`repr(C)`): an axis' cycle looks at whether it has one.
+/// A phasing or offset job: the profile of the shift (leading value units for phasing, follower
+/// units for offsets) starts at `t0`. The axis keeps the profile apart (its cycle looks at
+/// whether a job runs, the profile is read only then).
 #[derive(Copy, Clone, Debug, PartialEq)]
-#[repr(C)]
 pub(in crate::objects::axis) struct PhasingJob {
     pub id: JobId,
     pub instr: Instruction,
     pub t0: i64,
-    pub prof: Profile,
 }
 
 /// The inputs shared by the absolute synchronizations (MC_GearInPos, MC_CamIn): the leader, where
