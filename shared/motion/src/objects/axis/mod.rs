@@ -31,7 +31,7 @@ use crate::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, 
 use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
 use crate::objects::leading::LeadingValue;
 use crate::plant::link::{AxisSignals, DriveInputs, DriveLink, DriveOutputs, SimPlant};
-use std::cell::OnceCell;
+use std::cell::{Cell, OnceCell};
 
 /// PLCopen axis states (S7-1500T Motion Control V4.0 function manual, A.2.35 'StatusWord tag' (the
 /// manual draws no state diagram), PLCopen Motion Control part 1, axis state diagram).
@@ -260,12 +260,15 @@ struct Power {
 /// An axis technology object with its drive connection.
 ///
 /// The fields are in this order (`repr(C)`) so that what every cycle of every axis reads and
-/// writes lies together at the start (a node steps a thousand axes a millisecond: their state
-/// does not stay in the caches), then what followers and running jobs read, then what is read
-/// seldom.
+/// writes lies together (a node steps a thousand axes a millisecond: their state does not stay
+/// in the caches between two cycles): the job events' counts (at the end of the queue), the
+/// state, the running jobs and the synchronous jobs' discriminants; then what followers and
+/// running jobs read; then what is read seldom.
 #[derive(Clone, Debug)]
 #[repr(C)]
 pub struct Axis {
+    /// Job events (their counts last: next to the state below).
+    events: EventQueue,
     now: i64,
     t0: i64,
     basic: State,
@@ -305,17 +308,18 @@ pub struct Axis {
     main: Option<MotionJob>,
     /// Leading values for this cycle: of the active and of the pending job's leader.
     lead: [Option<crate::objects::leading::LeadingValue>; 2],
+    /// Whether `status` holds the status (so that a cycle need not look at it).
+    status_kept: Cell<bool>,
+    sync_pending: Option<sync::SyncJob>,
+    sync: Option<sync::SyncJob>,
+    prof: Profile,
+    /// Cams of the active and the pending CamIn, with their mappings.
+    cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
+    cam_maps: [Option<sync::CamMap>; 2],
     /// The status after the last cycle or command, computed when first read (most cycles
     /// nobody reads it): emptied by [`Axis::step`] and [`Axis::command`], pinned before a
     /// change between them that must not show until then ([`Axis::raise`]).
     status: OnceCell<AxisStatus>,
-    events: EventQueue,
-    prof: Profile,
-    sync: Option<sync::SyncJob>,
-    sync_pending: Option<sync::SyncJob>,
-    /// Cams of the active and the pending CamIn, with their mappings.
-    cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
-    cam_maps: [Option<sync::CamMap>; 2],
     /// The profiles of `sup_job`, `phasing` and `offset_job` (meaningful while they run).
     sup_prof: Profile,
     phasing_prof: Profile,
@@ -413,6 +417,7 @@ impl Axis {
             next_id: 1,
             now: 0,
             status: OnceCell::new(),
+            status_kept: Cell::new(false),
             cfg,
         })
     }
@@ -424,13 +429,31 @@ impl Axis {
 
     /// The status after the last cycle (or command).
     pub fn status(&self) -> &AxisStatus {
+        self.status_kept.set(true);
         self.status.get_or_init(|| self.current_status())
+    }
+
+    /// The status if it was built since the last cycle or command.
+    fn kept_status(&self) -> Option<&AxisStatus> {
+        if self.status_kept.get() {
+            self.status.get()
+        } else {
+            None
+        }
+    }
+
+    /// Forgets the status (the end of a cycle or command).
+    fn forget_status(&mut self) {
+        if self.status_kept.get() {
+            self.status = OnceCell::new();
+            self.status_kept.set(false);
+        }
     }
 
     /// The status after the last cycle (or command), as [`Axis::status`] has it, by value:
     /// for a caller that keeps its own copy (it is not kept here too).
     pub fn status_value(&self) -> AxisStatus {
-        match self.status.get() {
+        match self.kept_status() {
             Some(s) => *s,
             None => self.current_status(),
         }
@@ -460,7 +483,7 @@ impl Axis {
     pub fn setpoint_leading_value(&self) -> LeadingValue {
         // The total setpoint as the status shows it, without building the status: unless the
         // status was pinned, the setpoint has not changed since the last cycle or command.
-        let s = match self.status.get() {
+        let s = match self.kept_status() {
             Some(s) => State {
                 p: s.position_unwrapped,
                 v: s.velocity,
@@ -878,7 +901,7 @@ impl Axis {
     /// continues from there, so nothing jumps.
     pub fn command(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
         let r = self.apply(cmd);
-        self.status = OnceCell::new();
+        self.forget_status();
         r
     }
 

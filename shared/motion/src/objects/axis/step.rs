@@ -49,7 +49,7 @@ impl Axis {
             DriveLink::Simulation(plant) => plant.apply(&out),
             DriveLink::Connected { outputs, .. } => *outputs = out,
         }
-        self.status = std::cell::OnceCell::new();
+        self.forget_status();
     }
 
     /// The drive outputs of this cycle: the total setpoint in physical coordinates.

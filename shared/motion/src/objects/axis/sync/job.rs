@@ -19,11 +19,13 @@ pub(in crate::objects::axis) enum SyncPhase {
     Synchronous,
 }
 
-/// A synchronous operation job. The small fields first (`repr(C)`): an axis' cycle looks at
-/// whether it has one and in which phase.
+/// A synchronous operation job. The law first (`repr(C)`): its discriminant is where an
+/// `Option` of the job keeps whether there is one, which an axis' cycle reads next to the
+/// state before it in the axis.
 #[derive(Copy, Clone, Debug, PartialEq)]
 #[repr(C)]
 pub(in crate::objects::axis) struct SyncJob {
+    pub law: SyncLaw,
     pub id: JobId,
     pub instr: Instruction,
     pub phase: SyncPhase,
@@ -32,7 +34,6 @@ pub(in crate::objects::axis) struct SyncJob {
     pub master: LeaderId,
     pub ratio: f64,
     pub lim: Limits,
-    pub law: SyncLaw,
 }
 
 impl SyncJob {
