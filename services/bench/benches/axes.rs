@@ -383,13 +383,25 @@ fn read_statuses(exec: &mut Executive) {
     std::hint::black_box(exec.status());
 }
 
-/// Runs [`EngineOnly`] for `seconds` of engine time; with `read_status`, reads the status of
-/// every axis every that many cycles, as the node's telemetry does.
+/// How [`engine_only`] runs the engine besides stepping it.
+#[derive(Debug, Clone, Copy, Default)]
+struct EngineRun {
+    /// Read the status of every axis every that many cycles, as the node's telemetry does.
+    read_status: Option<i64>,
+    /// Before each cycle, evict the caches (write a buffer larger than the last-level cache),
+    /// outside the measured time: the engine as a node finds its state after sleeping, at worst.
+    cold: bool,
+}
+
+/// Bytes written to evict the caches (twice the machine's 32 MiB L3).
+const EVICT_BYTES: usize = 64 << 20;
+
+/// Runs [`EngineOnly`] for `seconds` of engine time.
 fn engine_only(
     cell_path: &Path,
     script_path: &Path,
     seconds: f64,
-    read_status: Option<i64>,
+    run: EngineRun,
 ) -> Result<EngineOnly, String> {
     let cell = tandem_config::load(cell_path).map_err(|e| e.to_string())?;
     let src = std::fs::read_to_string(script_path)
@@ -402,10 +414,19 @@ fn engine_only(
     let cycles = (seconds * 1e9) as i64 / cycle_ns + 1;
     let mut hist = tandem_node::Histogram::default();
     let mut next = 0;
-    let (cpu0, wall0) = (rt::thread_cpu_ns(), rt::now_ns());
+    let mut evict = if run.cold {
+        vec![0u8; EVICT_BYTES]
+    } else {
+        Vec::new()
+    };
+    let (mut cpu, mut wall) = (0, 0);
     for k in 0..cycles {
         let t = k * cycle_ns;
-        let t0 = rt::now_ns();
+        for (i, x) in evict.iter_mut().enumerate().step_by(64) {
+            *x = x.wrapping_add(i as u8);
+        }
+        std::hint::black_box(&mut evict);
+        let (cpu0, t0) = (rt::thread_cpu_ns(), rt::now_ns());
         while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
             next += 1;
             // The bench checks the node's run for rejections; here only the time counts.
@@ -414,12 +435,14 @@ fn engine_only(
         exec.step(t, &mut log).map_err(|e| e.to_string())?;
         exec.drain_job_notes(|_| {});
         exec.drain_io_notes(|_| {});
-        if read_status.is_some_and(|n| k % n.max(1) == 0) {
+        if run.read_status.is_some_and(|n| k % n.max(1) == 0) {
             read_statuses(&mut exec);
         }
-        hist.record(rt::now_ns() - t0);
+        let (cpu1, t1) = (rt::thread_cpu_ns(), rt::now_ns());
+        hist.record(t1 - t0);
+        cpu += cpu1 - cpu0;
+        wall += t1 - t0;
     }
-    let (cpu, wall) = (rt::thread_cpu_ns() - cpu0, rt::now_ns() - wall0);
     let n = cycles.max(1) as f64;
     Ok(EngineOnly {
         cycles: cycles as u64,
@@ -445,9 +468,13 @@ fn generate(n: usize, seconds: f64, dir: &Path) -> Result<(String, PathBuf, Path
 /// `--engine-only`: the engine alone on the cell and script of `n` axes, reading every axis'
 /// status every [`TELEMETRY_EVERY`] cycles as the node's telemetry does, printed; no node (for
 /// instruction counts under `valgrind --tool=callgrind`, which the node's real clock defeats).
-fn engine_alone(n: usize, seconds: f64, dir: &Path) -> Result<(), String> {
+fn engine_alone(n: usize, seconds: f64, dir: &Path, cold: bool) -> Result<(), String> {
     let (_, cell_path, script_path) = generate(n, seconds, dir)?;
-    let e = engine_only(&cell_path, &script_path, seconds, Some(TELEMETRY_EVERY))?;
+    let run = EngineRun {
+        read_status: Some(TELEMETRY_EVERY),
+        cold,
+    };
+    let e = engine_only(&cell_path, &script_path, seconds, run)?;
     println!(
         "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
          CPU {:.1} µs per cycle ({:.1} % of a core)",
@@ -497,7 +524,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         (validate - load).as_secs_f64() * 1e3
     );
 
-    let engine = engine_only(&cell_path, &script_path, seconds, None)?;
+    let engine = engine_only(&cell_path, &script_path, seconds, EngineRun::default())?;
     eprintln!(
         "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
          CPU {:.1} µs per cycle ({:.1} % of a core)",
@@ -822,6 +849,15 @@ fn main() -> ExitCode {
                 ),
         )
         .arg(
+            Arg::new("cold")
+                .long("cold")
+                .action(ArgAction::SetTrue)
+                .help(
+                    "With --engine-only: evict the caches before each cycle (outside the \
+                     measured time), as a node may find them after sleeping",
+                ),
+        )
+        .arg(
             Arg::new("keep")
                 .long("keep")
                 .action(ArgAction::SetTrue)
@@ -855,7 +891,7 @@ fn main() -> ExitCode {
     if m.get_flag("engine-only") {
         let mut code = ExitCode::SUCCESS;
         for n in sizes {
-            if let Err(e) = engine_alone(n, seconds, &dir) {
+            if let Err(e) = engine_alone(n, seconds, &dir, m.get_flag("cold")) {
                 eprintln!("tandem-bench-axes: {n} axes: error: {e}");
                 code = ExitCode::FAILURE;
             }
