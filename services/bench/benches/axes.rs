@@ -39,6 +39,8 @@ const STROKE: f64 = 200.0;
 const MASTER_VELOCITY: f64 = 1000.0;
 /// Length of the cam's master range (one knife turn per 500 mm).
 const CAM_LENGTH: f64 = 500.0;
+/// Cycles between two telemetry snapshots of the node (at the default `telemetry_hz`, 50).
+const TELEMETRY_EVERY: i64 = 10;
 /// Targets.
 const CPU_TARGET_AXES: usize = 256;
 const CPU_TARGET_PERCENT: f64 = 20.0;
@@ -375,8 +377,32 @@ impl EngineOnly {
     }
 }
 
+/// Reads the status of every axis (a function of its own, for callgrind's `--toggle-collect`).
+#[inline(never)]
+fn read_statuses(exec: &mut Executive) {
+    std::hint::black_box(exec.status());
+}
+
+/// How [`engine_only`] runs the engine besides stepping it.
+#[derive(Debug, Clone, Copy, Default)]
+struct EngineRun {
+    /// Read the status of every axis every that many cycles, as the node's telemetry does.
+    read_status: Option<i64>,
+    /// Before each cycle, evict the caches (write a buffer larger than the last-level cache),
+    /// outside the measured time: the engine as a node finds its state after sleeping, at worst.
+    cold: bool,
+}
+
+/// Bytes written to evict the caches (twice the machine's 32 MiB L3).
+const EVICT_BYTES: usize = 64 << 20;
+
 /// Runs [`EngineOnly`] for `seconds` of engine time.
-fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<EngineOnly, String> {
+fn engine_only(
+    cell_path: &Path,
+    script_path: &Path,
+    seconds: f64,
+    run: EngineRun,
+) -> Result<EngineOnly, String> {
     let cell = tandem_config::load(cell_path).map_err(|e| e.to_string())?;
     let src = std::fs::read_to_string(script_path)
         .map_err(|e| format!("{}: {e}", script_path.display()))?;
@@ -388,10 +414,19 @@ fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<Eng
     let cycles = (seconds * 1e9) as i64 / cycle_ns + 1;
     let mut hist = tandem_node::Histogram::default();
     let mut next = 0;
-    let (cpu0, wall0) = (rt::thread_cpu_ns(), rt::now_ns());
+    let mut evict = if run.cold {
+        vec![0u8; EVICT_BYTES]
+    } else {
+        Vec::new()
+    };
+    let (mut cpu, mut wall) = (0, 0);
     for k in 0..cycles {
         let t = k * cycle_ns;
-        let t0 = rt::now_ns();
+        for (i, x) in evict.iter_mut().enumerate().step_by(64) {
+            *x = x.wrapping_add(i as u8);
+        }
+        std::hint::black_box(&mut evict);
+        let (cpu0, t0) = (rt::thread_cpu_ns(), rt::now_ns());
         while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
             next += 1;
             // The bench checks the node's run for rejections; here only the time counts.
@@ -400,9 +435,14 @@ fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<Eng
         exec.step(t, &mut log).map_err(|e| e.to_string())?;
         exec.drain_job_notes(|_| {});
         exec.drain_io_notes(|_| {});
-        hist.record(rt::now_ns() - t0);
+        if run.read_status.is_some_and(|n| k % n.max(1) == 0) {
+            read_statuses(&mut exec);
+        }
+        let (cpu1, t1) = (rt::thread_cpu_ns(), rt::now_ns());
+        hist.record(t1 - t0);
+        cpu += cpu1 - cpu0;
+        wall += t1 - t0;
     }
-    let (cpu, wall) = (rt::thread_cpu_ns() - cpu0, rt::now_ns() - wall0);
     let n = cycles.max(1) as f64;
     Ok(EngineOnly {
         cycles: cycles as u64,
@@ -412,16 +452,45 @@ fn engine_only(cell_path: &Path, script_path: &Path, seconds: f64) -> Result<Eng
     })
 }
 
-fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome, String> {
+/// Writes the cell and the script of `n` axes into `dir`: (cell name, cell path, script path).
+fn generate(n: usize, seconds: f64, dir: &Path) -> Result<(String, PathBuf, PathBuf), String> {
     let mix = Mix::of(n);
     let cell_name = format!("bench-axes-{n}");
     let cell_path = dir.join(format!("cell-{n}.toml"));
     let script_path = dir.join(format!("script-{n}.toml"));
-    let log_path = dir.join(format!("node-{n}.log"));
     let write =
         |p: &PathBuf, s: String| std::fs::write(p, s).map_err(|e| format!("{}: {e}", p.display()));
     write(&cell_path, cell_toml(&cell_name, &mix))?;
     write(&script_path, script_toml(&mix, seconds))?;
+    Ok((cell_name, cell_path, script_path))
+}
+
+/// `--engine-only`: the engine alone on the cell and script of `n` axes, reading every axis'
+/// status every [`TELEMETRY_EVERY`] cycles as the node's telemetry does, printed; no node (for
+/// instruction counts under `valgrind --tool=callgrind`, which the node's real clock defeats).
+fn engine_alone(n: usize, seconds: f64, dir: &Path, cold: bool) -> Result<(), String> {
+    let (_, cell_path, script_path) = generate(n, seconds, dir)?;
+    let run = EngineRun {
+        read_status: Some(TELEMETRY_EVERY),
+        cold,
+    };
+    let e = engine_only(&cell_path, &script_path, seconds, run)?;
+    println!(
+        "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
+         CPU {:.1} µs per cycle ({:.1} % of a core)",
+        e.cycles,
+        e.mean_us,
+        e.p50_us,
+        e.cpu_us,
+        e.percent()
+    );
+    Ok(())
+}
+
+fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome, String> {
+    let mix = Mix::of(n);
+    let (cell_name, cell_path, script_path) = generate(n, seconds, dir)?;
+    let log_path = dir.join(format!("node-{n}.log"));
 
     // Validate as the node will load them, and time it: the node does the same before its
     // first cycle, so the epoch leaves room for it.
@@ -455,7 +524,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         (validate - load).as_secs_f64() * 1e3
     );
 
-    let engine = engine_only(&cell_path, &script_path, seconds)?;
+    let engine = engine_only(&cell_path, &script_path, seconds, EngineRun::default())?;
     eprintln!(
         "tandem-bench-axes: {n} axes, engine only: {} cycles, step {:.1} µs mean, {:.0} µs p50, \
          CPU {:.1} µs per cycle ({:.1} % of a core)",
@@ -770,6 +839,25 @@ fn main() -> ExitCode {
                 ),
         )
         .arg(
+            Arg::new("engine-only")
+                .long("engine-only")
+                .action(ArgAction::SetTrue)
+                .help(
+                    "Run only the engine alone (Executive::step in a tight loop, reading every \
+                     axis' status every 10th cycle as the node's telemetry does), not the node: \
+                     for instruction counts under valgrind --tool=callgrind",
+                ),
+        )
+        .arg(
+            Arg::new("cold")
+                .long("cold")
+                .action(ArgAction::SetTrue)
+                .help(
+                    "With --engine-only: evict the caches before each cycle (outside the \
+                     measured time), as a node may find them after sleeping",
+                ),
+        )
+        .arg(
             Arg::new("keep")
                 .long("keep")
                 .action(ArgAction::SetTrue)
@@ -800,6 +888,18 @@ fn main() -> ExitCode {
     }
     let mut outcomes = Vec::new();
     let mut failed = false;
+    if m.get_flag("engine-only") {
+        let mut code = ExitCode::SUCCESS;
+        for n in sizes {
+            if let Err(e) = engine_alone(n, seconds, &dir, m.get_flag("cold")) {
+                eprintln!("tandem-bench-axes: {n} axes: error: {e}");
+                code = ExitCode::FAILURE;
+            }
+        }
+        // Cleanup of a scratch directory: one already gone is fine.
+        let _ = std::fs::remove_dir_all(&dir);
+        return code;
+    }
     for n in sizes {
         match run_one(n, seconds, &dir, with_log) {
             Ok(o) => {

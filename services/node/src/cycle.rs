@@ -13,7 +13,7 @@ use crate::ports::Ports;
 use crate::report::{cpu_time_ns, Report};
 use std::sync::mpsc::{Receiver, SyncSender};
 use tandem_config::script::ScriptEntry;
-use tandem_config::Cell;
+use tandem_config::{AxisIndex, Cell};
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::objects::axis::AxisStatus;
 use tandem_protocol::wire::{
@@ -329,10 +329,11 @@ impl<'c> NodeCycle<'c> {
 
     /// Hands this cycle's job events to the recorder, each with its axis' pending alarm.
     fn hand_over_jobs(&mut self) {
-        let status = self.exec.status();
         for event in self.jobs.drain(..) {
-            let alarm = status
-                .get(event.object as usize)
+            // Only these axes' status is read (copying every axis' would cost each cycle).
+            let alarm = self
+                .exec
+                .axis_status(AxisIndex(event.object as usize))
                 .map_or(0, |s| s.error_detail.number);
             if self
                 .links

@@ -158,7 +158,7 @@ struct LeaderBuffer {
 
 /// How a follower reads one leader: the coupling, and the buffer of samples if it reads it
 /// delayed or from another node.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct LeaderSource {
     leader: Leader,
     coupling: Coupling,
@@ -192,7 +192,8 @@ struct StepPlan {
     unreached: Vec<usize>,
     /// Per axis: taken into `order` (while planning).
     taken: Vec<bool>,
-    /// A plan was made.
+    /// A plan was made and every owned axis still has the leaders it was planned with (an
+    /// axis' leaders change only when it steps or takes a command: [`StepPlan::note`]).
     valid: bool,
 }
 
@@ -208,14 +209,17 @@ impl StepPlan {
         }
     }
 
-    /// Whether the plan still holds: every owned axis has the leaders it was planned with.
-    fn holds(&self, axes: &[Axis], owned: &[bool]) -> bool {
-        self.valid
-            && axes
-                .iter()
-                .zip(&self.leaders)
-                .zip(owned)
-                .all(|((a, l), o)| !o || a.leaders() == *l)
+    /// Whether axis `i` still has the leaders it was planned with.
+    fn planned_with(&self, i: usize, axis: &Axis) -> bool {
+        self.leaders.get(i) == Some(&axis.leaders())
+    }
+
+    /// Notes the leaders of axis `i` after it stepped or took a command: the plan no longer
+    /// holds when they are not those it was planned with.
+    fn note(&mut self, i: usize, axis: &Axis) {
+        if !self.planned_with(i, axis) {
+            self.valid = false;
+        }
     }
 }
 
@@ -454,7 +458,11 @@ pub struct Executive<'c> {
     object_axes: Vec<usize>,
     motions: Vec<Option<CycleMotion>>,
     alarms_seen: Vec<[(u16, u16); 8]>,
+    /// Per axis: its status after the last step, copied from the axis when first read (most
+    /// steps nobody reads most of them).
     status: Vec<AxisStatus>,
+    /// Per axis: `status` is older than the axis' last step (see [`Executive::snapshot`]).
+    stale: Vec<bool>,
     encoder_status: Vec<EncoderStatus>,
     /// The status at each axis' previous cycle (the start of its objects' motion).
     last_cycle: Vec<AxisStatus>,
@@ -524,6 +532,7 @@ impl<'c> Executive<'c> {
             alarms_seen: vec![[(0, 0); 8]; axes.len()],
             last_cycle: status.clone(),
             status,
+            stale: vec![false; cell.axes.len()],
             encoder_status,
             plan: StepPlan::with_capacity(axes.len()),
             cycles,
@@ -551,9 +560,32 @@ impl<'c> Executive<'c> {
         self.owned.axis(i)
     }
 
-    /// The status of every axis of the cell (meaningful for the owned ones).
-    pub fn status(&self) -> &[AxisStatus] {
+    /// The status of every axis of the cell after the last step (meaningful for the owned
+    /// ones).
+    pub fn status(&mut self) -> &[AxisStatus] {
+        for i in 0..self.stale.len() {
+            self.snapshot(i);
+        }
         &self.status
+    }
+
+    /// The status of axis `i` after the last step, as [`Executive::status`] has it.
+    pub fn axis_status(&mut self, i: AxisIndex) -> Option<&AxisStatus> {
+        self.snapshot(i.0);
+        self.status.get(i.0)
+    }
+
+    /// Copies the status of axis `i` after the last step, unless that is done: when it is read,
+    /// and before a command changes the axis.
+    fn snapshot(&mut self, i: usize) {
+        if let (Some(stale @ true), Some(axis), Some(s)) = (
+            self.stale.get_mut(i),
+            self.axes.get(i),
+            self.status.get_mut(i),
+        ) {
+            *s = axis.status_value();
+            *stale = false;
+        }
     }
 
     /// The status of every encoder of the cell (meaningful for the owned ones).
@@ -762,7 +794,13 @@ impl<'c> Executive<'c> {
             }
             // The leader must be one of the follower's configured leaders.
             Some(Some(m)) if cell.coupling(i, m).is_none() => Err(ErrorId::IllegalObject),
-            _ => self.axes[i.0].command(&command).map(Some),
+            _ => {
+                // The status of the last step stays what it was until the next step.
+                self.snapshot(i.0);
+                let r = self.axes[i.0].command(&command).map(Some);
+                self.plan.note(i.0, &self.axes[i.0]);
+                r
+            }
         };
         if let (Ok(_), Command::Home { mode, .. }) = (&result, command) {
             self.objects.homing_started(cell, i, mode);
@@ -986,17 +1024,31 @@ impl<'c> Executive<'c> {
     /// needs has, with the leading values of this step. The order is planned again when an
     /// axis' leaders changed since the last step.
     fn step_axes(&mut self, t: i64) {
-        if !self.plan.holds(&self.axes, &self.owned.axes) {
+        if !self.plan.valid {
             self.replan();
         }
         // Which nodes' cycles fall on `t` (one division per node, not per axis).
         for (due, node) in self.due.iter_mut().zip(&self.cell.nodes) {
             *due = t % node.cycle_ns == 0;
         }
-        for k in 0..self.plan.order.len() {
-            let Planned { axis: i, reads } = self.plan.order[k];
-            for read in reads.into_iter().flatten() {
+        // The plan is read in place while the axes step (taken out, put back below).
+        let mut plan = std::mem::take(&mut self.plan);
+        // The last leader read directly (without a buffer) and its value: the followers of one
+        // leader come one after another, and the value changes only when the leader steps.
+        let mut last: Option<(LeaderSource, Option<LeadingValue>)> = None;
+        let mut holds = true;
+        for p in &plan.order {
+            let i = p.axis;
+            for read in p.reads.iter().flatten() {
                 let lv = match read.source {
+                    Some(src) if src.buffer.is_none() => match last {
+                        Some((s, v)) if s == src => v,
+                        _ => {
+                            let v = self.leading_value(src, t);
+                            last = Some((src, v));
+                            v
+                        }
+                    },
                     Some(src) => self.leading_value(src, t),
                     None => None,
                 };
@@ -1004,16 +1056,22 @@ impl<'c> Executive<'c> {
             }
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
+                holds &= plan.planned_with(i, &self.axes[i]);
+                if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
+                    last = None;
+                }
             }
         }
         // Not empty only with a coupling loop, which commands cannot create (16#8019): the
         // axis then runs without its leading value and raises "leader missing".
-        for k in 0..self.plan.unreached.len() {
-            let i = self.plan.unreached[k];
+        for &i in &plan.unreached {
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
+                holds &= plan.planned_with(i, &self.axes[i]);
             }
         }
+        plan.valid &= holds;
+        self.plan = plan;
     }
 
     /// Plans the order of the owned axes from their current leaders: passes over the axes in
@@ -1063,7 +1121,7 @@ impl<'c> Executive<'c> {
         self.plan = plan;
     }
 
-    /// The job events and new alarms of the owned axes, and their status.
+    /// The job events and new alarms of the owned axes; their status is copied when read.
     fn axis_events(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
         for (i, axis) in self.axes.iter_mut().enumerate() {
@@ -1075,8 +1133,10 @@ impl<'c> Executive<'c> {
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
             }
             // Without a pending alarm, nor one seen last step, there is nothing new to log.
-            if !axis.alarm_pending() && self.alarms_seen[i].iter().all(|&(n, s)| n | s == 0) {
-                self.status[i] = *axis.status();
+            // Its status is copied when read.
+            self.stale[i] = true;
+            // (The slots are filled from the first: all are empty when the first is.)
+            if !axis.alarm_pending() && self.alarms_seen[i][0] == (0, 0) {
                 continue;
             }
             let mut now = [(0u16, 0u16); 8];
@@ -1096,7 +1156,6 @@ impl<'c> Executive<'c> {
                 }
             }
             self.alarms_seen[i] = now;
-            self.status[i] = *axis.status();
         }
         Ok(())
     }
@@ -1107,7 +1166,9 @@ impl<'c> Executive<'c> {
         let cell = self.cell;
         // Only the axes whose motion is needed have one (the others' stay `None`); their
         // previous cycle's status is kept for it.
-        for &i in &self.motion_axes {
+        for k in 0..self.motion_axes.len() {
+            let i = self.motion_axes[k];
+            self.snapshot(i);
             self.motions[i] = (t % self.cycles[i] == 0).then(|| {
                 cycle_motion(
                     &self.last_cycle[i],
@@ -1157,7 +1218,11 @@ impl<'c> Executive<'c> {
                 cell.axes[a].name,
                 distance
             )?;
-            if let Err(id) = self.axes[a.0].command(&command) {
+            // The status of this step stays what it was before the correction.
+            self.snapshot(a.0);
+            let r = self.axes[a.0].command(&command);
+            self.plan.note(a.0, &self.axes[a.0]);
+            if let Err(id) = r {
                 self.rejected += 1;
                 writeln!(
                     log,

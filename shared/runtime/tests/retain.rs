@@ -81,11 +81,11 @@ impl<'c> Run<'c> {
         String::from_utf8_lossy(&self.log).into_owned()
     }
 
-    fn homed(&self) -> bool {
+    fn homed(&mut self) -> bool {
         self.exec.status()[0].status_word & status_bit::HOMING_DONE != 0
     }
 
-    fn actual(&self) -> f64 {
+    fn actual(&mut self) -> f64 {
         self.exec.status()[0].actual_position
     }
 

@@ -67,7 +67,7 @@ impl<'c> Run<'c> {
         String::from_utf8_lossy(&self.log).into_owned()
     }
 
-    fn state(&self) -> AxisState {
+    fn state(&mut self) -> AxisState {
         self.exec.status()[0].state
     }
 
@@ -81,7 +81,7 @@ impl<'c> Run<'c> {
     }
 
     /// Steps until `f` holds, at most `max` cycles.
-    fn until(&mut self, max: usize, what: &str, f: impl Fn(&Self) -> bool) {
+    fn until(&mut self, max: usize, what: &str, f: impl Fn(&mut Self) -> bool) {
         for _ in 0..max {
             if f(self) {
                 return;

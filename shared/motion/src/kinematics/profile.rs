@@ -130,12 +130,16 @@ impl Segment {
 }
 
 /// A planned profile: segments plus the exact end state, valid from its start for all `t >= 0`.
+///
+/// In this order (`repr(C)`): an evaluation reads the count, the duration and the end first,
+/// then one segment, so they share cache lines with the first segments.
 #[derive(Copy, Clone, Debug, PartialEq)]
+#[repr(C)]
 pub struct Profile {
-    segs: [Segment; MAX_SEGMENTS],
     n: usize,
     duration: f64,
     end: State,
+    segs: [Segment; MAX_SEGMENTS],
 }
 
 impl Profile {

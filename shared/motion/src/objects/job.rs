@@ -142,7 +142,11 @@ pub struct JobEvent {
 pub const EVENT_CAPACITY: usize = 64;
 
 /// Fixed-capacity FIFO of job events; when full the oldest event is dropped and counted.
+///
+/// The counts come last (`repr(C)`): the cycle reads them every time, the slots seldom, and
+/// an axis keeps the state its cycle reads right after them.
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct EventQueue {
     buf: [Option<JobEvent>; EVENT_CAPACITY],
     head: usize,

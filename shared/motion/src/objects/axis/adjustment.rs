@@ -112,7 +112,9 @@ impl Axis {
         self.basic = State::rest(self.actual_p);
         self.extrapolator.reset(self.actual_p, self.actual_v);
         self.replan();
-        self.refresh_status();
+        // The status is built again when next read.
+        self.status = std::cell::OnceCell::new();
+        self.status_kept.set(false);
         Ok(())
     }
 

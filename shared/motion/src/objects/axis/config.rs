@@ -169,36 +169,40 @@ pub struct SoftwareLimits {
 }
 
 /// Everything an axis is built from.
+///
+/// In this order (`repr(C)`): what an axis reads every cycle first, what it reads when a job
+/// starts or at construction after.
 #[derive(Clone, Debug, PartialEq)]
+#[repr(C)]
 pub struct AxisConfig {
+    /// Servo cycle (s, > 0).
+    pub cycle: f64,
     /// Speed or positioning axis.
     pub kind: AxisKind,
-    /// Linear or rotary.
-    pub motion_type: MotionType,
-    /// Modulo settings (positioning axes).
-    pub modulo: Option<Modulo>,
-    /// Encoder type.
-    pub encoder: EncoderType,
     /// Virtual axis / simulation mode (S7-1500T Motion Control V4.0 function manual, 3.2.5.7 'Axis
     /// in simulation'): homing completes at once without motion, hardware limit switches have no
     /// effect.
     pub virtual_axis: bool,
-    /// Servo cycle (s, > 0).
-    pub cycle: f64,
-    /// `DynamicLimits`.
-    pub limits: DynamicLimits,
-    /// `DynamicDefaults`.
-    pub defaults: DynamicDefaults,
-    /// Software limit switches (non-modulo axes), active when set.
-    pub sw_limits: Option<SoftwareLimits>,
     /// `PositionLimits_HW.Active`: evaluate the plant's hardware limit switches.
     pub hw_limits_active: bool,
-    /// Positioning monitoring.
-    pub positioning: PositioningMonitoring,
-    /// Following-error monitoring.
-    pub following_error: FollowingErrorMonitoring,
+    /// Modulo settings (positioning axes).
+    pub modulo: Option<Modulo>,
+    /// Software limit switches (non-modulo axes), active when set.
+    pub sw_limits: Option<SoftwareLimits>,
+    /// `DynamicLimits`.
+    pub limits: DynamicLimits,
     /// Standstill signal.
     pub standstill: StandstillSignal,
+    /// Following-error monitoring.
+    pub following_error: FollowingErrorMonitoring,
+    /// Positioning monitoring.
+    pub positioning: PositioningMonitoring,
+    /// Linear or rotary.
+    pub motion_type: MotionType,
+    /// Encoder type.
+    pub encoder: EncoderType,
+    /// `DynamicDefaults`.
+    pub defaults: DynamicDefaults,
     /// Homing.
     pub homing: HomingConfig,
     /// Simulated drive model.

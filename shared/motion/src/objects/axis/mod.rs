@@ -33,6 +33,7 @@ use crate::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, 
 use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
 use crate::objects::leading::LeadingValue;
 use crate::plant::link::{AxisSignals, DriveInputs, DriveLink, DriveOutputs, SimPlant};
+use std::cell::{Cell, OnceCell};
 
 /// PLCopen axis states (S7-1500T Motion Control V4.0 function manual, A.2.35 'StatusWord tag' (the
 /// manual draws no state diagram), PLCopen Motion Control part 1, axis state diagram).
@@ -230,10 +231,11 @@ struct PosMon {
     entered_ns: Option<i64>,
 }
 
+/// A superimposed job: its profile (kept apart in the axis, read only while the job runs)
+/// starts at `t0`.
 #[derive(Copy, Clone, Debug, PartialEq)]
 struct SupJob {
     id: JobId,
-    prof: Profile,
     t0: i64,
 }
 
@@ -258,66 +260,83 @@ struct Power {
 }
 
 /// An axis technology object with its drive connection.
+///
+/// The fields are in this order (`repr(C)`) so that what every cycle of every axis reads and
+/// writes lies together (a node steps a thousand axes a millisecond: their state does not stay
+/// in the caches between two cycles): the job events' counts (at the end of the queue), the
+/// state, the running jobs and the synchronous jobs' discriminants; then what followers and
+/// running jobs read; then what is read seldom.
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct Axis {
-    cfg: AxisConfig,
-    link: DriveLink,
-    /// The input signals of the last cycle.
-    signals: AxisSignals,
-    power: Power,
-    enabled: bool,
-    pos_ctrl: bool,
-    /// Axis position = physical position + offset.
-    offset: f64,
-    /// The absolute encoder adjustment (MC_Home 6/7), retained by the runtime.
-    absolute: AbsoluteOffset,
-    homed: bool,
+    /// Job events (their counts last: next to the state below).
+    events: EventQueue,
+    now: i64,
+    t0: i64,
     basic: State,
     sup: State,
-    goal: Goal,
-    prof: Profile,
-    t0: i64,
-    override_pct: f64,
-    main: Option<MotionJob>,
-    sup_job: Option<SupJob>,
-    passive: Option<PassiveHoming>,
-    stop_lock: bool,
-    sync: Option<sync::SyncJob>,
-    sync_pending: Option<sync::SyncJob>,
-    phasing: Option<sync::PhasingJob>,
-    /// Phase shift state (leading value units).
-    phase: State,
-    offset_job: Option<sync::PhasingJob>,
-    /// MC_SynchronizedMotionSimulation running (its job).
-    sync_sim: Option<JobId>,
-    /// Cams of the active and the pending CamIn, with their mappings.
-    cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
-    cam_maps: [Option<sync::CamMap>; 2],
-    /// The cam handed over for the next MC_CamIn.
-    provided_cam: Option<(CamId, std::sync::Arc<crate::cam::Cam>)>,
-    /// Offset of the following value (MC_OffsetAbsolute/Relative), follower units.
-    shift_out: State,
-    /// Leading values for this cycle: of the active and of the pending job's leader.
-    lead: [Option<crate::objects::leading::LeadingValue>; 2],
-    sync_flags: u8,
-    /// The actual value prepared for actual-value coupling (run only while a follower may use
-    /// it: [`Axis::set_actual_value_output`]).
-    extrapolator: Extrapolator,
-    actual_output: bool,
-    alarms: [Option<AlarmInstance>; MAX_ALARMS],
-    /// Whether `alarms` has one (kept with it, so the cycle need not scan the slots).
-    alarm_pending: bool,
-    hw_trigger: Option<(Sense, f64)>,
-    sw_active: Option<Sense>,
-    standstill_since: Option<i64>,
-    fe: f64,
+    /// Axis position = physical position + offset.
+    offset: f64,
     actual_p: f64,
     actual_v: f64,
     prev_phys: f64,
-    events: EventQueue,
+    fe: f64,
+    override_pct: f64,
+    /// Phase shift state (leading value units).
+    phase: State,
+    /// Offset of the following value (MC_OffsetAbsolute/Relative), follower units.
+    shift_out: State,
+    goal: Goal,
+    standstill_since: Option<i64>,
+    hw_trigger: Option<(Sense, f64)>,
+    power: Power,
+    enabled: bool,
+    pos_ctrl: bool,
+    homed: bool,
+    stop_lock: bool,
+    actual_output: bool,
+    /// Whether `alarms` has one (kept with it, so the cycle need not scan the slots).
+    alarm_pending: bool,
+    sw_active: Option<Sense>,
+    sync_flags: u8,
+    /// MC_SynchronizedMotionSimulation running (its job).
+    sync_sim: Option<JobId>,
+    /// The input signals of the last cycle.
+    signals: AxisSignals,
+    passive: Option<PassiveHoming>,
+    sup_job: Option<SupJob>,
+    phasing: Option<sync::PhasingJob>,
+    offset_job: Option<sync::PhasingJob>,
+    main: Option<MotionJob>,
+    /// Leading values for this cycle: of the active and of the pending job's leader.
+    lead: [Option<crate::objects::leading::LeadingValue>; 2],
+    /// Whether `status` holds the status (so that a cycle need not look at it).
+    status_kept: Cell<bool>,
+    sync_pending: Option<sync::SyncJob>,
+    sync: Option<sync::SyncJob>,
+    prof: Profile,
+    /// Cams of the active and the pending CamIn, with their mappings.
+    cams: [Option<std::sync::Arc<crate::cam::Cam>>; 2],
+    cam_maps: [Option<sync::CamMap>; 2],
+    /// The status after the last cycle or command, computed when first read (most cycles
+    /// nobody reads it): emptied by [`Axis::step`] and [`Axis::command`], pinned before a
+    /// change between them that must not show until then ([`Axis::raise`]).
+    status: OnceCell<AxisStatus>,
+    /// The profiles of `sup_job`, `phasing` and `offset_job` (meaningful while they run).
+    sup_prof: Profile,
+    phasing_prof: Profile,
+    offset_prof: Profile,
+    cfg: AxisConfig,
+    link: DriveLink,
+    /// The actual value prepared for actual-value coupling (run only while a follower may use
+    /// it: [`Axis::set_actual_value_output`]).
+    extrapolator: Extrapolator,
+    alarms: [Option<AlarmInstance>; MAX_ALARMS],
+    /// The cam handed over for the next MC_CamIn.
+    provided_cam: Option<(CamId, std::sync::Arc<crate::cam::Cam>)>,
     next_id: JobId,
-    now: i64,
-    status: AxisStatus,
+    /// The absolute encoder adjustment (MC_Home 6/7), retained by the runtime.
+    absolute: AbsoluteOffset,
 }
 
 fn sign(x: f64) -> f64 {
@@ -343,7 +362,7 @@ impl Axis {
         ));
         let p0 = cfg.initial_position;
         let absolute = AbsoluteOffset::initial(cfg.encoder);
-        let mut axis = Self {
+        Ok(Self {
             link,
             signals: AxisSignals::default(),
             power: Power {
@@ -376,6 +395,9 @@ impl Axis {
             phasing: None,
             phase: State::default(),
             offset_job: None,
+            sup_prof: Profile::hold(State::default()),
+            phasing_prof: Profile::hold(State::default()),
+            offset_prof: Profile::hold(State::default()),
             sync_sim: None,
             cams: [None, None],
             cam_maps: [None; 2],
@@ -397,33 +419,10 @@ impl Axis {
             events: EventQueue::default(),
             next_id: 1,
             now: 0,
-            status: AxisStatus {
-                time_ns: 0,
-                state: AxisState::Disabled,
-                status_word: 0,
-                error_word: 0,
-                warning_word: 0,
-                error_detail: ErrorDetail::NONE,
-                position: p0,
-                velocity: 0.0,
-                acceleration: 0.0,
-                actual_position: p0,
-                actual_velocity: 0.0,
-                following_error: 0.0,
-                override_velocity: 100.0,
-                position_unwrapped: p0,
-                actual_position_unwrapped: p0,
-                motion_job: None,
-                superimposed_job: None,
-                sync_job: None,
-                sync_function: sync_function::NONE,
-                sync_status_word: 0,
-                phase_shift: 0.0,
-            },
+            status: OnceCell::new(),
+            status_kept: Cell::new(false),
             cfg,
-        };
-        axis.refresh_status();
-        Ok(axis)
+        })
     }
 
     /// The configuration.
@@ -433,7 +432,34 @@ impl Axis {
 
     /// The status after the last cycle (or command).
     pub fn status(&self) -> &AxisStatus {
-        &self.status
+        self.status_kept.set(true);
+        self.status.get_or_init(|| self.current_status())
+    }
+
+    /// The status if it was built since the last cycle or command.
+    fn kept_status(&self) -> Option<&AxisStatus> {
+        if self.status_kept.get() {
+            self.status.get()
+        } else {
+            None
+        }
+    }
+
+    /// Forgets the status (the end of a cycle or command).
+    fn forget_status(&mut self) {
+        if self.status_kept.get() {
+            self.status = OnceCell::new();
+            self.status_kept.set(false);
+        }
+    }
+
+    /// The status after the last cycle (or command), as [`Axis::status`] has it, by value:
+    /// for a caller that keeps its own copy (it is not kept here too).
+    pub fn status_value(&self) -> AxisStatus {
+        match self.kept_status() {
+            Some(s) => *s,
+            None => self.current_status(),
+        }
     }
 
     /// Takes the oldest pending job event.
@@ -458,11 +484,20 @@ impl Axis {
 
     /// This axis as a leader with setpoint coupling: its total setpoint (continuous position).
     pub fn setpoint_leading_value(&self) -> LeadingValue {
-        let s = &self.status;
+        // The total setpoint as the status shows it, without building the status: unless the
+        // status was pinned, the setpoint has not changed since the last cycle or command.
+        let s = match self.kept_status() {
+            Some(s) => State {
+                p: s.position_unwrapped,
+                v: s.velocity,
+                a: s.acceleration,
+            },
+            None => self.total(),
+        };
         LeadingValue {
-            p: s.position_unwrapped,
-            v: s.velocity,
-            a: s.acceleration,
+            p: s.p,
+            v: s.v,
+            a: s.a,
             modulo: self.cfg.modulo,
         }
     }
@@ -574,13 +609,13 @@ impl Axis {
 
     fn warn_clamped(&mut self, c: Clamped) {
         if c.velocity {
-            self.raise(AlarmId::VelocityLimited, supplement::NONE);
+            self.raise_alarm(AlarmId::VelocityLimited, supplement::NONE);
         }
         if c.acceleration {
-            self.raise(AlarmId::AccelerationLimited, supplement::NONE);
+            self.raise_alarm(AlarmId::AccelerationLimited, supplement::NONE);
         }
         if c.jerk {
-            self.raise(AlarmId::JerkLimited, supplement::NONE);
+            self.raise_alarm(AlarmId::JerkLimited, supplement::NONE);
         }
     }
 
@@ -724,8 +759,15 @@ impl Axis {
     }
 
     /// Raises a technology alarm and applies its reaction (S7-1500T Motion Control V4.0 function
-    /// manual, 9.3 'Technology alarms').
+    /// manual, 9.3 'Technology alarms'). Between cycles the status shows it from the next cycle
+    /// or command on, as before.
     pub fn raise(&mut self, id: AlarmId, supp: u16) {
+        self.status();
+        self.raise_alarm(id, supp);
+    }
+
+    /// [`Axis::raise`] within a cycle or command (whose end empties the status).
+    fn raise_alarm(&mut self, id: AlarmId, supp: u16) {
         if self.alarms().any(|a| a.id == id && a.supplement == supp) {
             return;
         }
@@ -862,7 +904,7 @@ impl Axis {
     /// continues from there, so nothing jumps.
     pub fn command(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
         let r = self.apply(cmd);
-        self.refresh_status();
+        self.forget_status();
         r
     }
 
@@ -1036,11 +1078,8 @@ impl Axis {
         let prof =
             plan_position(s, s.p + distance, &r.limits).map_err(|_| ErrorId::IllegalDistance)?;
         let id = self.new_id();
-        self.sup_job = Some(SupJob {
-            id,
-            prof,
-            t0: self.now,
-        });
+        self.sup_job = Some(SupJob { id, t0: self.now });
+        self.sup_prof = prof;
         self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Busy);
         Ok(id)
     }

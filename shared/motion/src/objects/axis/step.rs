@@ -49,7 +49,7 @@ impl Axis {
             DriveLink::Simulation(plant) => plant.apply(&out),
             DriveLink::Connected { outputs, .. } => *outputs = out,
         }
-        self.refresh_status();
+        self.forget_status();
     }
 
     /// The drive outputs of this cycle: the total setpoint in physical coordinates.
@@ -81,12 +81,12 @@ impl Axis {
             DriveState::Fault { code } => {
                 // After MC_Reset the fault stays until the drive has processed the reset.
                 if self.enabled || (self.power.awaiting_drive && !self.power.after_reset) {
-                    self.raise(AlarmId::DriveFault, supplement::drive_fault_code(code));
+                    self.raise_alarm(AlarmId::DriveFault, supplement::drive_fault_code(code));
                 }
             }
             DriveState::EnableTimedOut { step } => {
                 if self.power.awaiting_drive {
-                    self.raise(
+                    self.raise_alarm(
                         AlarmId::DriveFault,
                         supplement::DRIVE_ENABLE_NOT_POSSIBLE + u16::from(step),
                     );
@@ -94,7 +94,7 @@ impl Axis {
             }
             DriveState::Disabled | DriveState::Enabling { .. } => {
                 if self.enabled {
-                    self.raise(AlarmId::DriveFault, supplement::DRIVE_SHUT_DOWN);
+                    self.raise_alarm(AlarmId::DriveFault, supplement::DRIVE_SHUT_DOWN);
                 }
             }
         }
@@ -130,7 +130,7 @@ impl Axis {
             _ => self.prof.at(self.elapsed(self.t0) + dt),
         };
         let sup = match &self.sup_job {
-            Some(j) => j.prof.at(self.elapsed(j.t0) + dt),
+            Some(j) => self.sup_prof.at(self.elapsed(j.t0) + dt),
             None => self.sup,
         };
         State {
@@ -171,7 +171,7 @@ impl Axis {
             _ => self.basic = self.prof.at(self.elapsed(self.t0)),
         }
         if let Some(j) = &self.sup_job {
-            self.sup = j.prof.at(self.elapsed(j.t0));
+            self.sup = self.sup_prof.at(self.elapsed(j.t0));
         }
     }
 
@@ -187,12 +187,12 @@ impl Axis {
         let eps = 1e-9 * (1.0 + sw.max.abs().max(sw.min.abs()));
         if tot.p > sw.max + eps {
             self.sw_active = Some(Sense::Positive);
-            self.raise(AlarmId::SwLimitCrossed, supplement::POSITIVE);
+            self.raise_alarm(AlarmId::SwLimitCrossed, supplement::POSITIVE);
             return;
         }
         if tot.p < sw.min - eps {
             self.sw_active = Some(Sense::Negative);
-            self.raise(AlarmId::SwLimitCrossed, supplement::NEGATIVE);
+            self.raise_alarm(AlarmId::SwLimitCrossed, supplement::NEGATIVE);
             return;
         }
         // The status stays while the alarm is pending or the setpoint is at the limit.
@@ -228,7 +228,7 @@ impl Axis {
         } else {
             supplement::NEGATIVE
         };
-        self.raise(AlarmId::SwLimitReached, supp);
+        self.raise_alarm(AlarmId::SwLimitReached, supp);
         self.fold_superimposed();
         let here = self.stop_point(self.basic, &max);
         let reachable = match sense {
@@ -292,10 +292,10 @@ impl Axis {
                     } else {
                         supplement::HW_LIMIT_NEGATIVE
                     };
-                    self.raise(AlarmId::HwLimit, supp);
+                    self.raise_alarm(AlarmId::HwLimit, supp);
                 }
                 Some((s, _)) if s == sense && sign(v) == sense.sign() => {
-                    self.raise(AlarmId::HwLimit, supplement::HW_LIMIT_ILLEGAL_DIRECTION);
+                    self.raise_alarm(AlarmId::HwLimit, supplement::HW_LIMIT_ILLEGAL_DIRECTION);
                 }
                 _ => {}
             }
@@ -314,6 +314,10 @@ impl Axis {
     }
 
     fn active_homing(&mut self, prev: f64, phys: f64) {
+        // (Looked at in place first: the job is copied only while it homes.)
+        if self.main.as_ref().is_none_or(|m| m.homing.is_none()) {
+            return;
+        }
         let Some(job) = self.main else {
             return;
         };
@@ -343,7 +347,7 @@ impl Axis {
                 // approach velocity. The second reversal means nothing was found.
                 h.reversals += 1;
                 if h.reversals >= 2 {
-                    self.raise(AlarmId::HomingNotFound, supplement::NONE);
+                    self.raise_alarm(AlarmId::HomingNotFound, supplement::NONE);
                     return;
                 }
                 h.search_dir = -heading;
@@ -470,8 +474,8 @@ impl Axis {
         let sup_done = self
             .sup_job
             .as_ref()
-            .filter(|j| self.elapsed(j.t0) >= j.prof.duration())
-            .map(|j| (j.id, j.prof.end()));
+            .filter(|j| self.elapsed(j.t0) >= self.sup_prof.duration())
+            .map(|j| (j.id, self.sup_prof.end()));
         if let Some((id, end)) = sup_done {
             self.sup = end;
             self.sup_job = None;
@@ -479,6 +483,10 @@ impl Axis {
         }
         if self.power.disabling && finished {
             self.remove_enable();
+            return;
+        }
+        // Every case below waits for the end of the profile (and the job is not copied before).
+        if !finished {
             return;
         }
         let Some(mut m) = self.main else {
@@ -575,7 +583,7 @@ impl Axis {
                     }
                     None
                 } else if self.now - pm.start_ns > ns(pmc.tolerance_time) {
-                    self.raise(
+                    self.raise_alarm(
                         AlarmId::PositioningMonitoring,
                         supplement::TARGET_NOT_REACHED,
                     );
@@ -586,7 +594,7 @@ impl Axis {
             }
             Some(t) => {
                 if !inside {
-                    self.raise(AlarmId::PositioningMonitoring, supplement::TARGET_LEFT);
+                    self.raise_alarm(AlarmId::PositioningMonitoring, supplement::TARGET_LEFT);
                     Some(false)
                 } else if self.now - t >= ns(pmc.min_dwell_time) {
                     Some(true)
@@ -623,13 +631,14 @@ impl Axis {
         };
         let err = self.fe.abs();
         if err > allowed {
-            self.raise(AlarmId::FollowingError, supplement::NONE);
+            self.raise_alarm(AlarmId::FollowingError, supplement::NONE);
         } else if err > allowed * fe_cfg.warning_level / 100.0 {
-            self.raise(AlarmId::FollowingErrorWarning, supplement::NONE);
+            self.raise_alarm(AlarmId::FollowingErrorWarning, supplement::NONE);
         }
     }
 
-    pub(super) fn refresh_status(&mut self) {
+    /// The status of the axis as it is now.
+    pub(super) fn current_status(&self) -> super::AxisStatus {
         let tot = self.total();
         let (ew, ww, detail) = self.alarm_words();
         let main = self.main.as_ref().map(|m| m.instr);
@@ -638,7 +647,7 @@ impl Axis {
             sw &= status_bit::SPEED_AXIS_MASK;
         }
         let state = self.plc_state(&detail, main, tot);
-        self.status = super::AxisStatus {
+        super::AxisStatus {
             time_ns: self.now,
             state,
             status_word: sw,
@@ -672,7 +681,7 @@ impl Axis {
                 0
             },
             phase_shift: self.phase.p,
-        };
+        }
     }
 
     /// ErrorWord, WarningWord and ErrorDetail from the pending alarms.

@@ -12,6 +12,13 @@ use crate::objects::axis::{sync_status, Axis, Goal, SyncProfileReference};
 use crate::objects::job::{Instruction, JobEventKind};
 use crate::objects::leading::LeadingValue;
 
+/// The job and instruction of the active synchronous operation (for its events).
+#[derive(Clone, Copy)]
+struct JobRef {
+    id: crate::objects::job::JobId,
+    instr: Instruction,
+}
+
 /// What evaluating the law did this cycle: the job events to report and the cam's step.
 struct LawStep {
     events: [Option<JobEventKind>; 2],
@@ -25,9 +32,10 @@ impl Axis {
         if !self.step_pending_sync() {
             return;
         }
-        let Some(mut job) = self.sync else {
+        // The active job is evaluated in place (it is 200 bytes: no copy in and out).
+        if self.sync.is_none() {
             return;
-        };
+        }
         let Some(lv) = self.lead[0] else {
             self.coupled_leader_missing();
             return;
@@ -38,15 +46,20 @@ impl Axis {
             v: lv.v + self.phase.v,
             a: lv.a + self.phase.a,
         };
-        if !job.ready {
-            self.set_up_coupling(&mut job, x);
+        if self.sync.is_some_and(|j| !j.ready) {
+            self.set_up_coupling(x);
         }
         // With a simulated synchronous operation the coupling runs logically only.
         let own = self.basic;
-        let Some(law) = self.evaluate_law(&mut job, x) else {
+        let Some(law) = self.evaluate_law(x) else {
             return;
         };
-        self.sync = Some(job);
+        let Some(job) = self.sync.as_ref().map(|j| JobRef {
+            id: j.id,
+            instr: j.instr,
+        }) else {
+            return;
+        };
         if self.sync_sim.is_some() {
             self.basic = if self.goal == Goal::Sync {
                 State {
@@ -66,7 +79,7 @@ impl Axis {
         for e in law.events.into_iter().flatten() {
             self.emit(job.id, job.instr, e);
         }
-        if !self.finish_cam_step(&job, law.cam_step, x) {
+        if !self.finish_cam_step(job, law.cam_step, x) {
             return;
         }
         self.advance_offset();
@@ -85,7 +98,7 @@ impl Axis {
             return true;
         };
         let Some(lv) = self.lead[1] else {
-            self.raise(AlarmId::LeaderMissing, supplement::NONE);
+            self.raise_alarm(AlarmId::LeaderMissing, supplement::NONE);
             return false;
         };
         let Some(started) = self.pending_start(&mut p, lv) else {
@@ -132,16 +145,17 @@ impl Axis {
                 a: b.a,
             };
         }
-        self.raise(AlarmId::LeaderMissing, supplement::NONE);
+        self.raise_alarm(AlarmId::LeaderMissing, supplement::NONE);
     }
 
     /// MC_PhasingAbsolute/Relative: the phase shift of the leading value follows its profile;
     /// the job is done at the profile's end.
     fn advance_phasing(&mut self) {
         if let Some(ph) = self.phasing {
-            self.phase = ph.prof.at(self.elapsed(ph.t0));
-            if self.elapsed(ph.t0) >= ph.prof.duration() {
-                self.phase = ph.prof.end();
+            let prof = &self.phasing_prof;
+            self.phase = prof.at(self.elapsed(ph.t0));
+            if self.elapsed(ph.t0) >= prof.duration() {
+                self.phase = prof.end();
                 self.phasing = None;
                 self.emit(ph.id, ph.instr, JobEventKind::Done);
             }
@@ -151,7 +165,10 @@ impl Axis {
     /// Sets the coupling up from this cycle's follower setpoint (from the previous goal) and
     /// leading value `x`: for gearing, the relative profile that brings the relative velocity
     /// and acceleration to zero.
-    fn set_up_coupling(&mut self, job: &mut SyncJob, x: State) {
+    fn set_up_coupling(&mut self, x: State) {
+        let Some(job) = self.sync.as_mut() else {
+            return;
+        };
         let g = job.ratio;
         if let SyncLaw::Gear { .. } = job.law {
             let r = State {
@@ -179,22 +196,28 @@ impl Axis {
     /// Evaluates the job's law at the leading value `x` into the basic setpoint. `None`: the
     /// leading value reversed during an absolute synchronization (alarm 608 raised, the job
     /// kept), the cycle's synchronous part ends here.
-    fn evaluate_law(&mut self, job: &mut SyncJob, x: State) -> Option<LawStep> {
-        match job.law {
-            SyncLaw::Gear { .. } => Some(self.evaluate_gear(job, x)),
-            SyncLaw::GearPos { .. } => self.evaluate_gear_pos(job, x),
+    fn evaluate_law(&mut self, x: State) -> Option<LawStep> {
+        match self.sync.as_ref()?.law {
+            SyncLaw::Gear { .. } => Some(self.evaluate_gear(x)),
+            SyncLaw::GearPos { .. } => self.evaluate_gear_pos(x),
         }
     }
 
     /// Relative gearing: the relative profile while synchronizing, then `offset + ratio * x`
     /// (velocity gearing integrates the leader's velocity).
-    fn evaluate_gear(&mut self, job: &mut SyncJob, x: State) -> LawStep {
+    fn evaluate_gear(&mut self, x: State) -> LawStep {
         let mut events = [None; 2];
+        let e = self.elapsed(self.t0);
+        let Some(job) = self.sync.as_mut() else {
+            return LawStep {
+                events,
+                cam_step: None,
+            };
+        };
         let g = job.ratio;
         if let SyncLaw::Gear { offset, prev } = &mut job.law {
             let velocity = job.instr == Instruction::GearInVelocity;
             if job.phase == SyncPhase::Synchronizing {
-                let e = self.elapsed(self.t0);
                 let r = self.prof.at(e);
                 self.basic = State {
                     p: g * x.p + r.p,
@@ -233,9 +256,10 @@ impl Axis {
 
     /// Absolute synchronization (GearInPos, CamIn): the quintic up to the sync point, then
     /// `y_sync + ratio * (x - x_sync)` or the cam.
-    fn evaluate_gear_pos(&mut self, job: &mut SyncJob, x: State) -> Option<LawStep> {
+    fn evaluate_gear_pos(&mut self, x: State) -> Option<LawStep> {
         let mut events = [None; 2];
-        let mut cam_step = None;
+        let mut cam = false;
+        let job = self.sync.as_mut()?;
         let g = job.ratio;
         if let SyncLaw::GearPos {
             lead_dir,
@@ -248,8 +272,7 @@ impl Axis {
             if job.phase == SyncPhase::Synchronizing && *lead_dir * (x.p - *x_sync) < 0.0 {
                 if x.v * *lead_dir < 0.0 {
                     // The leading value reversed during synchronization (alarm 608).
-                    self.sync = Some(*job);
-                    self.raise(AlarmId::SynchronizationError, supplement::NONE);
+                    self.raise_alarm(AlarmId::SynchronizationError, supplement::NONE);
                     return None;
                 }
                 if let Some(q) = quintic {
@@ -266,7 +289,7 @@ impl Axis {
                     events[0] = Some(JobEventKind::InSync);
                 }
                 if job.instr == Instruction::CamIn {
-                    cam_step = Some(self.cam_synchronous(x));
+                    cam = true;
                 } else {
                     self.basic = State {
                         p: *y_sync + g * (x.p - *x_sync),
@@ -276,12 +299,14 @@ impl Axis {
                 }
             }
         }
+        // The cam is evaluated once the job is no longer borrowed (it does not read it).
+        let cam_step = cam.then(|| self.cam_synchronous(x));
         Some(LawStep { events, cam_step })
     }
 
     /// What a cam's step means for the job: EndOfProfile (and a pending cam taking over), the
     /// end of a once-through cam, or a failure. `false`: the synchronous operation ended.
-    fn finish_cam_step(&mut self, job: &SyncJob, cam_step: Option<CamStep>, x: State) -> bool {
+    fn finish_cam_step(&mut self, job: JobRef, cam_step: Option<CamStep>, x: State) -> bool {
         match cam_step {
             Some(CamStep::Running(true)) => {
                 self.emit(job.id, job.instr, JobEventKind::EndOfProfile);
@@ -314,8 +339,9 @@ impl Axis {
         let offset_done = match &self.offset_job {
             Some(o) => {
                 let e = self.elapsed(o.t0);
-                self.shift_out = o.prof.at(e);
-                (e >= o.prof.duration()).then_some((o.id, o.instr, o.prof.end()))
+                let prof = &self.offset_prof;
+                self.shift_out = prof.at(e);
+                (e >= prof.duration()).then_some((o.id, o.instr, prof.end()))
             }
             None => None,
         };

@@ -3,7 +3,7 @@
 
 use super::law::SyncLaw;
 use crate::kinematics::dynamics::Dynamics;
-use crate::kinematics::profile::{Limits, Profile};
+use crate::kinematics::profile::Limits;
 use crate::objects::axis::{SyncDirection, SyncProfileReference};
 use crate::objects::job::{Instruction, JobId};
 use crate::objects::leading::LeaderId;
@@ -19,18 +19,21 @@ pub(in crate::objects::axis) enum SyncPhase {
     Synchronous,
 }
 
-/// A synchronous operation job.
+/// A synchronous operation job. The law first (`repr(C)`): its discriminant is where an
+/// `Option` of the job keeps whether there is one, which an axis' cycle reads next to the
+/// state before it in the axis.
 #[derive(Copy, Clone, Debug, PartialEq)]
+#[repr(C)]
 pub(in crate::objects::axis) struct SyncJob {
+    pub law: SyncLaw,
     pub id: JobId,
     pub instr: Instruction,
+    pub phase: SyncPhase,
+    /// The law has been set up from the first leading value.
+    pub ready: bool,
     pub master: LeaderId,
     pub ratio: f64,
     pub lim: Limits,
-    pub phase: SyncPhase,
-    pub law: SyncLaw,
-    /// The law has been set up from the first leading value.
-    pub ready: bool,
 }
 
 impl SyncJob {
@@ -40,12 +43,13 @@ impl SyncJob {
     }
 }
 
-/// A phasing job: a profile of the phase shift (leading value units).
+/// A phasing or offset job: the profile of the shift (leading value units for phasing, follower
+/// units for offsets) starts at `t0`. The axis keeps the profile apart (its cycle looks at
+/// whether a job runs, the profile is read only then).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub(in crate::objects::axis) struct PhasingJob {
     pub id: JobId,
     pub instr: Instruction,
-    pub prof: Profile,
     pub t0: i64,
 }
 

@@ -6,6 +6,7 @@ use super::job::{PhasingJob, SyncPhase};
 use crate::catalog::error_id::ErrorId;
 use crate::catalog::override_table::NewJob;
 use crate::kinematics::dynamics::Dynamics;
+use crate::kinematics::profile::Profile;
 use crate::kinematics::profile::{plan_position, State};
 use crate::objects::axis::Axis;
 use crate::objects::job::{Instruction, JobEventKind, JobId};
@@ -34,7 +35,7 @@ impl Axis {
         if s.phase != SyncPhase::Synchronous {
             return Err(ErrorId::SynchronizingActive);
         }
-        let mut job = self.plan_shift(
+        let (mut job, prof) = self.plan_shift(
             self.phase,
             (shift, absolute),
             dynamics,
@@ -44,17 +45,19 @@ impl Axis {
         job.id = self.new_id();
         self.emit(job.id, job.instr, JobEventKind::Busy);
         self.phasing = Some(job);
+        self.phasing_prof = prof;
         Ok(job.id)
     }
 
-    /// A shift profile (phasing or offset) from `current` to the value (absolute) or by it.
+    /// A shift job (phasing or offset) and its profile from `current` to the value (absolute)
+    /// or by it.
     fn plan_shift(
         &mut self,
         current: State,
         (value, absolute): (f64, bool),
         dynamics: &Dynamics,
         (abs_instr, rel_instr): (Instruction, Instruction),
-    ) -> Result<PhasingJob, ErrorId> {
+    ) -> Result<(PhasingJob, Profile), ErrorId> {
         let r = self
             .cfg
             .limits
@@ -64,12 +67,14 @@ impl Axis {
         let prof =
             plan_position(current, target, &r.limits).map_err(|_| ErrorId::IllegalDistance)?;
         let instr = if absolute { abs_instr } else { rel_instr };
-        Ok(PhasingJob {
-            id: 0,
-            instr,
+        Ok((
+            PhasingJob {
+                id: 0,
+                instr,
+                t0: self.now,
+            },
             prof,
-            t0: self.now,
-        })
+        ))
     }
 
     pub(in crate::objects::axis) fn cmd_offset(
@@ -88,7 +93,7 @@ impl Axis {
         if s.phase != SyncPhase::Synchronous {
             return Err(ErrorId::SynchronizingActive);
         }
-        let mut job = self.plan_shift(
+        let (mut job, prof) = self.plan_shift(
             self.shift_out,
             (offset, absolute),
             dynamics,
@@ -98,6 +103,7 @@ impl Axis {
         job.id = self.new_id();
         self.emit(job.id, job.instr, JobEventKind::Busy);
         self.offset_job = Some(job);
+        self.offset_prof = prof;
         Ok(job.id)
     }
 }
