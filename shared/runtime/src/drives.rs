@@ -400,18 +400,20 @@ impl Cia402Link {
     fn plant_inputs(&self, increments: f64) -> u32 {
         let p = self.scaling.drive_position(increments.round() as i64);
         let mut bits = 0;
-        if self.plant.hw_limit_min.is_some_and(|x| p <= x) {
-            bits |= digital_inputs::NEGATIVE_LIMIT;
-        }
-        if self.plant.hw_limit_max.is_some_and(|x| p >= x) {
-            bits |= digital_inputs::POSITIVE_LIMIT;
-        }
-        if self
-            .plant
-            .reference_cam
-            .is_some_and(|(lo, hi)| p >= lo && p <= hi)
-        {
-            bits |= digital_inputs::HOME_SWITCH;
+        for (on, bit) in [
+            (
+                self.plant.at_negative_limit(p),
+                digital_inputs::NEGATIVE_LIMIT,
+            ),
+            (
+                self.plant.at_positive_limit(p),
+                digital_inputs::POSITIVE_LIMIT,
+            ),
+            (self.plant.on_reference_cam(p), digital_inputs::HOME_SWITCH),
+        ] {
+            if on {
+                bits |= bit;
+            }
         }
         bits
     }

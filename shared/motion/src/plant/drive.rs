@@ -46,6 +46,24 @@ pub struct Plant {
     pub hw_limit_max: Option<f64>,
 }
 
+impl Plant {
+    /// Whether the reference cam is active at physical position `x`.
+    pub fn on_reference_cam(&self, x: f64) -> bool {
+        self.reference_cam
+            .is_some_and(|(lo, hi)| x >= lo && x <= hi)
+    }
+
+    /// Whether the negative hardware limit switch is active at `x`.
+    pub fn at_negative_limit(&self, x: f64) -> bool {
+        self.hw_limit_min.is_some_and(|m| x <= m)
+    }
+
+    /// Whether the positive hardware limit switch is active at `x`.
+    pub fn at_positive_limit(&self, x: f64) -> bool {
+        self.hw_limit_max.is_some_and(|m| x >= m)
+    }
+}
+
 /// Encoder zero marks.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct ZeroMark {

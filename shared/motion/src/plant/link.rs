@@ -130,11 +130,8 @@ impl SimPlant {
         let actual = self.drive.actual();
         let (prev, p) = (self.last, actual.p);
         self.last = p;
-        let on_cam = |x: f64| {
-            self.plant
-                .reference_cam
-                .is_some_and(|(lo, hi)| x >= lo && x <= hi)
-        };
+        let plant = &self.plant;
+        let on_cam = |x: f64| plant.on_reference_cam(x);
         let reference_cam_left = match self.plant.reference_cam {
             Some((lo, hi)) if on_cam(prev) && !on_cam(p) => Some(if p > prev { hi } else { lo }),
             _ => None,
@@ -142,8 +139,8 @@ impl SimPlant {
         DriveInputs {
             actual,
             signals: AxisSignals {
-                limit_positive: self.plant.hw_limit_max.is_some_and(|x| p >= x),
-                limit_negative: self.plant.hw_limit_min.is_some_and(|x| p <= x),
+                limit_positive: plant.at_positive_limit(p),
+                limit_negative: plant.at_negative_limit(p),
                 reference_cam: on_cam(p),
                 reference_cam_left,
                 zero_mark: self.plant.zero_mark.and_then(|z| z.crossed(prev, p)),

@@ -1681,12 +1681,7 @@ impl Axis {
     /// Whether the reference cam is active now (when a homing job starts between cycles).
     fn on_reference_cam_now(&self) -> bool {
         match &self.link {
-            DriveLink::Simulation(p) => {
-                let x = p.actual().p;
-                p.plant()
-                    .reference_cam
-                    .is_some_and(|(lo, hi)| x >= lo && x <= hi)
-            }
+            DriveLink::Simulation(p) => p.plant().on_reference_cam(p.actual().p),
             DriveLink::Connected { inputs, .. } => inputs.signals.reference_cam,
         }
     }
