@@ -463,6 +463,9 @@ pub struct Executive<'c> {
     status: Vec<AxisStatus>,
     /// Per axis: `status` is older than the axis' last step (see [`Executive::snapshot`]).
     stale: Vec<bool>,
+    /// Per axis: it may have job events or alarms to log (set when it steps with some, when it
+    /// takes a command, and while alarms were seen); the others are not looked at.
+    news: Vec<bool>,
     encoder_status: Vec<EncoderStatus>,
     /// The status at each axis' previous cycle (the start of its objects' motion).
     last_cycle: Vec<AxisStatus>,
@@ -533,6 +536,7 @@ impl<'c> Executive<'c> {
             last_cycle: status.clone(),
             status,
             stale: vec![false; cell.axes.len()],
+            news: vec![false; cell.axes.len()],
             encoder_status,
             plan: StepPlan::with_capacity(axes.len()),
             cycles,
@@ -799,6 +803,7 @@ impl<'c> Executive<'c> {
                 self.snapshot(i.0);
                 let r = self.axes[i.0].command(&command).map(Some);
                 self.plan.note(i.0, &self.axes[i.0]);
+                self.news[i.0] = true;
                 r
             }
         };
@@ -1057,6 +1062,7 @@ impl<'c> Executive<'c> {
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
                 holds &= plan.planned_with(i, &self.axes[i]);
+                self.news[i] |= self.axes[i].has_events() || self.axes[i].alarm_pending();
                 if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
                     last = None;
                 }
@@ -1068,6 +1074,7 @@ impl<'c> Executive<'c> {
             if self.due[self.node_of[i]] {
                 self.axes[i].step(t);
                 holds &= plan.planned_with(i, &self.axes[i]);
+                self.news[i] |= self.axes[i].has_events() || self.axes[i].alarm_pending();
             }
         }
         plan.valid &= holds;
@@ -1128,13 +1135,18 @@ impl<'c> Executive<'c> {
             if !self.owned.axes[i] {
                 continue;
             }
+            // Its status is copied when read.
+            self.stale[i] = true;
+            // Without job events nor a pending alarm since the last step, nor alarms seen then,
+            // there is nothing to log (and the axis is not looked at).
+            if !std::mem::take(&mut self.news[i]) {
+                continue;
+            }
             while let Some(ev) = axis.pop_event() {
                 let name = &cell.axes[i].name;
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
             }
             // Without a pending alarm, nor one seen last step, there is nothing new to log.
-            // Its status is copied when read.
-            self.stale[i] = true;
             // (The slots are filled from the first: all are empty when the first is.)
             if !axis.alarm_pending() && self.alarms_seen[i][0] == (0, 0) {
                 continue;
@@ -1156,6 +1168,8 @@ impl<'c> Executive<'c> {
                 }
             }
             self.alarms_seen[i] = now;
+            // Looked at again next step while alarms are seen: they may go.
+            self.news[i] = now[0] != (0, 0);
         }
         Ok(())
     }
@@ -1222,6 +1236,7 @@ impl<'c> Executive<'c> {
             self.snapshot(a.0);
             let r = self.axes[a.0].command(&command);
             self.plan.note(a.0, &self.axes[a.0]);
+            self.news[a.0] = true;
             if let Err(id) = r {
                 self.rejected += 1;
                 writeln!(

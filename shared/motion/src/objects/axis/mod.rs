@@ -467,6 +467,11 @@ impl Axis {
         self.events.pop()
     }
 
+    /// Whether a job event is pending (as `pop_event().is_some()`, without taking it).
+    pub fn has_events(&self) -> bool {
+        !self.events.is_empty()
+    }
+
     /// Whether a technology alarm is pending (as `alarms().next().is_some()`, without scanning).
     pub fn alarm_pending(&self) -> bool {
         self.alarm_pending
