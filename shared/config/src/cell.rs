@@ -214,6 +214,11 @@ pub struct Cia402Connection {
     pub enable_timeout_ns: i64,
     /// Encoder and mechanics: the drive's increments to and from the axis's units.
     pub scaling: tandem_motion::plant::mechanics::Scaling,
+    /// Torque feedforward 0x60B2 from the setpoint acceleration: the moment of inertia at the
+    /// motor (motor plus load reflected to it, kg·m²) it is computed with; `None`: off
+    /// (`[axes.<name>.drive] torque_precontrol`, `inertia`).
+    #[doc(alias = "0x60B2")]
+    pub torque_precontrol_inertia: Option<f64>,
 }
 
 /// An axis of the cell, with the node that hosts it.

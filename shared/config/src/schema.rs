@@ -996,6 +996,11 @@ pub struct DriveSection {
     pub device: Option<String>,
     /// cia402: time allowed for each step of the enable sequence (s, default 1).
     pub enable_timeout: Option<f64>,
+    /// cia402: torque feedforward 0x60B2 from the setpoint acceleration (default false).
+    pub torque_precontrol: Option<bool>,
+    /// cia402: the moment of inertia at the motor the torque feedforward uses (kg·m², motor
+    /// plus load reflected to the motor; default: the simulated drive's `inertia`).
+    pub inertia: Option<f64>,
     /// simulation: `position_loop` or `delay`.
     #[serde(default = "d_model")]
     pub model: String,
@@ -1039,6 +1044,8 @@ impl Default for DriveSection {
             kind: d_drive_type(),
             device: None,
             enable_timeout: None,
+            torque_precontrol: None,
+            inertia: None,
             model: d_model(),
             kv: d_kv(),
             kpc: d_kpc(),

@@ -20,11 +20,11 @@
 use tandem_config::{Cell, Cia402Connection, DeviceKind, DriveConnection};
 use tandem_motion::objects::measuring::MeasuringRoute;
 use tandem_motion::plant::cia402::{
-    digital_inputs, touch_probe, DriveCommand, DriveFeedback, EnableSequence, EnableStatus,
-    EnableStep, ModeOfOperation, PowerRequest,
+    digital_inputs, statusword, touch_probe, Cia402State, DeviceCommand, DriveCommand,
+    DriveFeedback, EnableSequence, EnableStatus, EnableStep, ModeOfOperation, PowerRequest,
 };
 use tandem_motion::plant::drive::{Actual, Plant};
-use tandem_motion::plant::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
+use tandem_motion::plant::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState, HomingLatch};
 use tandem_motion::plant::mechanics::{EncoderKind, RawCounter, Scaling};
 use tandem_motion::plant::servo::{ServoParams, SimServo, SimServoError};
 
@@ -84,6 +84,21 @@ pub struct Cia402Link {
     probe_status: u16,
     /// What is retained of the axis, if its encoder is absolute or cyclic absolute.
     pub(crate) retention: Option<Retention>,
+    /// The axis asked to stop on the drive's ramp (its last [`DriveOutputs::quick_stop`]).
+    quick_stop: bool,
+    /// The enable sequence reported the drive enabled at the last sample.
+    operational: bool,
+    /// The statusword 0x6041 of the last sample.
+    statusword: u16,
+    /// Torque feedforward 0x60B2 in per mille of the rated torque 0x6076 per drive
+    /// increment/s² of the setpoint acceleration; `None`: off.
+    torque_per_acceleration: Option<f64>,
+    /// The touch probe homing latches with: 2 when probe 1 serves a measuring input, else 1.
+    homing_probe: u8,
+    /// The homing mark the homing probe is armed for (as last commanded).
+    homing_armed: Option<HomingLatch>,
+    /// The homing probe's status bits of the last sample (touch probe 1 positions).
+    homing_status: u16,
 }
 
 /// Whether measuring input `m` measures through its axis's drive's touch probe: route
@@ -227,6 +242,27 @@ impl Drives {
                 .measuring_inputs
                 .iter()
                 .position(|m| m.axis.0 == i && on_touch_probe(cell, m));
+            // Homing latches with touch probe 2 when probe 1 serves a measuring input.
+            link.homing_probe = if link.probe_input.is_some() { 2 } else { 1 };
+            // 0x60B2 per increment/s²: J · 2π / (increments per revolution) N·m, in per mille
+            // of the rated torque 0x6076.
+            link.torque_per_acceleration = c.torque_precontrol_inertia.map(|j| {
+                j * core::f64::consts::TAU
+                    / f64::from(params.increments_per_revolution)
+                    / params.rated_torque
+                    * 1e3
+            });
+            if let (Some((lo, hi)), Some(Some(slot))) =
+                (a.config.plant.reference_cam, slots.get_mut(c.device.0))
+            {
+                let Device::SimServo(servo) = &mut slot.device;
+                // The home switch is wired to the homing probe's input as well (the simulated
+                // plant's reference cam, at its physical position).
+                let at = |x: f64| f64::from(c.scaling.drive_increments(x));
+                let (lo, hi) = (at(lo), at(hi));
+                // Probe 1 or 2 exists: refused only for another probe number.
+                let _ = servo.set_probe_mark(link.homing_probe, Some((lo.min(hi), lo.max(hi))));
+            }
             if let (Some(m), Some(Some(slot))) = (
                 link.probe_input.and_then(|k| cell.measuring_inputs.get(k)),
                 slots.get_mut(c.device.0),
@@ -357,6 +393,13 @@ impl Cia402Link {
             probe_armed: false,
             probe_status: 0,
             retention: Retention::of(c),
+            quick_stop: false,
+            operational: false,
+            statusword: 0,
+            torque_per_acceleration: None,
+            homing_probe: 1,
+            homing_armed: None,
+            homing_status: 0,
         })
     }
 
@@ -434,9 +477,14 @@ impl Cia402Link {
                 n
             }
         };
-        let out = self.enable.step(t, self.request, fb.statusword);
+        let out = self
+            .enable
+            .step(t, self.power_request(fb.statusword), fb.statusword);
         self.controlword = out.controlword;
+        self.operational = out.status == EnableStatus::Enabled;
+        self.statusword = fb.statusword;
         let state = match out.status {
+            EnableStatus::QuickStopping => DriveState::Stopping,
             EnableStatus::Enabled => DriveState::Operational,
             EnableStatus::Enabling { step } => DriveState::Enabling {
                 step: step_number(step),
@@ -447,13 +495,13 @@ impl Cia402Link {
             EnableStatus::Fault => DriveState::Fault {
                 code: fb.error_code,
             },
-            EnableStatus::Disabled
-            | EnableStatus::Disabling
-            | EnableStatus::QuickStopping
-            | EnableStatus::Lost { .. } => DriveState::Disabled,
+            EnableStatus::Disabled | EnableStatus::Disabling | EnableStatus::Lost { .. } => {
+                DriveState::Disabled
+            }
         };
         let oldest = self.setpoints[(self.head + 1) % self.setpoints.len()];
         let di = fb.digital_inputs;
+        let (zero_mark, reference_cam_left) = self.homing_marks(fb);
         DriveInputs {
             actual: Actual {
                 p: self.scaling.drive_position(count),
@@ -464,10 +512,95 @@ impl Cia402Link {
                 limit_negative: di & digital_inputs::NEGATIVE_LIMIT != 0,
                 limit_positive: di & digital_inputs::POSITIVE_LIMIT != 0,
                 reference_cam: di & digital_inputs::HOME_SWITCH != 0,
-                reference_cam_left: None,
-                zero_mark: None,
+                reference_cam_left,
+                zero_mark,
             },
             state,
+            in_limitation: self.operational
+                && fb.statusword & statusword::INTERNAL_LIMIT_ACTIVE != 0,
+        }
+    }
+
+    /// The request to the enable sequence with statusword `sw`: the axis's, except while the
+    /// axis has removed the enable to stop on the drive's ramp ([`DriveOutputs::quick_stop`])
+    /// and the drive still moves: quick stop 0x0002 (transition 11) while it is in operation
+    /// enabled or brakes in quick stop active; once it stands still (bit 10 "target reached" in
+    /// quick stop active) or has left on its own (0x605A 1..4: transition 12), the enable goes
+    /// (disable voltage 0x0000: transition 12 for the options 5..8 that stay in quick stop
+    /// active). Inferred: S7's "the drive brakes on its own ramp" is the CiA 402 quick stop
+    /// (0x6085 with 0x605A), not disable voltage, under which the motor coasts.
+    fn power_request(&self, sw: u16) -> PowerRequest {
+        let braking = self.quick_stop
+            && !self.request.enable
+            && match Cia402State::from_statusword(sw) {
+                Some(Cia402State::OperationEnabled) => true,
+                Some(Cia402State::QuickStopActive) => sw & statusword::TARGET_REACHED == 0,
+                _ => false,
+            };
+        if braking {
+            PowerRequest {
+                enable: true,
+                quick_stop: true,
+                ..self.request
+            }
+        } else {
+            self.request
+        }
+    }
+
+    /// The homing probe's new latch in sample `fb`, if it is armed for a homing mark: the
+    /// zero mark (positive edge of the zero pulse) or the reference cam's edge (negative edge
+    /// of the home switch), each a physical position through the raw counter and the
+    /// mechanics, as [`Cia402Link::probe_latches`] converts a measuring input's.
+    fn homing_marks(&mut self, fb: &DriveFeedback) -> (Option<f64>, Option<f64>) {
+        let second = self.homing_probe == 2;
+        let shift = if second {
+            touch_probe::PROBE_2_SHIFT
+        } else {
+            0
+        };
+        let status = (fb.touch_probe_status >> shift) & 0x00FF;
+        let previous = core::mem::replace(&mut self.homing_status, status);
+        let new = |bit: u16| status & bit != 0 && previous & bit == 0;
+        let (positive, negative) = if second {
+            (fb.touch_probe_2_positive, fb.touch_probe_2_negative)
+        } else {
+            (fb.touch_probe_1_positive, fb.touch_probe_1_negative)
+        };
+        let at = |raw: i32| {
+            let count = self
+                .counter
+                .map_or(i64::from(raw), |c| c.nearest(raw as u32));
+            self.scaling.drive_position(count)
+        };
+        match self.homing_armed {
+            Some(HomingLatch::ZeroMark) if new(touch_probe::STATUS_POSITIVE_STORED) => {
+                (Some(at(positive)), None)
+            }
+            Some(HomingLatch::ReferenceCamEdge) if new(touch_probe::STATUS_NEGATIVE_STORED) => {
+                (None, Some(at(negative)))
+            }
+            _ => (None, None),
+        }
+    }
+
+    /// The touch probe function bits of the homing probe for the axis's request `wanted`
+    /// (touch probe 1 positions): first event, the zero pulse's positive edge or the probe
+    /// input's (the home switch's) negative edge. A change from one mark to the other passes
+    /// through one disarmed command, so that the drive clears what it stored.
+    fn homing_function(&mut self, wanted: Option<HomingLatch>) -> u16 {
+        self.homing_armed = match (self.homing_armed, wanted) {
+            (Some(armed), Some(w)) if armed != w => None,
+            _ => wanted,
+        };
+        match self.homing_armed {
+            None => 0,
+            Some(HomingLatch::ZeroMark) => {
+                touch_probe::ENABLE | touch_probe::SOURCE_ZERO_PULSE | touch_probe::SAMPLE_POSITIVE
+            }
+            Some(HomingLatch::ReferenceCamEdge) => {
+                touch_probe::ENABLE | touch_probe::SOURCE_INPUT | touch_probe::SAMPLE_NEGATIVE
+            }
         }
     }
 
@@ -508,14 +641,29 @@ impl Cia402Link {
         self.counter.is_some_and(|c| c.retain_due(retained))
     }
 
-    /// The drive's command for the axis's outputs: CSP with the position setpoint and the
-    /// velocity as feedforward (0x60B1), the controlword of the enable sequence.
+    /// The drive's command for the axis's outputs and the controlword of the enable sequence:
+    /// - position-controlled (and while not enabled): CSP (8) with the position setpoint
+    ///   0x607A and the velocity as feedforward 0x60B1;
+    /// - not position-controlled (MC_Power StartMode 0, MC_MoveVelocity / MC_MoveJog with
+    ///   PositionControlled FALSE) once the drive is enabled: CSV (9) with the velocity as
+    ///   target velocity 0x60FF (the position setpoint still in 0x607A);
+    /// - in both, with torque precontrol configured, the setpoint acceleration times the
+    ///   inertia as torque offset 0x60B2 (per mille of the rated torque 0x6076);
+    /// - touch probe 0x60B8: probe 1 for the measuring input while it has a job, the homing
+    ///   probe while a homing job waits for its mark.
     pub fn command(&mut self, out: &DriveOutputs) -> DriveCommand {
         self.request = PowerRequest {
             enable: out.enable,
             quick_stop: false,
             fault_reset: out.fault_reset,
         };
+        self.quick_stop = out.quick_stop;
+        if self.power_request(self.statusword).quick_stop {
+            // The stop on the drive's ramp goes out with the command of the cycle that removed
+            // the enable (the sequence decides the same at the next sample), so the drive never
+            // follows the setpoint that tracks the actual value.
+            self.controlword = DeviceCommand::QuickStop.controlword();
+        }
         self.head = (self.head + 1) % self.setpoints.len();
         if let Some(s) = self.setpoints.get_mut(self.head) {
             *s = out.position;
@@ -524,7 +672,7 @@ impl Cia402Link {
             .scaling
             .drive_increments_per_second(out.velocity)
             .round();
-        let probe = if self.probe_armed {
+        let mut probe = if self.probe_armed {
             touch_probe::ENABLE
                 | touch_probe::SOURCE_INPUT
                 | touch_probe::SAMPLE_POSITIVE
@@ -532,11 +680,31 @@ impl Cia402Link {
         } else {
             0
         };
+        let homing = self.homing_function(out.homing_latch);
+        probe |= if self.homing_probe == 2 {
+            homing << touch_probe::PROBE_2_SHIFT
+        } else {
+            homing
+        };
+        let v = v.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
+        let torque = self.torque_per_acceleration.map_or(0.0, |k| {
+            k * self.scaling.drive_increments_per_second(out.acceleration)
+        });
+        let torque_offset = torque
+            .round()
+            .clamp(f64::from(i16::MIN), f64::from(i16::MAX)) as i16;
+        let velocity_mode = !out.position_controlled && self.operational;
         DriveCommand {
             controlword: self.controlword,
-            mode: ModeOfOperation::CyclicSynchronousPosition as i8,
+            mode: if velocity_mode {
+                ModeOfOperation::CyclicSynchronousVelocity
+            } else {
+                ModeOfOperation::CyclicSynchronousPosition
+            } as i8,
             target_position: self.scaling.drive_increments(out.position),
-            velocity_offset: v.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32,
+            target_velocity: if velocity_mode { v } else { 0 },
+            velocity_offset: if velocity_mode { 0 } else { v },
+            torque_offset,
             touch_probe_function: probe,
             ..DriveCommand::default()
         }

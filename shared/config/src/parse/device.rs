@@ -269,10 +269,22 @@ pub(super) fn drives(
         }
         let scaling =
             scaling(a, servo).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+        let inertia = a.drive.inertia.unwrap_or(servo.inertia);
+        if !(inertia.is_finite() && inertia > 0.0) {
+            return Err(at(
+                &["drive", "inertia"],
+                Problem::Invalid("must be a positive moment of inertia (kg·m²)"),
+            ));
+        }
         entry.drive = DriveConnection::Cia402(Box::new(Cia402Connection {
             device: DeviceIndex(k),
             enable_timeout_ns: (timeout * 1e9).round() as i64,
             scaling,
+            torque_precontrol_inertia: a
+                .drive
+                .torque_precontrol
+                .unwrap_or(false)
+                .then_some(inertia),
         }));
     }
     Ok(())
@@ -286,6 +298,12 @@ fn only_with_a_drive(a: &AxisSection) -> Result<(), &'static [&'static str]> {
     }
     if a.drive.enable_timeout.is_some() {
         return Err(&["drive", "enable_timeout"]);
+    }
+    if a.drive.torque_precontrol.is_some() {
+        return Err(&["drive", "torque_precontrol"]);
+    }
+    if a.drive.inertia.is_some() {
+        return Err(&["drive", "inertia"]);
     }
     if matches!(a.encoder, EncoderSpec::Table(_)) {
         return Err(&["encoder"]);

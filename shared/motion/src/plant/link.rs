@@ -59,6 +59,22 @@ pub enum DriveState {
         /// The step that did not complete.
         step: u8,
     },
+    /// Enable removed with a stop on the drive's own ramp: the drive is braking (CiA 402: quick
+    /// stop active, the ramp of 0x605A / 0x6085 not finished). Not enabled, as
+    /// [`DriveState::Disabled`].
+    #[doc(alias = "QuickStopActive")]
+    Stopping,
+}
+
+/// A mark the homing job waits for, to be latched by the drive (its touch probe) while the
+/// axis asks for it ([`DriveOutputs::homing_latch`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum HomingLatch {
+    /// The encoder zero mark (CiA 402 touch probe source: the zero pulse).
+    ZeroMark,
+    /// The reference cam's edge where the axis leaves the cam (the home switch on the touch
+    /// probe input, its falling edge).
+    ReferenceCamEdge,
 }
 
 /// What the axis reads at the start of its cycle.
@@ -71,6 +87,10 @@ pub struct DriveInputs {
     pub signals: AxisSignals,
     /// The drive's state.
     pub state: DriveState,
+    /// The drive works at one of its own limits (CiA 402 statusword 0x6041 bit 11 "internal
+    /// limit active", e.g. its torque limit): the axis shows StatusWord X27 "InLimitation".
+    #[doc(alias = "InLimitation")]
+    pub in_limitation: bool,
 }
 
 /// What the axis writes at the end of its cycle: the setpoint for the next cycle.
@@ -86,6 +106,16 @@ pub struct DriveOutputs {
     pub position_controlled: bool,
     /// Acknowledge a drive fault (MC_Reset): set for the one cycle of the reset.
     pub fault_reset: bool,
+    /// Acceleration setpoint (physical units/s²), for a torque feedforward.
+    pub acceleration: f64,
+    /// With `enable` false: the enable was removed to stop on the drive's own ramp (MC_Power
+    /// StopMode 1 "immediate stop" and the alarm reactions "remove enable" and "track
+    /// setpoints": setpoint 0, the drive brakes on its own). A CiA 402 drive gets quick stop
+    /// until it stands still. `false`: the axis has braked itself; the enable goes at once.
+    #[doc(alias = "QuickStop")]
+    pub quick_stop: bool,
+    /// The homing job waits for this mark: the drive is to latch it (armed only while set).
+    pub homing_latch: Option<HomingLatch>,
 }
 
 /// The simulated drive and the sensors of its plant (the axis in simulation).
@@ -146,6 +176,7 @@ impl SimPlant {
                 zero_mark: self.plant.zero_mark.and_then(|z| z.crossed(prev, p)),
             },
             state: DriveState::Operational,
+            in_limitation: false,
         }
     }
 

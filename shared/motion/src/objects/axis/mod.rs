@@ -257,6 +257,9 @@ struct Power {
     /// The enable being awaited follows a fault reset: the drive may still report its fault
     /// until it has processed the reset.
     after_reset: bool,
+    /// The enable was removed to stop on the drive's own ramp (StopMode 1, alarm reactions 4
+    /// and 5): a connected drive is asked for its quick stop ([`DriveOutputs::quick_stop`]).
+    quick_stop: bool,
 }
 
 /// An axis technology object with its drive connection.
@@ -291,6 +294,8 @@ pub struct Axis {
     hw_trigger: Option<(Sense, f64)>,
     power: Power,
     enabled: bool,
+    /// The connected drive works at its own limit (StatusWord X27 "InLimitation").
+    in_limitation: bool,
     pos_ctrl: bool,
     homed: bool,
     stop_lock: bool,
@@ -374,8 +379,10 @@ impl Axis {
                 awaiting_drive: false,
                 fault_reset: false,
                 after_reset: false,
+                quick_stop: false,
             },
             enabled: false,
+            in_limitation: false,
             pos_ctrl: false,
             offset: 0.0,
             absolute,
@@ -804,20 +811,33 @@ impl Axis {
                 let lim = self.emergency_limits();
                 self.set_goal(Goal::Stop { lim })
             }
-            Reaction::RemoveEnable | Reaction::TrackSetpoints => self.remove_enable(),
+            Reaction::RemoveEnable | Reaction::TrackSetpoints => self.remove_enable_by_drive(),
         }
     }
 
     /// The enable: at once in simulation; a connected drive is asked for it and the axis is
     /// enabled when the drive reports it operational ([`Axis::drive_state`]).
     fn request_enable(&mut self) {
+        self.power.quick_stop = false;
         match self.link {
             DriveLink::Simulation(_) => self.enable_now(),
             DriveLink::Connected { .. } => self.power.awaiting_drive = true,
         }
     }
 
+    /// Removes the enable to stop on the drive's own ramp (S7-1500T Motion Control V4.0
+    /// function manual, 'MC_Power' StopMode 1 and the alarm reactions 'Remove enable' and
+    /// 'Track setpoints': "output setpoint 0 and remove the enable; the drive brakes on its own
+    /// ramp"): a connected drive is asked for its quick stop.
+    fn remove_enable_by_drive(&mut self) {
+        self.remove_enable();
+        self.power.quick_stop = true;
+    }
+
+    /// Removes the enable (after the axis has braked, or at once on the drive's ramp through
+    /// [`Axis::remove_enable_by_drive`]).
     fn remove_enable(&mut self) {
+        self.power.quick_stop = false;
         self.power.awaiting_drive = false;
         if self.enabled {
             self.enabled = false;
@@ -1210,6 +1230,7 @@ impl Axis {
                 awaiting_drive: false,
                 fault_reset: false,
                 after_reset: false,
+                quick_stop: false,
             };
             self.emit(self.power.job, Instruction::Power, JobEventKind::Busy);
             if !self.alarms().any(|a| a.reaction.removes_enable()) {
@@ -1222,7 +1243,7 @@ impl Axis {
             self.abort_all(JobEventKind::CommandAborted);
             if self.enabled {
                 match stop_mode {
-                    StopMode::Immediate => self.remove_enable(),
+                    StopMode::Immediate => self.remove_enable_by_drive(),
                     StopMode::Emergency => {
                         self.power.disabling = true;
                         let lim = self.emergency_limits();
@@ -1551,14 +1572,15 @@ impl Axis {
             _ => None,
         };
         if let Some(mark) = mark {
-            // A drive of the process image gives no homing mark yet (its touch probe is not
-            // connected to homing): modes that need one are refused (docs/io.md, deviations).
+            // A drive of the process image latches the marks with its touch probe: the
+            // encoder's zero pulse and the home switch on the probe input (docs/io.md,
+            // 'Homing through the touch probe'); what is wired to it is the drive's business.
             let (cam, zero) = match self.link {
                 DriveLink::Simulation(_) => (
                     self.cfg.plant.reference_cam.is_some(),
                     self.cfg.plant.zero_mark.is_some(),
                 ),
-                DriveLink::Connected { .. } => (false, false),
+                DriveLink::Connected { .. } => (true, true),
             };
             let cam_ok = cam || mark == HomingMark::ZeroMark;
             let zero_ok = zero || mark == HomingMark::DigitalInput;

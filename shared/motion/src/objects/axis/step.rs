@@ -8,7 +8,7 @@ use super::{
 use crate::catalog::alarm::{status_bit, supplement, AlarmId, ErrorDetail, Reaction};
 use crate::kinematics::profile::{plan_position, Limits, State};
 use crate::objects::job::{Instruction, JobEventKind};
-use crate::plant::link::{DriveLink, DriveOutputs, DriveState};
+use crate::plant::link::{DriveLink, DriveOutputs, DriveState, HomingLatch};
 
 impl Axis {
     /// Runs one cycle for time `now_ns` (cell clock, ns): the setpoint computed here is the
@@ -21,6 +21,7 @@ impl Axis {
         };
         self.signals = inputs.signals;
         if matches!(self.link, DriveLink::Connected { .. }) {
+            self.in_limitation = inputs.in_limitation;
             self.drive_state(inputs.state);
         }
         let act = inputs.actual;
@@ -61,7 +62,34 @@ impl Axis {
             enable: self.enabled || self.power.awaiting_drive,
             position_controlled: self.pos_ctrl,
             fault_reset: self.power.fault_reset,
+            acceleration: tot.a,
+            quick_stop: self.power.quick_stop && !self.enabled && !self.power.awaiting_drive,
+            homing_latch: self.homing_latch(),
         }
+    }
+
+    /// The mark a homing job waits for now, for a drive that latches it: active homing in
+    /// phase [`HomePhase::Armed`] (the zero mark) or on the cam with the digital input as its
+    /// mark (the cam's edge); passive homing likewise. `None` while no job waits for a mark.
+    ///
+    /// Active homing arms the cam's edge only while the setpoint moves in the homing direction,
+    /// so that a cam left on the wrong side while reversing on it is not latched (a first-event
+    /// latch would keep that edge); the drive clears its latch when disarmed and arms afresh.
+    fn homing_latch(&self) -> Option<HomingLatch> {
+        let latch = |phase: HomePhase, mark: HomingMark| match (phase, mark) {
+            (HomePhase::Armed, _) => Some(HomingLatch::ZeroMark),
+            (HomePhase::OnCam, HomingMark::DigitalInput) => Some(HomingLatch::ReferenceCamEdge),
+            _ => None,
+        };
+        let hc = &self.cfg.homing;
+        if let Some(h) = self.main.as_ref().and_then(|m| m.homing) {
+            let heading = sign(self.total().v) == hc.homing_direction.sign();
+            return latch(h.phase, hc.active_mark)
+                .filter(|l| *l == HomingLatch::ZeroMark || heading);
+        }
+        self.passive
+            .as_ref()
+            .and_then(|p| latch(p.phase, hc.passive_mark))
     }
 
     /// What the state of a connected drive means for the axis (S7-1500T Motion Control V4.0
@@ -92,7 +120,7 @@ impl Axis {
                     );
                 }
             }
-            DriveState::Disabled | DriveState::Enabling { .. } => {
+            DriveState::Disabled | DriveState::Enabling { .. } | DriveState::Stopping => {
                 if self.enabled {
                     self.raise_alarm(AlarmId::DriveFault, supplement::DRIVE_SHUT_DOWN);
                 }
@@ -781,6 +809,7 @@ impl Axis {
                 status_bit::NON_POSITION_CONTROLLED,
                 self.enabled && !self.pos_ctrl,
             )
+            | bit(status_bit::IN_LIMITATION, self.in_limitation)
     }
 
     /// The PLCopen state from the alarm reaction, the enable and the running jobs.
