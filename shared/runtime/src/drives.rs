@@ -97,8 +97,6 @@ pub struct Cia402Link {
     homing_probe: u8,
     /// The homing mark the homing probe is armed for (as last commanded).
     homing_armed: Option<HomingLatch>,
-    /// The homing probe's status bits of the last sample (touch probe 1 positions).
-    homing_status: u16,
 }
 
 /// Whether measuring input `m` measures through its axis's drive's touch probe: route
@@ -399,7 +397,6 @@ impl Cia402Link {
             torque_per_acceleration: None,
             homing_probe: 1,
             homing_armed: None,
-            homing_status: 0,
         })
     }
 
@@ -548,11 +545,18 @@ impl Cia402Link {
         }
     }
 
-    /// The homing probe's new latch in sample `fb`, if it is armed for a homing mark: the
-    /// zero mark (positive edge of the zero pulse) or the reference cam's edge (negative edge
-    /// of the home switch), each a physical position through the raw counter and the
-    /// mechanics, as [`Cia402Link::probe_latches`] converts a measuring input's.
-    fn homing_marks(&mut self, fb: &DriveFeedback) -> (Option<f64>, Option<f64>) {
+    /// The homing probe's latch in sample `fb`, while it is armed for a homing mark: the zero
+    /// mark (positive edge of the zero pulse) or the reference cam's edge (negative edge of the
+    /// home switch), each a physical position through the raw counter and the mechanics, as
+    /// [`Cia402Link::probe_latches`] converts a measuring input's.
+    ///
+    /// The value is given in every sample from the one that first shows it until the axis
+    /// disarms the probe (its homing job took the mark and moved on), not only once: the
+    /// axis takes a mark only in a cycle where its own conditions hold (e.g. the home switch
+    /// bit of 0x60FD already off, which the plant's rounding to whole increments may show a
+    /// cycle after the latch). A first-event latch holds the first edge after arming, so a
+    /// repeated value is the same mark.
+    fn homing_marks(&self, fb: &DriveFeedback) -> (Option<f64>, Option<f64>) {
         let second = self.homing_probe == 2;
         let shift = if second {
             touch_probe::PROBE_2_SHIFT
@@ -560,8 +564,7 @@ impl Cia402Link {
             0
         };
         let status = (fb.touch_probe_status >> shift) & 0x00FF;
-        let previous = core::mem::replace(&mut self.homing_status, status);
-        let new = |bit: u16| status & bit != 0 && previous & bit == 0;
+        let stored = |bit: u16| status & touch_probe::STATUS_ENABLED != 0 && status & bit != 0;
         let (positive, negative) = if second {
             (fb.touch_probe_2_positive, fb.touch_probe_2_negative)
         } else {
@@ -574,10 +577,10 @@ impl Cia402Link {
             self.scaling.drive_position(count)
         };
         match self.homing_armed {
-            Some(HomingLatch::ZeroMark) if new(touch_probe::STATUS_POSITIVE_STORED) => {
+            Some(HomingLatch::ZeroMark) if stored(touch_probe::STATUS_POSITIVE_STORED) => {
                 (Some(at(positive)), None)
             }
-            Some(HomingLatch::ReferenceCamEdge) if new(touch_probe::STATUS_NEGATIVE_STORED) => {
+            Some(HomingLatch::ReferenceCamEdge) if stored(touch_probe::STATUS_NEGATIVE_STORED) => {
                 (None, Some(at(negative)))
             }
             _ => (None, None),
