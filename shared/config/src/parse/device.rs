@@ -305,8 +305,7 @@ pub(super) fn drives(
         entry.drive = match &devices[k].kind {
             DeviceKind::SimAnalogDrive(_) => {
                 let cycle_ns = (entry.config.cycle * 1e9).round() as i64;
-                let params = analog_params(a, cycle_ns, enable_timeout_ns)
-                    .map_err(|(key, p)| at(&key, p))?;
+                let params = analog_params(a, cycle_ns, enable_timeout_ns, &at)?;
                 DriveConnection::Analog(Box::new(AnalogDriveConnection {
                     device: DeviceIndex(k),
                     params,
@@ -433,11 +432,12 @@ fn analog_params(
     a: &AxisSection,
     cycle_ns: i64,
     enable_timeout_ns: i64,
-) -> Result<AnalogParams, (Vec<&'static str>, Problem)> {
+    at: &dyn Fn(&[&str], Problem) -> ConfigError,
+) -> Result<AnalogParams, ConfigError> {
     let d = &a.drive;
     let reference_velocity = d
         .reference_velocity
-        .ok_or((vec!["drive"], Problem::Missing("reference_velocity")))?;
+        .ok_or_else(|| at(&["drive"], Problem::Missing("reference_velocity")))?;
     let controller = ControllerParams {
         cycle_ns,
         kv: d.kv,
@@ -447,32 +447,32 @@ fn analog_params(
         reference_velocity,
     };
     controller.validate().map_err(|e: AnalogParamsError| {
-        let key = match e.field {
-            "kpc_percent" => "kpc",
-            "velocity_time_constant" => "t_vtc",
-            "additional_position_time_constant" => "t_addptc",
-            "cycle_ns" => return (vec!["node"], Problem::Invalid(e.problem.text())),
-            other => other,
-        };
-        (vec!["drive", key], Problem::Invalid(e.problem.text()))
+        let problem = Problem::Invalid(e.problem.text());
+        match e.field {
+            "kpc_percent" => at(&["drive", "kpc"], problem),
+            "velocity_time_constant" => at(&["drive", "t_vtc"], problem),
+            "additional_position_time_constant" => at(&["drive", "t_addptc"], problem),
+            "cycle_ns" => at(&["node"], problem),
+            other => at(&["drive", other], problem),
+        }
     })?;
     let EncoderSpec::Table(t) = &a.encoder else {
-        return Err((
-            vec!["encoder"],
+        return Err(at(
+            &["encoder"],
             Problem::Missing("[axes.<name>.encoder] steps_per_revolution"),
         ));
     };
     let steps = t
         .steps_per_revolution
-        .ok_or((vec!["encoder"], Problem::Missing("steps_per_revolution")))?;
+        .ok_or_else(|| at(&["encoder"], Problem::Missing("steps_per_revolution")))?;
     if t.encoder_kind() != EncoderKind::Incremental {
-        return Err((
-            vec!["encoder", "type"],
+        return Err(at(
+            &["encoder", "type"],
             Problem::Invalid("an analog drive's encoder is incremental (absolute: not yet)"),
         ));
     }
     let scaling =
-        scaling(a, steps, None).map_err(|(key, e)| (key, Problem::Mechanics(Box::new(e))))?;
+        scaling(a, steps, None).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
     Ok(AnalogParams {
         controller,
         enable_timeout_ns,
