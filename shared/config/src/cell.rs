@@ -143,6 +143,8 @@ pub enum DeviceKind {
     SimServo(tandem_motion::plant::servo::ServoParams),
     /// A simulated digital output terminal (`kind = "sim_digital_output"`).
     SimDigitalOutput(DigitalOutputParams),
+    /// A simulated analog drive with its load encoder (`kind = "sim_analog_drive"`).
+    SimAnalogDrive(tandem_motion::plant::analog::SimAnalogParams),
 }
 
 impl DeviceKind {
@@ -151,6 +153,7 @@ impl DeviceKind {
         match self {
             DeviceKind::SimServo(_) => "sim_servo",
             DeviceKind::SimDigitalOutput(_) => "sim_digital_output",
+            DeviceKind::SimAnalogDrive(_) => "sim_analog_drive",
         }
     }
 }
@@ -203,6 +206,19 @@ pub enum DriveConnection {
     Simulation,
     /// `cia402`: a CiA 402 drive of the node's process image.
     Cia402(Box<Cia402Connection>),
+    /// `analog`: an analog drive of the node's process image, tandem closing the position
+    /// loop.
+    Analog(Box<AnalogDriveConnection>),
+}
+
+/// An axis on an analog drive of the process image.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct AnalogDriveConnection {
+    /// The drive.
+    pub device: DeviceIndex,
+    /// The position controller, the enable timeout, the ready input, the encoder and the
+    /// mechanics.
+    pub params: tandem_motion::plant::analog::AnalogParams,
 }
 
 /// An axis on a CiA 402 drive of the process image.

@@ -49,8 +49,9 @@ pub struct CellFile {
 pub struct DeviceSection {
     /// The node whose process image holds it.
     pub node: String,
-    /// `sim_servo`: a simulated CiA 402 servo drive; `sim_digital_output`: a simulated digital
-    /// output terminal.
+    /// `sim_servo`: a simulated CiA 402 servo drive; `sim_analog_drive`: a simulated drive with
+    /// a ±10 V speed setpoint, enable input, ready output and a load encoder;
+    /// `sim_digital_output`: a simulated digital output terminal.
     pub kind: String,
     /// sim_servo: increments per motor revolution of its position actual value (0x6064).
     pub increments_per_revolution: Option<u32>,
@@ -79,6 +80,19 @@ pub struct DeviceSection {
     pub following_error_window: Option<u32>,
     /// sim_servo: increment offset of the encoder zero pulse within a revolution.
     pub zero_pulse_offset: Option<u32>,
+    /// sim_analog_drive: motor speed at 10 V, 100 % of the command (1/min, default 3000).
+    pub reference_speed: Option<f64>,
+    /// sim_analog_drive: the drive's speed limit (1/min, default 3300).
+    pub max_speed: Option<f64>,
+    /// sim_analog_drive: its speed loop as a first-order lag (s, default 0.004).
+    pub time_constant: Option<f64>,
+    /// sim_analog_drive: time of its stop ramp from the reference speed to 0, without enable
+    /// or in a fault (s, default 0.1).
+    pub ramp_down_time: Option<f64>,
+    /// sim_analog_drive: time from its enable input to its ready output (s, default 0.01).
+    pub ready_delay: Option<f64>,
+    /// sim_analog_drive: offset of its analog input (V, -10 to 10, default 0).
+    pub offset: Option<f64>,
     /// sim_digital_output: the number of channels, 1 to 32 (required).
     pub channels: Option<u32>,
     /// sim_digital_output: `true` switches each channel at a given time (a timestamped output
@@ -988,19 +1002,29 @@ impl Default for HomingSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveSection {
-    /// `simulation` (default: the drive model inside the axis) or `cia402` (a CiA 402 drive
-    /// of the process image, `device`).
+    /// `simulation` (default: the drive model inside the axis), `cia402` (a CiA 402 drive
+    /// of the process image, `device`) or `analog` (a drive with a ±10 V speed setpoint and an
+    /// encoder of its own, `device`; tandem closes the position loop).
     #[serde(rename = "type", default = "d_drive_type")]
     pub kind: String,
-    /// cia402: the device (`[devices.<name>]`).
+    /// cia402, analog: the device (`[devices.<name>]`).
     pub device: Option<String>,
-    /// cia402: time allowed for each step of the enable sequence (s, default 1).
+    /// cia402: time allowed for each step of the enable sequence; analog: for the ready input
+    /// after the enable output (s, default 1).
     pub enable_timeout: Option<f64>,
     /// cia402: torque feedforward 0x60B2 from the setpoint acceleration (default false).
     pub torque_precontrol: Option<bool>,
     /// cia402: the moment of inertia at the motor the torque feedforward uses (kg·m², motor
     /// plus load reflected to the motor; default: the simulated drive's `inertia`).
     pub inertia: Option<f64>,
+    /// analog: the load's velocity at 100 % of the command, 10 V (units/s, required): S7's
+    /// `ReferenceSpeed` through the mechanics.
+    pub reference_velocity: Option<f64>,
+    /// analog: the drive's ready output is wired to an input (default `true`); without it
+    /// MC_Power's Status comes with the enable output.
+    pub ready: Option<bool>,
+    /// analog: `DynamicAxisModel.AdditionalPositionTimeConstant` (s, default 0).
+    pub t_addptc: Option<f64>,
     /// simulation: `position_loop` or `delay`.
     #[serde(default = "d_model")]
     pub model: String,
@@ -1046,6 +1070,9 @@ impl Default for DriveSection {
             enable_timeout: None,
             torque_precontrol: None,
             inertia: None,
+            reference_velocity: None,
+            ready: None,
+            t_addptc: None,
             model: d_model(),
             kv: d_kv(),
             kpc: d_kpc(),

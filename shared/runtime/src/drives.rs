@@ -30,6 +30,8 @@ use tandem_motion::plant::servo::{ServoParams, SimServo, SimServoError};
 
 use crate::error::ExecError;
 
+pub mod analog;
+
 /// Cycles between a setpoint and the actual value that shows it (see the module's order).
 const TRANSPORT_CYCLES: usize = 2;
 
@@ -185,6 +187,8 @@ pub(crate) struct Drives {
     slots: Vec<Option<Slot>>,
     /// The owned axes on a drive.
     pub(crate) links: Vec<Cia402Link>,
+    /// The analog drives and the owned axes on them.
+    pub(crate) analog: analog::AnalogDrives,
 }
 
 /// The drive's enable step as [`DriveState`] numbers it (the supplement of alarm 421).
@@ -275,12 +279,17 @@ impl Drives {
             }
             links.push(link);
         }
-        Ok(Self { slots, links })
+        let analog = analog::AnalogDrives::new(cell, owned)?;
+        Ok(Self {
+            slots,
+            links,
+            analog,
+        })
     }
 
     /// Whether any axis is on a drive of the process image.
     pub(crate) fn any(&self) -> bool {
-        !self.links.is_empty()
+        !self.links.is_empty() || self.analog.any()
     }
 
     /// Steps 1 and 2 of the order: every due device runs to `t`, is sampled, and latches the
@@ -342,12 +351,16 @@ impl Drives {
 
     /// Whether this executive runs device `device`.
     pub(crate) fn runs(&self, device: usize) -> bool {
-        matches!(self.slots.get(device), Some(Some(_)))
+        matches!(self.slots.get(device), Some(Some(_))) || self.analog.runs(device)
     }
 
     /// Injects a fault with error code `code` into device `device` (a simulated drive), or
     /// removes its cause with `code == 0`.
     pub(crate) fn inject_fault(&mut self, device: usize, code: u16) -> Result<(), SimServoError> {
+        if self.analog.runs(device) {
+            self.analog.inject_fault(device, code);
+            return Ok(());
+        }
         let Some(Some(slot)) = self.slots.get_mut(device) else {
             return Ok(());
         };

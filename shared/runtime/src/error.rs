@@ -41,6 +41,13 @@ pub enum ExecError {
     },
     /// A drive's enable timeout that is not positive.
     EnableTimeout(tandem_motion::plant::cia402::InvalidEnableTimeout),
+    /// An analog drive, or an axis's connection to one, whose parameters the model refuses.
+    AnalogDrive {
+        /// The device's name.
+        name: String,
+        /// The model's reason.
+        reason: tandem_motion::plant::analog::AnalogConnectionError,
+    },
 }
 
 impl fmt::Display for ExecError {
@@ -51,6 +58,7 @@ impl fmt::Display for ExecError {
             ExecError::Object { kind, name, reason } => write!(f, "{kind} {name}: {reason}"),
             ExecError::Device { name, reason } => write!(f, "device {name}: {reason}"),
             ExecError::EnableTimeout(e) => write!(f, "{e}"),
+            ExecError::AnalogDrive { name, reason } => write!(f, "device {name}: {reason}"),
         }
     }
 }

@@ -514,6 +514,11 @@ impl<'c> Executive<'c> {
                 a.connect_drive();
             }
         }
+        for link in &drives.analog.links {
+            if let Some(a) = axes.get_mut(link.axis) {
+                a.connect_drive();
+            }
+        }
         let status: Vec<AxisStatus> = axes.iter().map(|a| *a.status()).collect();
         let encoder_status = encoders.iter().map(|e| *e.status()).collect();
         Ok(Self {
@@ -921,6 +926,7 @@ impl<'c> Executive<'c> {
     /// sampled, latch the last step's commands, and each axis on a drive reads its sample
     /// (the order in [`crate::drives`]).
     fn drive_inputs(&mut self, t: i64) {
+        self.drives.analog.read(t, &mut self.axes);
         self.drives.exchange(t);
         for k in 0..self.drives.links.len() {
             let axis = self.drives.links[k].axis;
@@ -947,6 +953,7 @@ impl<'c> Executive<'c> {
     /// The outputs of the axes on drives become the drives' commands, with touch probe 1
     /// armed while its measuring input has a job.
     fn drive_outputs(&mut self, t: i64) {
+        self.drives.analog.write(t, &self.axes);
         for k in 0..self.drives.links.len() {
             let link = &mut self.drives.links[k];
             let axis = link.axis;
@@ -969,6 +976,12 @@ impl<'c> Executive<'c> {
         code: u16,
     ) -> Result<(), tandem_motion::plant::servo::SimServoError> {
         self.drives.inject_fault(device, code)
+    }
+
+    /// The state of analog drive `device` (index in [`Cell::devices`]) and of its axis's link,
+    /// if this executive runs it.
+    pub fn analog_drive(&self, device: usize) -> Option<crate::drives::analog::AnalogDriveStatus> {
+        self.drives.analog.status(device)
     }
 
     /// The TxPDO that drive `device` gave at the last boundary, if this executive runs it.

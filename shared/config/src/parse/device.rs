@@ -1,18 +1,21 @@
-//! `[devices.<name>]` (simulated servo drives and digital outputs) and the drive connection of
-//! each axis (`[axes.<name>.drive]`, `[axes.<name>.encoder]`, `[axes.<name>.mechanics]`): which
+//! `[devices.<name>]` (simulated servo drives, analog drives and digital outputs) and the drive
+//! connection of each axis (`[axes.<name>.drive]`, `[axes.<name>.encoder]`, `[axes.<name>.mechanics]`): which
 //! device of which node's process image drives the axis, and how the drive's increments become
 //! the axis's units.
 
 use super::{node_named, pick, Ctx};
 use crate::cell::{
-    AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind, DigitalOutputParams,
-    DriveConnection, Node, MAX_CHANNELS,
+    AnalogDriveConnection, AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind,
+    DigitalOutputParams, DriveConnection, Node, MAX_CHANNELS,
 };
 use crate::error::{ConfigError, Problem};
 use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
+use tandem_motion::plant::analog::{
+    AnalogParams, AnalogParamsError, ControllerParams, SimAnalogParams,
+};
 use tandem_motion::plant::cia402::QuickStopOption;
 use tandem_motion::plant::mechanics::{
-    EncoderConfig, Mechanics, MechanicsError, MechanicsField, Mounting, Scaling,
+    EncoderConfig, EncoderKind, Mechanics, MechanicsError, MechanicsField, Mounting, Scaling,
 };
 use tandem_motion::plant::servo::{ServoParams, SimServo};
 
@@ -21,12 +24,29 @@ use tandem_motion::plant::servo::{ServoParams, SimServo};
 enum Kind {
     Servo,
     DigitalOutput,
+    Analog,
 }
 
 /// The device kinds by name.
-const DEVICE_KINDS: [(&str, Kind); 2] = [
+const DEVICE_KINDS: [(&str, Kind); 3] = [
     ("sim_servo", Kind::Servo),
     ("sim_digital_output", Kind::DigitalOutput),
+    ("sim_analog_drive", Kind::Analog),
+];
+
+/// How an axis reaches its drive (`[axes.<name>.drive] type`).
+#[derive(Copy, Clone, PartialEq, Eq)]
+enum DriveType {
+    Simulation,
+    Cia402,
+    Analog,
+}
+
+/// The drive connections by name.
+const DRIVE_TYPES: [(&str, DriveType); 3] = [
+    ("simulation", DriveType::Simulation),
+    ("cia402", DriveType::Cia402),
+    ("analog", DriveType::Analog),
 ];
 
 /// The encoder mountings by name (S7 `Sensor[n].MountingMode` 0, 1, 2).
@@ -47,7 +67,7 @@ pub(super) fn devices(
         let at = |k: &str, p| cx.at(&["devices", name, k], p);
         let kind = match pick("kind", &d.kind, &DEVICE_KINDS).map_err(|(k, p)| at(k, p))? {
             Kind::Servo => {
-                if let Some(k) = output_key_given(d) {
+                if let Some(k) = output_key_given(d).or_else(|| analog_key_given(d)) {
                     return Err(at(k, Problem::NotForKind("sim_servo")));
                 }
                 let params = servo_params(d, nodes[node].cycle_ns).map_err(|(k, p)| at(k, p))?;
@@ -60,12 +80,25 @@ pub(super) fn devices(
                 DeviceKind::SimServo(params)
             }
             Kind::DigitalOutput => {
-                if let Some(k) = servo_key_given(d) {
+                if let Some(k) = servo_key_given(d).or_else(|| analog_key_given(d)) {
                     return Err(at(k, Problem::NotForKind("sim_digital_output")));
                 }
                 DeviceKind::SimDigitalOutput(
                     output_params(d).map_err(|(k, p)| cx.at_or_table(&["devices", name, k], p))?,
                 )
+            }
+            Kind::Analog => {
+                if let Some(k) = servo_key_given(d).or_else(|| output_key_given(d)) {
+                    return Err(at(k, Problem::NotForKind("sim_analog_drive")));
+                }
+                let params = analog_device_params(d);
+                params.validate().map_err(|e| {
+                    cx.at_or_table(
+                        &["devices", name, e.field],
+                        Problem::Invalid(e.problem.text()),
+                    )
+                })?;
+                DeviceKind::SimAnalogDrive(params)
             }
         };
         out.push(DeviceEntry {
@@ -132,6 +165,36 @@ fn servo_key_given(d: &DeviceSection) -> Option<&'static str> {
     .map(|(k, _)| k)
 }
 
+/// The first key of a simulated analog drive given on another kind of device.
+fn analog_key_given(d: &DeviceSection) -> Option<&'static str> {
+    [
+        ("reference_speed", d.reference_speed.is_some()),
+        ("max_speed", d.max_speed.is_some()),
+        ("time_constant", d.time_constant.is_some()),
+        ("ramp_down_time", d.ramp_down_time.is_some()),
+        ("ready_delay", d.ready_delay.is_some()),
+        ("offset", d.offset.is_some()),
+    ]
+    .into_iter()
+    .find(|(_, given)| *given)
+    .map(|(k, _)| k)
+}
+
+/// The parameters of a simulated analog drive: the section's values over the defaults
+/// ([`SimAnalogParams::example`]); checked by the caller. Each field is named as its key.
+fn analog_device_params(d: &DeviceSection) -> SimAnalogParams {
+    let p = SimAnalogParams::example();
+    SimAnalogParams {
+        reference_speed: d.reference_speed.unwrap_or(p.reference_speed),
+        max_speed: d.max_speed.unwrap_or(p.max_speed),
+        time_constant: d.time_constant.unwrap_or(p.time_constant),
+        ramp_down_time: d.ramp_down_time.unwrap_or(p.ramp_down_time),
+        ready_delay: d.ready_delay.unwrap_or(p.ready_delay),
+        offset: d.offset.unwrap_or(p.offset),
+        ..p
+    }
+}
+
 /// The key of `[devices.<name>]` that sets a [`ServoParams`] field.
 fn servo_key(field: &'static str) -> &'static str {
     match field {
@@ -181,8 +244,8 @@ fn servo_params(d: &DeviceSection, cycle_ns: i64) -> Result<ServoParams, super::
     })
 }
 
-/// `[axes.<name>.drive]` of every axis: the simulated drive, or a CiA 402 drive of the axis's
-/// node, bound to one axis only, with its encoder and mechanics.
+/// `[axes.<name>.drive]` of every axis: the simulated drive, or a CiA 402 or analog drive of the
+/// axis's node, bound to one axis only, with its encoder and mechanics.
 pub(super) fn drives(
     cx: Ctx<'_>,
     raw: &CellFile,
@@ -196,16 +259,121 @@ pub(super) fn drives(
             path.extend_from_slice(key);
             cx.at_or_table(&path, p)
         };
-        let kinds = [("simulation", false), ("cia402", true)];
-        let cia402 = pick("drive.type", &a.drive.kind, &kinds)
+        let ty = pick("drive.type", &a.drive.kind, &DRIVE_TYPES)
             .map_err(|(_, p)| at(&["drive", "type"], p))?;
-        if !cia402 {
+        if ty == DriveType::Simulation {
             only_with_a_drive(a).map_err(|k| at(k, Problem::OnlyWithDrive))?;
             continue;
+        }
+        if ty == DriveType::Cia402 {
+            if let Some(k) = analog_drive_key_given(a) {
+                return Err(at(k, Problem::Invalid("only for `type = \"analog\"`")));
+            }
+        }
+        if ty == DriveType::Analog {
+            if let Some(k) = cia402_drive_key_given(a) {
+                return Err(at(k, Problem::Invalid("only for `type = \"cia402\"`")));
+            }
         }
         if a.virtual_axis {
             return Err(at(&["virtual"], Problem::VirtualWithDrive));
         }
+        let want = match ty {
+            DriveType::Analog => Wanted {
+                needs: "an analog drive (`sim_analog_drive`)",
+                kind_ok: |k| matches!(k, DeviceKind::SimAnalogDrive(_)),
+            },
+            _ => Wanted {
+                needs: "a drive (`sim_servo`)",
+                kind_ok: |k| matches!(k, DeviceKind::SimServo(_)),
+            },
+        };
+        let bound = Bound {
+            raw,
+            devices,
+            taken: &taken,
+        };
+        let k = bound.device(a, entry, want, &at)?;
+        taken[k] = Some(i);
+        let timeout = a.drive.enable_timeout.unwrap_or(ENABLE_TIMEOUT_S);
+        if !(timeout.is_finite() && timeout > 0.0 && timeout <= 60.0) {
+            return Err(at(
+                &["drive", "enable_timeout"],
+                Problem::Invalid("must be greater than 0 and at most 60 s"),
+            ));
+        }
+        let enable_timeout_ns = (timeout * 1e9).round() as i64;
+        if let EncoderSpec::Table(t) = &a.encoder {
+            pick("encoder.mounting", &t.mounting, &MOUNTINGS)
+                .map_err(|(_, p)| at(&["encoder", "mounting"], p))?;
+        }
+        entry.drive = match &devices[k].kind {
+            DeviceKind::SimAnalogDrive(_) => {
+                let cycle_ns = (entry.config.cycle * 1e9).round() as i64;
+                let params = analog_params(a, cycle_ns, enable_timeout_ns, &at)?;
+                DriveConnection::Analog(Box::new(AnalogDriveConnection {
+                    device: DeviceIndex(k),
+                    params,
+                }))
+            }
+            DeviceKind::SimServo(servo) => {
+                let steps = servo.increments_per_revolution;
+                let scaling = scaling(a, steps, Some(steps))
+                    .map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+                let inertia = a.drive.inertia.unwrap_or(servo.inertia);
+                if !(inertia.is_finite() && inertia > 0.0) {
+                    return Err(at(
+                        &["drive", "inertia"],
+                        Problem::Invalid("must be a positive moment of inertia (kg·m²)"),
+                    ));
+                }
+                DriveConnection::Cia402(Box::new(Cia402Connection {
+                    device: DeviceIndex(k),
+                    enable_timeout_ns,
+                    scaling,
+                    torque_precontrol_inertia: a
+                        .drive
+                        .torque_precontrol
+                        .unwrap_or(false)
+                        .then_some(inertia),
+                }))
+            }
+            // Refused by `bound_device`.
+            DeviceKind::SimDigitalOutput(_) => continue,
+        };
+    }
+    Ok(())
+}
+
+/// The kind of device a drive type needs.
+#[derive(Copy, Clone)]
+struct Wanted {
+    /// In words, for the error.
+    needs: &'static str,
+    /// Whether a device is of that kind.
+    kind_ok: fn(&DeviceKind) -> bool,
+}
+
+/// The devices and the axes they are bound to so far.
+struct Bound<'a> {
+    raw: &'a CellFile,
+    devices: &'a [DeviceEntry],
+    /// Per device, the axis bound to it.
+    taken: &'a [Option<usize>],
+}
+
+impl Bound<'_> {
+    /// The device `[axes.<name>.drive] device` of axis `a` names: known, of the kind `want`,
+    /// on the axis's node, not bound to another axis.
+    fn device(
+        &self,
+        a: &AxisSection,
+        entry: &AxisEntry,
+        want: Wanted,
+        at: &dyn Fn(&[&str], Problem) -> ConfigError,
+    ) -> Result<usize, ConfigError> {
+        let (raw, devices, taken) = (self.raw, self.devices, self.taken);
+        let (needs, kind_ok) = (want.needs, want.kind_ok);
         let dev_name = a
             .drive
             .device
@@ -226,16 +394,16 @@ pub(super) fn drives(
                 )
             })?;
         let dev = &devices[k];
-        let DeviceKind::SimServo(servo) = &dev.kind else {
+        if !kind_ok(&dev.kind) {
             return Err(at(
                 &["drive", "device"],
                 Problem::DeviceKind {
                     device: dev.name.clone(),
                     kind: dev.kind.name(),
-                    needs: "a drive (`sim_servo`)",
+                    needs,
                 },
             ));
-        };
+        }
         if dev.node != entry.node {
             return Err(at(
                 &["drive", "device"],
@@ -246,7 +414,7 @@ pub(super) fn drives(
                 },
             ));
         }
-        if let Some(other) = taken[k] {
+        if let Some(other) = taken.get(k).copied().flatten() {
             return Err(at(
                 &["drive", "device"],
                 Problem::DeviceTaken {
@@ -255,39 +423,91 @@ pub(super) fn drives(
                 },
             ));
         }
-        taken[k] = Some(i);
-        let timeout = a.drive.enable_timeout.unwrap_or(ENABLE_TIMEOUT_S);
-        if !(timeout.is_finite() && timeout > 0.0 && timeout <= 60.0) {
-            return Err(at(
-                &["drive", "enable_timeout"],
-                Problem::Invalid("must be greater than 0 and at most 60 s"),
-            ));
-        }
-        if let EncoderSpec::Table(t) = &a.encoder {
-            pick("encoder.mounting", &t.mounting, &MOUNTINGS)
-                .map_err(|(_, p)| at(&["encoder", "mounting"], p))?;
-        }
-        let scaling =
-            scaling(a, servo).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
-        let inertia = a.drive.inertia.unwrap_or(servo.inertia);
-        if !(inertia.is_finite() && inertia > 0.0) {
-            return Err(at(
-                &["drive", "inertia"],
-                Problem::Invalid("must be a positive moment of inertia (kg·m²)"),
-            ));
-        }
-        entry.drive = DriveConnection::Cia402(Box::new(Cia402Connection {
-            device: DeviceIndex(k),
-            enable_timeout_ns: (timeout * 1e9).round() as i64,
-            scaling,
-            torque_precontrol_inertia: a
-                .drive
-                .torque_precontrol
-                .unwrap_or(false)
-                .then_some(inertia),
-        }));
+        Ok(k)
     }
-    Ok(())
+}
+
+/// The first key of an analog drive connection given on another type: its key path.
+fn analog_drive_key_given(a: &AxisSection) -> Option<&'static [&'static str]> {
+    if a.drive.reference_velocity.is_some() {
+        Some(&["drive", "reference_velocity"])
+    } else if a.drive.ready.is_some() {
+        Some(&["drive", "ready"])
+    } else if a.drive.t_addptc.is_some() {
+        Some(&["drive", "t_addptc"])
+    } else {
+        None
+    }
+}
+
+/// The first key of a CiA 402 drive connection (torque precontrol) given on another type: its
+/// key path.
+fn cia402_drive_key_given(a: &AxisSection) -> Option<&'static [&'static str]> {
+    if a.drive.torque_precontrol.is_some() {
+        Some(&["drive", "torque_precontrol"])
+    } else if a.drive.inertia.is_some() {
+        Some(&["drive", "inertia"])
+    } else {
+        None
+    }
+}
+
+/// The analog drive connection of axis `a` on a node of cycle `cycle_ns`: its position
+/// controller (`kv`, `kpc`, `t_vtc`, `t_addptc`, `reference_velocity`), the ready input, and
+/// its encoder, which must be given as a table (`[axes.<name>.encoder]`, with
+/// `steps_per_revolution`: the drive has no encoder of its own) and be incremental. An error
+/// names the key.
+fn analog_params(
+    a: &AxisSection,
+    cycle_ns: i64,
+    enable_timeout_ns: i64,
+    at: &dyn Fn(&[&str], Problem) -> ConfigError,
+) -> Result<AnalogParams, ConfigError> {
+    let d = &a.drive;
+    let reference_velocity = d
+        .reference_velocity
+        .ok_or_else(|| at(&["drive"], Problem::Missing("reference_velocity")))?;
+    let controller = ControllerParams {
+        cycle_ns,
+        kv: d.kv,
+        kpc_percent: d.kpc,
+        velocity_time_constant: d.t_vtc,
+        additional_position_time_constant: d.t_addptc.unwrap_or(0.0),
+        reference_velocity,
+    };
+    controller.validate().map_err(|e: AnalogParamsError| {
+        let problem = Problem::Invalid(e.problem.text());
+        match e.field {
+            "kpc_percent" => at(&["drive", "kpc"], problem),
+            "velocity_time_constant" => at(&["drive", "t_vtc"], problem),
+            "additional_position_time_constant" => at(&["drive", "t_addptc"], problem),
+            "cycle_ns" => at(&["node"], problem),
+            other => at(&["drive", other], problem),
+        }
+    })?;
+    let EncoderSpec::Table(t) = &a.encoder else {
+        return Err(at(
+            &["encoder"],
+            Problem::Missing("[axes.<name>.encoder] steps_per_revolution"),
+        ));
+    };
+    let steps = t
+        .steps_per_revolution
+        .ok_or_else(|| at(&["encoder"], Problem::Missing("steps_per_revolution")))?;
+    if t.encoder_kind() != EncoderKind::Incremental {
+        return Err(at(
+            &["encoder", "type"],
+            Problem::Invalid("an analog drive's encoder is incremental (absolute: not yet)"),
+        ));
+    }
+    let scaling =
+        scaling(a, steps, None).map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+    Ok(AnalogParams {
+        controller,
+        enable_timeout_ns,
+        ready: d.ready.unwrap_or(true),
+        scaling,
+    })
 }
 
 /// On a simulated drive the keys of a drive of the process image are refused: the key path of
@@ -299,11 +519,11 @@ fn only_with_a_drive(a: &AxisSection) -> Result<(), &'static [&'static str]> {
     if a.drive.enable_timeout.is_some() {
         return Err(&["drive", "enable_timeout"]);
     }
-    if a.drive.torque_precontrol.is_some() {
-        return Err(&["drive", "torque_precontrol"]);
+    if let Some(k) = analog_drive_key_given(a) {
+        return Err(k);
     }
-    if a.drive.inertia.is_some() {
-        return Err(&["drive", "inertia"]);
+    if let Some(k) = cia402_drive_key_given(a) {
+        return Err(k);
     }
     if matches!(a.encoder, EncoderSpec::Table(_)) {
         return Err(&["encoder"]);
@@ -314,11 +534,13 @@ fn only_with_a_drive(a: &AxisSection) -> Result<(), &'static [&'static str]> {
     Ok(())
 }
 
-/// The axis's encoder and mechanics on the drive with parameters `servo`, validated; an error
-/// names the key.
+/// The axis's encoder and mechanics, validated: `steps` per revolution unless the encoder
+/// table gives them, and the drive's position increments per motor revolution
+/// (`drive_increments`, a CiA 402 drive's; `None` for an analog drive). An error names the key.
 fn scaling(
     a: &AxisSection,
-    servo: &ServoParams,
+    steps: u32,
+    drive_increments: Option<u32>,
 ) -> Result<Scaling, (Vec<&'static str>, MechanicsError)> {
     let default_table;
     let table = match &a.encoder {
@@ -339,9 +561,7 @@ fn scaling(
     };
     let encoder = EncoderConfig {
         kind,
-        steps_per_revolution: table
-            .steps_per_revolution
-            .unwrap_or(servo.increments_per_revolution),
+        steps_per_revolution: table.steps_per_revolution.unwrap_or(steps),
         fine_resolution_bits: table.fine_resolution_bits,
         determinable_revolutions: table.determinable_revolutions,
         raw_bits: table.raw_bits,
@@ -355,7 +575,7 @@ fn scaling(
         leadscrew_pitch: m.and_then(|m| m.leadscrew_pitch),
         inverse_drive: m.is_some_and(|m| m.inverse_drive),
         efficiency: m.map_or(1.0, |m| m.efficiency),
-        drive_increments_per_revolution: Some(servo.increments_per_revolution),
+        drive_increments_per_revolution: drive_increments,
     };
     Scaling::new(&encoder, &mechanics).map_err(|e| (field_key(e.field), e))
 }

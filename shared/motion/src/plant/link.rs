@@ -34,6 +34,26 @@ pub struct AxisSignals {
     pub zero_mark: Option<f64>,
 }
 
+impl AxisSignals {
+    /// The simulated plant's switches at physical position `p` and the edges passed since
+    /// `prev` (the reference cam left, at its edge; a zero mark), as a drive's measuring input
+    /// would latch them.
+    pub fn of_plant(plant: &Plant, prev: f64, p: f64) -> Self {
+        let on_cam = |x: f64| plant.on_reference_cam(x);
+        let reference_cam_left = match plant.reference_cam {
+            Some((lo, hi)) if on_cam(prev) && !on_cam(p) => Some(if p > prev { hi } else { lo }),
+            _ => None,
+        };
+        Self {
+            limit_positive: plant.at_positive_limit(p),
+            limit_negative: plant.at_negative_limit(p),
+            reference_cam: on_cam(p),
+            reference_cam_left,
+            zero_mark: plant.zero_mark.and_then(|z| z.crossed(prev, p)),
+        }
+    }
+}
+
 /// The state of the drive as the axis sees it.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub enum DriveState {
@@ -160,21 +180,9 @@ impl SimPlant {
         let actual = self.drive.actual();
         let (prev, p) = (self.last, actual.p);
         self.last = p;
-        let plant = &self.plant;
-        let on_cam = |x: f64| plant.on_reference_cam(x);
-        let reference_cam_left = match self.plant.reference_cam {
-            Some((lo, hi)) if on_cam(prev) && !on_cam(p) => Some(if p > prev { hi } else { lo }),
-            _ => None,
-        };
         DriveInputs {
             actual,
-            signals: AxisSignals {
-                limit_positive: plant.at_positive_limit(p),
-                limit_negative: plant.at_negative_limit(p),
-                reference_cam: on_cam(p),
-                reference_cam_left,
-                zero_mark: self.plant.zero_mark.and_then(|z| z.crossed(prev, p)),
-            },
+            signals: AxisSignals::of_plant(&self.plant, prev, p),
             state: DriveState::Operational,
             in_limitation: false,
         }

@@ -4,6 +4,7 @@
 //! drive model and plant of an axis in simulation ([`drive`]); and the timestamped edges of a
 //! mark sensor ([`sensor`]).
 
+pub mod analog;
 pub mod cia402;
 pub mod drive;
 pub mod link;
