@@ -5,8 +5,8 @@
 
 use super::{node_named, pick, Ctx};
 use crate::cell::{
-    AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind, DigitalOutputParams,
-    DriveConnection, Node, MAX_CHANNELS,
+    AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind, DigitalInputParams,
+    DigitalOutputParams, DriveConnection, Node, MAX_CHANNELS,
 };
 use crate::error::{ConfigError, Problem};
 use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
@@ -21,12 +21,14 @@ use tandem_motion::plant::servo::{ServoParams, SimServo};
 enum Kind {
     Servo,
     DigitalOutput,
+    DigitalInput,
 }
 
 /// The device kinds by name.
-const DEVICE_KINDS: [(&str, Kind); 2] = [
+const DEVICE_KINDS: [(&str, Kind); 3] = [
     ("sim_servo", Kind::Servo),
     ("sim_digital_output", Kind::DigitalOutput),
+    ("sim_digital_input", Kind::DigitalInput),
 ];
 
 /// The encoder mountings by name (S7 `Sensor[n].MountingMode` 0, 1, 2).
@@ -66,6 +68,18 @@ pub(super) fn devices(
                 DeviceKind::SimDigitalOutput(
                     output_params(d).map_err(|(k, p)| cx.at_or_table(&["devices", name, k], p))?,
                 )
+            }
+            Kind::DigitalInput => {
+                if let Some(k) = servo_key_given(d) {
+                    return Err(at(k, Problem::NotForKind("sim_digital_input")));
+                }
+                // The same keys as an output terminal: `channels` and `timestamped`.
+                let p =
+                    output_params(d).map_err(|(k, p)| cx.at_or_table(&["devices", name, k], p))?;
+                DeviceKind::SimDigitalInput(DigitalInputParams {
+                    channels: p.channels,
+                    timestamped: p.timestamped,
+                })
             }
         };
         out.push(DeviceEntry {

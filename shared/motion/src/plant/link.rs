@@ -88,6 +88,18 @@ pub struct DriveOutputs {
     pub fault_reset: bool,
 }
 
+/// Switch levels read from input signals of the node's process image, in place of the
+/// plant's simulated switch positions (`None`: the plant's own switch).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct SwitchInputs {
+    /// The positive hardware limit switch.
+    pub limit_positive: Option<bool>,
+    /// The negative hardware limit switch.
+    pub limit_negative: Option<bool>,
+    /// The reference cam.
+    pub reference_cam: Option<bool>,
+}
+
 /// The simulated drive and the sensors of its plant (the axis in simulation).
 #[derive(Clone, Debug)]
 pub struct SimPlant {
@@ -95,6 +107,10 @@ pub struct SimPlant {
     plant: Plant,
     /// The physical position of the last sample, for the edges since then.
     last: f64,
+    /// Switches from input signals, set before each sample.
+    inputs: SwitchInputs,
+    /// The reference cam's level at the last sample (for an input signal's edge).
+    cam_level: bool,
 }
 
 impl SimPlant {
@@ -111,7 +127,22 @@ impl SimPlant {
             drive: SimDrive::new(model, cycle, stop_deceleration, p0),
             plant,
             last: p0,
+            inputs: SwitchInputs::default(),
+            cam_level: false,
         }
+    }
+
+    /// Takes the switches given as input signals for the coming samples.
+    pub fn set_switch_inputs(&mut self, s: SwitchInputs) {
+        self.inputs = s;
+    }
+
+    /// Whether the reference cam is active now: its input signal, or the plant's cam at the
+    /// drive's position.
+    pub fn reference_cam_now(&self) -> bool {
+        self.inputs
+            .reference_cam
+            .unwrap_or_else(|| self.plant.on_reference_cam(self.drive.actual().p))
     }
 
     /// The sensors of the plant (reference cam, zero marks, hardware limits).
@@ -132,16 +163,28 @@ impl SimPlant {
         self.last = p;
         let plant = &self.plant;
         let on_cam = |x: f64| plant.on_reference_cam(x);
-        let reference_cam_left = match self.plant.reference_cam {
-            Some((lo, hi)) if on_cam(prev) && !on_cam(p) => Some(if p > prev { hi } else { lo }),
-            _ => None,
+        let inputs = self.inputs;
+        let reference_cam_left = match (inputs.reference_cam, self.plant.reference_cam) {
+            // Inferred: an input signal's edge is known to the sample; the position is that
+            // of the sample at which the level is first seen low.
+            (Some(level), _) => (self.cam_level && !level).then_some(p),
+            (None, Some((lo, hi))) if on_cam(prev) && !on_cam(p) => {
+                Some(if p > prev { hi } else { lo })
+            }
+            (None, _) => None,
         };
+        let reference_cam = inputs.reference_cam.unwrap_or_else(|| on_cam(p));
+        self.cam_level = reference_cam;
         DriveInputs {
             actual,
             signals: AxisSignals {
-                limit_positive: plant.at_positive_limit(p),
-                limit_negative: plant.at_negative_limit(p),
-                reference_cam: on_cam(p),
+                limit_positive: inputs
+                    .limit_positive
+                    .unwrap_or_else(|| plant.at_positive_limit(p)),
+                limit_negative: inputs
+                    .limit_negative
+                    .unwrap_or_else(|| plant.at_negative_limit(p)),
+                reference_cam,
                 reference_cam_left,
                 zero_mark: self.plant.zero_mark.and_then(|z| z.crossed(prev, p)),
             },
