@@ -951,8 +951,9 @@ impl<'c> Executive<'c> {
     }
 
     /// Once the cycle motions are known: the input signals' sensors add their edges to the
-    /// frame of `t`, and each measuring input fed by a signal takes that signal's edges.
-    fn input_sense(&mut self, t: i64) {
+    /// frame of `t`, each measuring input fed by a signal takes that signal's edges, and every
+    /// edge of the frame is logged with its time.
+    fn input_sense(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         self.inputs.sense(t, &self.motions);
         for k in 0..self.inputs.measuring.len() {
             let (m, signal) = self.inputs.measuring[k];
@@ -960,6 +961,16 @@ impl<'c> Executive<'c> {
                 self.objects.push_edge(m, e);
             }
         }
+        for e in self.inputs.frame() {
+            let name = self
+                .cell
+                .signals
+                .get(e.signal)
+                .map_or("?", |s| s.name.as_str());
+            let level = if e.rising { "ON" } else { "OFF" };
+            writeln!(log, "t={} {name} input {level}", Secs(e.time_ns))?;
+        }
+        Ok(())
     }
 
     /// The process image's drives at the boundary `t`: the devices run to `t` and are
@@ -1265,7 +1276,7 @@ impl<'c> Executive<'c> {
             });
         }
         if self.inputs.any() {
-            self.input_sense(t);
+            self.input_sense(t, log)?;
         }
         for k in 0..self.object_axes.len() {
             let i = AxisIndex(self.object_axes[k]);

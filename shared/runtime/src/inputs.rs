@@ -316,6 +316,11 @@ impl Inputs {
             })
     }
 
+    /// The edges of the current step, in the order they were sampled.
+    pub(crate) fn frame(&self) -> &[InputSignalEdge] {
+        &self.frame
+    }
+
     /// The state of input device `device` (index in [`Cell::devices`]), if it is here.
     pub(crate) fn status(&self, device: usize) -> Option<&InputDeviceStatus> {
         self.terminals
