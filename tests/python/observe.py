@@ -3,7 +3,8 @@
 
 Subscribes to everything of a cell (tandem/<cell>/**), sends commands as Zenoh queries to
 tandem/<cell>/<node>/<object>/cmd, asks which hosts are alive (liveliness), and prints one JSON
-summary on stdout: the keys seen and how often, the last state of every axis, the replies.
+summary on stdout: the keys seen and how often, the last state of every axis, the replies, and
+every edge of the nodes' signals (tandem/<cell>/<node>/<signal>/signal), in arrival order.
 
   observe.py --cell line --connect tcp/10.0.0.1:7447 --seconds 4 \
       --command followers/feed "MC_Power" --command followers/feed "MC_MoveVelocity --velocity 50"
@@ -36,6 +37,7 @@ def main():
 
     counts = {}
     last = {}
+    signals = []
     lock = threading.Lock()
 
     def on_sample(sample):
@@ -47,6 +49,11 @@ def main():
                     last[key] = json.loads(sample.payload.to_string())
                 except ValueError:
                     last[key] = {"malformed": True}
+            elif key.endswith("/signal"):
+                try:
+                    signals.append(json.loads(sample.payload.to_string()))
+                except ValueError:
+                    signals.append({"malformed": True, "key": key})
 
     sub = session.declare_subscriber(f"tandem/{a.cell}/**", on_sample)
     t0 = time.monotonic()
@@ -88,6 +95,7 @@ def main():
             "replies": replies,
             "alive": alive,
             "alive_events": alive_events,
+            "signals": signals,
         }
     session.close()
     json.dump(summary, sys.stdout)

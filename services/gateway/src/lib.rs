@@ -632,6 +632,14 @@ struct NodeFeeds<'a> {
         tandem_protocol::wire::Event,
         (),
     >,
+    /// The node's signal edges, if it has signals.
+    signals: Option<
+        iceoryx2::port::subscriber::Subscriber<
+            iceoryx2::prelude::ipc::Service,
+            tandem_protocol::wire::SignalEvent,
+            (),
+        >,
+    >,
 }
 
 /// Puts `value` on `key`; a failed put is counted by Zenoh's own statistics and the next
@@ -650,7 +658,23 @@ fn telemetry(x: &Ctx) -> Result<(), GatewayError> {
     let mut feeds = Vec::new();
     for n in &plan.nodes {
         let name = &cell.nodes[*n].name;
+        let has_signals = cell
+            .signals
+            .iter()
+            .any(|s| cell.devices.get(s.device.0).is_some_and(|d| d.node == *n));
+        let signals = if has_signals {
+            Some(
+                ipc::signals(&node, &cell.name, name)?
+                    .subscriber_builder()
+                    .buffer_size(1024)
+                    .create()
+                    .map_err(GatewayError::port("signal subscriber"))?,
+            )
+        } else {
+            None
+        };
         feeds.push(NodeFeeds {
+            signals,
             name,
             telemetry: ipc::telemetry(&node, &cell.name, name)?
                 .subscriber_builder()
@@ -671,6 +695,7 @@ fn telemetry(x: &Ctx) -> Result<(), GatewayError> {
         for f in &feeds {
             put_state(session, cell, &names, f);
             put_events(session, cell, &names, f);
+            put_signals(session, cell, f);
         }
         put_counters(session, cell, host, c);
         let now = Instant::now();
@@ -723,6 +748,49 @@ fn put_events(session: &zenoh::Session, cell: &Cell, names: &[&str], f: &NodeFee
             EVENT_LOG => put(session, keys::log(&cell.name, f.name), body),
             _ => {}
         }
+    }
+}
+
+/// Each signal edge of one node since the last call, on its signal's key (docs/processes.md,
+/// "Zenoh keys").
+fn put_signals(session: &zenoh::Session, cell: &Cell, f: &NodeFeeds) {
+    use tandem_protocol::wire::{SIGNAL_INPUT, SIGNAL_LATE, SIGNAL_TIMESTAMPED};
+    let Some(sub) = &f.signals else {
+        return;
+    };
+    while let Ok(Some(s)) = sub.receive() {
+        let e = s.payload();
+        let Some(signal) = cell.signals.get(e.signal as usize) else {
+            continue;
+        };
+        let input = e.flags & SIGNAL_INPUT != 0;
+        let body = if input {
+            serde_json::json!({
+                "signal": signal.name,
+                "node": f.name,
+                "direction": "input",
+                "level": e.level != 0,
+                "time_ns": e.t_ns,
+                "sampled_ns": e.ref_ns,
+                "timestamped": e.flags & SIGNAL_TIMESTAMPED != 0,
+            })
+        } else {
+            serde_json::json!({
+                "signal": signal.name,
+                "node": f.name,
+                "direction": "output",
+                "level": e.level != 0,
+                "time_ns": e.t_ns,
+                "edge_ns": e.ref_ns,
+                "timestamped": e.flags & SIGNAL_TIMESTAMPED != 0,
+                "late": e.flags & SIGNAL_LATE != 0,
+            })
+        };
+        put(
+            session,
+            keys::signal(&cell.name, f.name, &signal.name),
+            body.to_string(),
+        );
     }
 }
 

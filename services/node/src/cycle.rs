@@ -17,8 +17,9 @@ use tandem_config::{AxisIndex, Cell};
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::objects::axis::AxisStatus;
 use tandem_protocol::wire::{
-    job_code, AxisTelemetry, CommandReply, Event, IoEvent, LeadingValueSample, NodeHealth, Text,
-    EVENT_JOB, EVENT_LOG, IO_MEASURED, IO_OUTPUT, OUTCOME_ACCEPTED, OUTCOME_REJECTED,
+    job_code, AxisTelemetry, CommandReply, Event, IoEvent, LeadingValueSample, NodeHealth,
+    SignalEvent, Text, EVENT_JOB, EVENT_LOG, IO_MEASURED, IO_OUTPUT, OUTCOME_ACCEPTED,
+    OUTCOME_REJECTED, SIGNAL_INPUT, SIGNAL_LATE, SIGNAL_TIMESTAMPED,
 };
 use tandem_rt as rt;
 use tandem_runtime::exec::{Applied, Describe, Executive, JobNote};
@@ -97,6 +98,9 @@ pub(crate) struct NodeCycle<'c> {
     jobs: Vec<Event>,
     health: NodeHealth,
     report: Report,
+    /// Per signal of the cell: its device, channel and whether it is timestamped (to name an
+    /// output switch's signal without searching the cell's names).
+    signals: Vec<(usize, u8, bool)>,
 }
 
 /// What [`NodeCycle::new`] takes.
@@ -151,6 +155,15 @@ impl<'c> NodeCycle<'c> {
             jobs: Vec::with_capacity(JOB_EVENTS),
             health,
             report: Report::default(),
+            signals: p
+                .cell
+                .signals
+                .iter()
+                .map(|s| {
+                    let ts = s.signal_type == tandem_config::SignalType::TimestampedBool;
+                    (s.device.0, s.channel, ts)
+                })
+                .collect(),
         }
     }
 
@@ -287,6 +300,7 @@ impl<'c> NodeCycle<'c> {
                 failed += u64::from(p.send_copy(ev).is_err());
             }
         });
+        failed += self.publish_signals();
         let (events, names, jobs) = (&self.ports.events, &self.names, &mut self.jobs);
         let mut dropped = 0u64;
         self.exec.drain_job_notes(|j| {
@@ -304,6 +318,48 @@ impl<'c> NodeCycle<'c> {
         self.hand_over_jobs();
         self.hand_over_log(t);
         self.hand_over_adjustments();
+    }
+
+    /// The edges of the node's signals since the last cycle (inputs as sampled, outputs as
+    /// switched), one fixed-size record each; returns the sends that failed.
+    fn publish_signals(&mut self) -> u64 {
+        let Some(port) = &self.ports.signals else {
+            return 0;
+        };
+        let mut failed = 0u64;
+        let signals = &self.signals;
+        self.exec.drain_input_edges(|e| {
+            let ts = signals.get(e.signal).is_some_and(|s| s.2);
+            let ev = SignalEvent {
+                t_ns: e.time_ns,
+                ref_ns: e.sampled_ns,
+                signal: e.signal as u32,
+                level: u32::from(e.rising),
+                flags: SIGNAL_INPUT | if ts { SIGNAL_TIMESTAMPED } else { 0 },
+                reserved: 0,
+            };
+            failed += u64::from(port.send_copy(ev).is_err());
+        });
+        self.exec.drain_output_switches(|x| {
+            let Some(k) = signals
+                .iter()
+                .position(|s| s.0 == x.device && s.1 == x.channel)
+            else {
+                return;
+            };
+            let ts = signals.get(k).is_some_and(|s| s.2);
+            let ev = SignalEvent {
+                t_ns: x.time_ns,
+                ref_ns: x.edge_ns,
+                signal: k as u32,
+                level: u32::from(x.on),
+                flags: if ts { SIGNAL_TIMESTAMPED } else { 0 }
+                    | if x.late { SIGNAL_LATE } else { 0 },
+                reserved: 0,
+            };
+            failed += u64::from(port.send_copy(ev).is_err());
+        });
+        failed
     }
 
     /// Hands the axes' changed retained data (absolute encoder adjustments) to the recorder,

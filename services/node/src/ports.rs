@@ -8,7 +8,9 @@ use iceoryx2::prelude::ipc::Service;
 use tandem_config::{Cell, Coupling, Leader};
 use tandem_protocol::ipc::{self, IpcError, IpcNode, IpcOp};
 use tandem_protocol::names;
-use tandem_protocol::wire::{AxisTelemetry, Event, IoEvent, LeadingValueSample, NodeHealth};
+use tandem_protocol::wire::{
+    AxisTelemetry, Event, IoEvent, LeadingValueSample, NodeHealth, SignalEvent,
+};
 
 /// A publisher of an object's output edges or measured values.
 pub(crate) type IoPublisher = Publisher<Service, IoEvent, ()>;
@@ -55,6 +57,8 @@ pub(crate) struct Ports {
     /// Per output cam, cam track and measuring input of the cell (in that order): its edges or
     /// measured values, `None` for those of other nodes.
     pub(crate) io: Vec<Option<IoPublisher>>,
+    /// The edges of the node's signals (inputs and outputs), if it has any.
+    pub(crate) signals: Option<Publisher<Service, SignalEvent, ()>>,
     /// The node's iceoryx2 node.
     _node: IpcNode,
 }
@@ -112,6 +116,17 @@ impl Ports {
         let svc = opened(ipc::events(&iox, &cell.name, &me.name), port)?;
         let events = created(svc.publisher_builder().max_loaned_samples(4).create(), port)?;
         let io = Self::io(&iox, cell, n)?;
+        let has_signals = cell
+            .signals
+            .iter()
+            .any(|s| cell.devices.get(s.device.0).is_some_and(|d| d.node == n));
+        let signals = if has_signals {
+            let port = "signal publisher";
+            let svc = opened(ipc::signals(&iox, &cell.name, &me.name), port)?;
+            Some(created(svc.publisher_builder().create(), port)?)
+        } else {
+            None
+        };
         Ok(Self {
             leaders_out,
             leaders_in,
@@ -119,6 +134,7 @@ impl Ports {
             telemetry,
             events,
             io,
+            signals,
             _node: iox,
         })
     }

@@ -145,6 +145,8 @@ pub enum DeviceKind {
     SimDigitalOutput(DigitalOutputParams),
     /// A simulated analog drive with its load encoder (`kind = "sim_analog_drive"`).
     SimAnalogDrive(tandem_motion::plant::analog::SimAnalogParams),
+    /// A simulated digital input terminal (`kind = "sim_digital_input"`).
+    SimDigitalInput(DigitalInputParams),
 }
 
 impl DeviceKind {
@@ -154,8 +156,34 @@ impl DeviceKind {
             DeviceKind::SimServo(_) => "sim_servo",
             DeviceKind::SimDigitalOutput(_) => "sim_digital_output",
             DeviceKind::SimAnalogDrive(_) => "sim_analog_drive",
+            DeviceKind::SimDigitalInput(_) => "sim_digital_input",
         }
     }
+
+    /// The channels of a device with channels (digital inputs and outputs): their number,
+    /// whether they are timestamped, and whether they are inputs.
+    pub fn channels(&self) -> Option<(u8, bool, SignalDirection)> {
+        match self {
+            DeviceKind::SimServo(_) | DeviceKind::SimAnalogDrive(_) => None,
+            DeviceKind::SimDigitalOutput(p) => {
+                Some((p.channels, p.timestamped, SignalDirection::Output))
+            }
+            DeviceKind::SimDigitalInput(p) => {
+                Some((p.channels, p.timestamped, SignalDirection::Input))
+            }
+        }
+    }
+}
+
+/// A simulated digital input terminal: `channels` inputs, sampled at the cycle boundary, each
+/// edge with its time to the ns (`timestamped`, like an EL1252 of the EtherCAT terminal range,
+/// its latched `LatchPos`/`LatchNeg` times) or seen at the boundary only (like an EL1008).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct DigitalInputParams {
+    /// Number of channels, 1 to [`MAX_CHANNELS`].
+    pub channels: u8,
+    /// Each edge is reported with its time (ns); otherwise the level at the boundary.
+    pub timestamped: bool,
 }
 
 /// Most channels of a digital output device.
@@ -176,13 +204,67 @@ pub struct DigitalOutputParams {
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SignalIndex(pub usize);
 
-/// The type of a signal, given by its channel.
+/// The type of a signal, given by its channel. A digital channel gives `Bool` or
+/// `TimestampedBool`; an analog channel (a device kind not built yet) would add its value
+/// types here (inferred: `Integer` for a raw word, `Float` in units), bound and observed the
+/// same way.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum SignalType {
-    /// A digital output switched at the cycle boundary.
+    /// A digital input sampled at, or output switched at, the cycle boundary.
     Bool,
-    /// A digital output switched at a given time (the edge time goes with it).
+    /// A digital input whose edges carry their time, or an output switched at a given time
+    /// (the edge time goes with it).
     TimestampedBool,
+}
+
+/// Whether a signal is an input or an output of the process image (its device says).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum SignalDirection {
+    /// Read by the node (a channel of a `sim_digital_input`).
+    Input,
+    /// Written by the node (a channel of a `sim_digital_output`).
+    Output,
+}
+
+impl SignalDirection {
+    /// `an input` or `an output`, for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            SignalDirection::Input => "an input",
+            SignalDirection::Output => "an output",
+        }
+    }
+}
+
+/// The input signals bound to an axis's switches (`[axes.<name>.inputs]`), for an axis on the
+/// simulated drive (a CiA 402 drive gives them in 0x60FD).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct AxisInputs {
+    /// `limit_positive`: the positive hardware limit switch (`PositionLimits_HW.MaxSwitch`).
+    pub limit_positive: Option<SignalIndex>,
+    /// `limit_negative`: the negative hardware limit switch (`PositionLimits_HW.MinSwitch`).
+    pub limit_negative: Option<SignalIndex>,
+    /// `reference_cam`: the homing switch (`Homing.DigitalInput`).
+    pub reference_cam: Option<SignalIndex>,
+}
+
+impl AxisInputs {
+    /// Whether any switch is bound.
+    pub fn any(&self) -> bool {
+        self.limit_positive.is_some()
+            || self.limit_negative.is_some()
+            || self.reference_cam.is_some()
+    }
+}
+
+/// What the input signals feed: axes' switches and measuring inputs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InputBindings {
+    /// Per axis of [`Cell::axes`]: the signals of its switches.
+    pub axes: Vec<AxisInputs>,
+    /// Per measuring input of [`Cell::measuring_inputs`]: the timestamped input signal that
+    /// gives its edges (`input = "<signal>"`, route `timer_di`).
+    pub measuring_inputs: Vec<Option<SignalIndex>>,
 }
 
 /// A named signal of the cell (`[signals.<name>]`), bound to one channel of one device.
@@ -196,6 +278,10 @@ pub struct SignalEntry {
     pub channel: u8,
     /// Its type, from the channel.
     pub signal_type: SignalType,
+    /// Input or output, from the device.
+    pub direction: SignalDirection,
+    /// An input's simulated sensor (`[signals.<name>.sensor]`): a mark on an axis's load.
+    pub sensor: Option<SensorEntry>,
 }
 
 /// How an axis reaches its drive (`[axes.<name>.drive] type`).
@@ -459,6 +545,8 @@ pub struct Cell {
     pub devices: Vec<DeviceEntry>,
     /// The named signals, in name order.
     pub signals: Vec<SignalEntry>,
+    /// What the input signals feed.
+    pub inputs: InputBindings,
 }
 
 impl Cell {

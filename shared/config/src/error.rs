@@ -236,6 +236,34 @@ pub enum Problem {
         /// The object that drives it.
         by: String,
     },
+    /// An input signal where an output is needed, or an output where an input is.
+    SignalDirection {
+        /// The signal.
+        signal: String,
+        /// What it is (`an input`).
+        is: &'static str,
+        /// What the key needs (`an output`).
+        needs: &'static str,
+    },
+    /// A plain input signal where a timestamped one is needed.
+    SignalType {
+        /// The signal.
+        signal: String,
+        /// What the key needs.
+        needs: &'static str,
+    },
+    /// An input signal already bound to another role.
+    InputBound {
+        /// The signal.
+        signal: String,
+        /// The key that binds it already.
+        by: String,
+    },
+    /// A key that conflicts with another that gives the same thing.
+    Conflict {
+        /// What the other key is and says.
+        other: String,
+    },
 }
 
 /// A leading-value delay shorter than the link from a leader to a follower on another node
@@ -375,6 +403,16 @@ impl fmt::Display for Problem {
             Problem::SignalDriven { signal, by } => {
                 write!(f, "signal `{signal}` is already driven by `{by}`")
             }
+            Problem::SignalDirection { signal, is, needs } => {
+                write!(f, "signal `{signal}` is {is}; this needs {needs}")
+            }
+            Problem::SignalType { signal, needs } => {
+                write!(f, "signal `{signal}` is a plain `bool`; this needs {needs}")
+            }
+            Problem::InputBound { signal, by } => {
+                write!(f, "input signal `{signal}` is already bound to `{by}`")
+            }
+            Problem::Conflict { other } => write!(f, "conflicts with {other}"),
             Problem::Mechanics(e) => write!(f, "{e}"),
             Problem::Servo(e) => write!(f, "{e}"),
             Problem::Syntax(m) => f.write_str(m),

@@ -53,11 +53,12 @@ mod schema;
 pub mod script;
 
 pub use cell::{
-    AnalogDriveConnection, AxisEntry, AxisIndex, CamEntry, CamTrackEntry, Cell, Cia402Connection,
-    Coupling, DeviceEntry, DeviceIndex, DeviceKind, DigitalOutputParams, DriveConnection,
-    EncoderEntry, EncoderIndex, EncoderSource, Leader, LeadingValueConfig, MeasuringInputEntry,
-    Node, OutputCamEntry, Realtime, Registration, SensorEntry, SignalEntry, SignalIndex,
-    SignalType, LEADING_BUFFER, MAX_CHANNELS,
+    AnalogDriveConnection, AxisEntry, AxisIndex, AxisInputs, CamEntry, CamTrackEntry, Cell,
+    Cia402Connection, Coupling, DeviceEntry, DeviceIndex, DeviceKind, DigitalInputParams,
+    DigitalOutputParams, DriveConnection, EncoderEntry, EncoderIndex, EncoderSource, InputBindings,
+    Leader, LeadingValueConfig, MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration,
+    SensorEntry, SignalDirection, SignalEntry, SignalIndex, SignalType, LEADING_BUFFER,
+    MAX_CHANNELS,
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};

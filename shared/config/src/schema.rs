@@ -51,7 +51,8 @@ pub struct DeviceSection {
     pub node: String,
     /// `sim_servo`: a simulated CiA 402 servo drive; `sim_analog_drive`: a simulated drive with
     /// a ±10 V speed setpoint, enable input, ready output and a load encoder;
-    /// `sim_digital_output`: a simulated digital output terminal.
+    /// `sim_digital_output`: a simulated digital output terminal; `sim_digital_input`: a
+    /// simulated digital input terminal.
     pub kind: String,
     /// sim_servo: increments per motor revolution of its position actual value (0x6064).
     pub increments_per_revolution: Option<u32>,
@@ -93,10 +94,12 @@ pub struct DeviceSection {
     pub ready_delay: Option<f64>,
     /// sim_analog_drive: offset of its analog input (V, -10 to 10, default 0).
     pub offset: Option<f64>,
-    /// sim_digital_output: the number of channels, 1 to 32 (required).
+    /// sim_digital_output, sim_digital_input: the number of channels, 1 to 32 (required).
     pub channels: Option<u32>,
     /// sim_digital_output: `true` switches each channel at a given time (a timestamped output
     /// like an EL2252, one switching event per cycle); `false` (default) at the cycle boundary.
+    /// sim_digital_input: `true` reports each edge with its time (like an EL1252); `false`
+    /// (default) the level at the cycle boundary.
     pub timestamped: Option<bool>,
 }
 
@@ -109,6 +112,22 @@ pub struct SignalSection {
     pub device: String,
     /// The channel, 1-based.
     pub channel: u32,
+    /// `[signals.<name>.sensor]`: an input's simulated sensor, a mark on an axis's load
+    /// (`axis` required).
+    pub sensor: Option<SensorSection>,
+}
+
+/// `[axes.<name>.inputs]`: input signals (`[signals.<name>]`) as the axis's switches, for an
+/// axis on the simulated drive.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisInputsSection {
+    /// The positive hardware limit switch (`PositionLimits_HW.MaxSwitch`).
+    pub limit_positive: Option<String>,
+    /// The negative hardware limit switch (`PositionLimits_HW.MinSwitch`).
+    pub limit_negative: Option<String>,
+    /// The reference cam (homing switch).
+    pub reference_cam: Option<String>,
 }
 
 /// `encoder`: the encoder type alone (`encoder = "absolute"`), or the table
@@ -385,6 +404,9 @@ pub struct MeasuringInputSection {
     pub apply_activation_time: bool,
     /// `[measuring_inputs.sensor]`: a simulated sensor.
     pub sensor: Option<SensorSection>,
+    /// A timestamped input signal (`[signals.<name>]`) whose edges the input measures (route
+    /// `timer_di`).
+    pub input: Option<String>,
     /// `[measuring_inputs.registration]`: register correction from each new measured value.
     pub registration: Option<RegistrationSection>,
 }
@@ -661,6 +683,8 @@ pub struct AxisSection {
     pub sw_limits: Option<SwLimitsSection>,
     /// `[axes.<name>.hw_limits]`.
     pub hw_limits: Option<HwLimitsSection>,
+    /// `[axes.<name>.inputs]`: input signals as the limit switches and reference cam.
+    pub inputs: Option<AxisInputsSection>,
     /// `[axes.<name>.positioning]`.
     #[serde(default)]
     pub positioning: PositioningSection,

@@ -22,6 +22,10 @@
 //! A simulated drive (`[devices.<name>]`) takes `DriveFault` (`code`): a fault with that CiA 402
 //! error code (0x603F, e.g. `code = 0x2310`) from the entry's `t`, or with `code = 0` its cause
 //! removed (a fault reset then succeeds).
+//! A simulated input signal (`[signals.<name>]` on a `sim_digital_input`) takes `SetInput`
+//! (`value`, default `true`; `pulse`, s, default 0): the input's level from the entry's `t`
+//! exactly, and with `pulse > 0` back to `!value` that long after (a timestamped input reports
+//! both edges at those times).
 //! Use [`parse_cell`] to address them.
 
 use crate::command::{self, CommandError, Expected, Value};
@@ -39,6 +43,8 @@ pub struct ObjectNames<'a> {
     pub measuring_inputs: Vec<&'a str>,
     /// `[devices.<name>]`.
     pub devices: Vec<&'a str>,
+    /// The input signals (`[signals.<name>]` on a `sim_digital_input`).
+    pub input_signals: Vec<&'a str>,
 }
 
 /// One timed command.
@@ -99,13 +105,19 @@ pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, C
             .map(|c| c.name.as_str())
             .collect(),
         devices: cell.devices.iter().map(|d| d.name.as_str()).collect(),
+        input_signals: cell
+            .signals
+            .iter()
+            .filter(|x| x.direction == crate::cell::SignalDirection::Input)
+            .map(|x| x.name.as_str())
+            .collect(),
     };
     parse_with(file, src, &names, &cams, &objects)
 }
 
 /// The instructions of output cams, cam tracks, measuring inputs and simulated devices: name,
-/// the kind of object it addresses (0 output cam, 1 cam track, 2 measuring input, 3 device) and
-/// parameters with defaults.
+/// the kind of object it addresses (0 output cam, 1 cam track, 2 measuring input, 3 device,
+/// 4 input signal) and parameters with defaults.
 type ObjectInstruction = (&'static str, u8, &'static [(&'static str, Value)]);
 
 const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
@@ -153,6 +165,11 @@ const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
     ("MC_AbortMeasuringInput", 2, &[]),
     ("InputEdge", 2, &[("rising", Value::Bool(true))]),
     ("DriveFault", 3, &[("code", Value::Num(0.0))]),
+    (
+        "SetInput",
+        4,
+        &[("value", Value::Bool(true)), ("pulse", Value::Num(0.0))],
+    ),
 ];
 
 /// An entry for an output cam, cam track or measuring input.
@@ -221,6 +238,13 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
                 code: u16::try_from(c).map_err(|_| wrong("code", Expected::Integer))?,
             }
         }
+        "SetInput" => Action::SetInput {
+            value: b(0),
+            pulse_ns: Some(x(1))
+                .filter(|p| (0.0..=3600.0).contains(p))
+                .and_then(seconds_to_ns)
+                .ok_or(wrong("pulse", Expected::Number))?,
+        },
         _ => Action::InputEdge { rising: b(0) },
     })
 }
@@ -352,7 +376,8 @@ fn object_instruction<'t>(
         0 => (&objects.output_cams, "output cam"),
         1 => (&objects.cam_tracks, "cam track"),
         2 => (&objects.measuring_inputs, "measuring input"),
-        _ => (&objects.devices, "device"),
+        3 => (&objects.devices, "device"),
+        _ => (&objects.input_signals, "input signal"),
     };
     if !list.contains(&target) {
         return Err(CommandError::UnknownObject {

@@ -7,6 +7,7 @@
 use crate::names;
 use crate::wire::{
     AxisTelemetry, CommandReply, CommandRequest, Event, IoEvent, LeadingValueSample, NodeHealth,
+    SignalEvent,
 };
 use core::fmt;
 use iceoryx2::prelude::*;
@@ -22,6 +23,8 @@ pub type TelemetryService =
     publish_subscribe::PortFactory<ipc::Service, [AxisTelemetry], NodeHealth>;
 /// A node's event service.
 pub type EventService = publish_subscribe::PortFactory<ipc::Service, Event, ()>;
+/// A node's signal edges.
+pub type SignalService = publish_subscribe::PortFactory<ipc::Service, SignalEvent, ()>;
 /// An object's output edges or measured values.
 pub type IoService = publish_subscribe::PortFactory<ipc::Service, IoEvent, ()>;
 /// A node's command service.
@@ -200,6 +203,11 @@ pub fn telemetry(
 /// The job events and log lines of `node_name`.
 pub fn events(node: &IpcNode, cell: &str, node_name: &str) -> Result<EventService, IpcError> {
     pubsub(node, &names::events(cell, node_name), 0, 1024)
+}
+
+/// The edges of `node_name`'s signals (inputs and outputs of its process image).
+pub fn signals(node: &IpcNode, cell: &str, node_name: &str) -> Result<SignalService, IpcError> {
+    pubsub(node, &names::signals(cell, node_name), 0, 1024)
 }
 
 /// The output edges or measured values of object `object`.

@@ -59,6 +59,17 @@ pub fn parse_command<'a>(cell: &str, key: &'a str) -> Option<(&'a str, &'a str)>
     (!object.contains('/')).then_some((node, object))
 }
 
+/// Each edge of signal `signal` (an input or output of `node`'s process image), as JSON, as it
+/// happens.
+pub fn signal(cell: &str, node: &str, signal: &str) -> String {
+    format!("tandem/{cell}/{node}/{signal}/signal")
+}
+
+/// Every signal of the cell.
+pub fn signals(cell: &str) -> String {
+    format!("tandem/{cell}/*/*/signal")
+}
+
 /// A node's health (cycle, compute, lateness, overruns), as JSON.
 pub fn health(cell: &str, node: &str) -> String {
     format!("tandem/{cell}/{node}/health")

@@ -32,6 +32,11 @@ pub fn events(cell: &str, node: &str) -> String {
     format!("tandem/{cell}/node/{node}/events")
 }
 
+/// Publish-subscribe: every edge of `node`'s signals, inputs and outputs of its process image.
+pub fn signals(cell: &str, node: &str) -> String {
+    format!("tandem/{cell}/node/{node}/signals")
+}
+
 /// Publish-subscribe: the switching edges of an output cam or cam track, or the measured
 /// values of a measuring input, named `object`.
 pub fn io(cell: &str, object: &str) -> String {

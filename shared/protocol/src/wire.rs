@@ -375,3 +375,32 @@ pub struct IoEvent {
     /// 1/0 for an output, the position for a measured value.
     pub value: f64,
 }
+
+/// [`SignalEvent::flags`]: the signal is an input (else an output).
+pub const SIGNAL_INPUT: u32 = 1;
+/// The signal's channel is timestamped: `t_ns` is the edge's own time.
+pub const SIGNAL_TIMESTAMPED: u32 = 2;
+/// An output switched later than its channel could (see the output stage).
+pub const SIGNAL_LATE: u32 = 4;
+
+/// One edge of a signal of a node's process image (docs/io.md, "Input signals" and
+/// "Outputs").
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
+#[type_name("tandem.SignalEvent.v1")]
+#[repr(C)]
+pub struct SignalEvent {
+    /// The instant the signal changed (ns, cell clock): an input's edge time (its own on a
+    /// timestamped input, the sampling boundary on a plain one); the instant an output switched.
+    pub t_ns: i64,
+    /// An input: the boundary whose sample carried the edge; an output: the edge time the
+    /// output cam or cam track computed (before the look-ahead).
+    pub ref_ns: i64,
+    /// The signal's index in the cell (`[signals.<name>]` in name order).
+    pub signal: u32,
+    /// The new level: 1 on, 0 off.
+    pub level: u32,
+    /// `SIGNAL_*` bits.
+    pub flags: u32,
+    /// Reserved (0).
+    pub reserved: u32,
+}

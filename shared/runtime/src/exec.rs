@@ -16,10 +16,12 @@ mod retain;
 
 use crate::drives::Drives;
 use crate::error::ExecError;
+pub use crate::inputs::{InputDeviceStatus, InputSignalEdge, INPUT_EDGES};
 pub use crate::notes::{seconds, Describe, IoNote, JobNote, Secs, NOTES};
 pub use crate::outputs::{OutputDeviceStatus, OutputSwitch, LOOK_AHEAD_CYCLES, SWITCHES};
 pub use retain::{AdjustmentChange, RestoreError, Restored};
 
+use crate::inputs::Inputs;
 use crate::notes::keep;
 use crate::objects::{cycle_motion, CycleMotion, Objects};
 use crate::outputs::Outputs;
@@ -484,6 +486,8 @@ pub struct Executive<'c> {
     drives: Drives,
     /// The digital outputs of the process image and the objects driving them.
     outputs: Outputs,
+    /// The digital inputs of the process image, their stimuli and sensors.
+    inputs: Inputs,
 }
 
 impl<'c> Executive<'c> {
@@ -502,7 +506,14 @@ impl<'c> Executive<'c> {
             .iter()
             .map(|a| cell.nodes[a.node].cycle_ns)
             .collect();
-        let (has_objects, needs_motion) = axes_with_objects(cell, &owned);
+        let inputs = Inputs::new(cell, node, &owned.axes);
+        let (has_objects, mut needs_motion) = axes_with_objects(cell, &owned);
+        // An input signal's sensor sees the motion of the axis that carries its mark.
+        for a in inputs.sensor_axes() {
+            if let (Some(n), true) = (needs_motion.get_mut(a), owned.axes.get(a) == Some(&true)) {
+                *n = true;
+            }
+        }
         let buffers = leader_buffers(cell, &owned);
         let object_axes = (0..needs_motion.len())
             .filter(|&i| owned.axes[i] && (has_objects[i] || needs_motion[i]))
@@ -524,6 +535,7 @@ impl<'c> Executive<'c> {
         Ok(Self {
             drives,
             outputs: Outputs::new(cell, node),
+            inputs,
             cell,
             objects: Objects::new(cell)?,
             owned,
@@ -747,6 +759,10 @@ impl<'c> Executive<'c> {
             Action::InterpolateCam { cam, from } => {
                 return interpolate_cam(cell, &mut self.cams, cam, from).map(|()| None);
             }
+            Action::SetInput { value, pulse_ns } => {
+                let k = cell.signal(target).ok_or(ErrorId::IllegalObject)?;
+                return self.inputs.set(k.0, t, value, pulse_ns).map(|()| None);
+            }
             Action::DriveFault { code } => {
                 let d = cell.devices.iter().position(|d| d.name == target);
                 let Some(d) = d.filter(|&d| self.drives.runs(d)) else {
@@ -907,6 +923,9 @@ impl<'c> Executive<'c> {
     pub fn step(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         self.step_encoders(t, log)?;
         self.record_samples(t, true);
+        if self.inputs.any() {
+            self.input_sample(t);
+        }
         if self.drives.any() {
             self.drive_inputs(t);
         }
@@ -920,6 +939,43 @@ impl<'c> Executive<'c> {
         self.step_objects(t, log)?;
         self.outputs.step(t, &mut self.objects.out.output_edges);
         self.register_corrections(t, log)
+    }
+
+    /// The process image's digital inputs at the boundary `t`: the devices due are sampled
+    /// and the axes on the simulated drive take their bound switches (the order in
+    /// [`crate::inputs`]).
+    fn input_sample(&mut self, t: i64) {
+        self.inputs.sample(t);
+        for k in 0..self.inputs.axes.len() {
+            let (a, bound) = self.inputs.axes[k];
+            let switches = self.inputs.switches(&bound);
+            if let Some(axis) = self.axes.get_mut(a) {
+                axis.set_switch_inputs(switches);
+            }
+        }
+    }
+
+    /// Once the cycle motions are known: the input signals' sensors add their edges to the
+    /// frame of `t`, each measuring input fed by a signal takes that signal's edges, and every
+    /// edge of the frame is logged with its time.
+    fn input_sense(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        self.inputs.sense(t, &self.motions);
+        for k in 0..self.inputs.measuring.len() {
+            let (m, signal) = self.inputs.measuring[k];
+            for e in self.inputs.edges_of(signal) {
+                self.objects.push_edge(m, e);
+            }
+        }
+        for e in self.inputs.frame() {
+            let name = self
+                .cell
+                .signals
+                .get(e.signal)
+                .map_or("?", |s| s.name.as_str());
+            let level = if e.rising { "ON" } else { "OFF" };
+            writeln!(log, "t={} {name} input {level}", Secs(e.time_ns))?;
+        }
+        Ok(())
     }
 
     /// The process image's drives at the boundary `t`: the devices run to `t` and are
@@ -997,6 +1053,31 @@ impl<'c> Executive<'c> {
     /// counters.
     pub fn output_device(&self, device: usize) -> Option<&OutputDeviceStatus> {
         self.outputs.status(device)
+    }
+
+    /// The state of simulated digital input device `device` (index in [`Cell::devices`]), if
+    /// this executive runs it: its channels' levels and counters.
+    pub fn input_device(&self, device: usize) -> Option<&InputDeviceStatus> {
+        self.inputs.status(device)
+    }
+
+    /// The level of signal `signal` (an input at its last sample, an output as last
+    /// switched), if its device is in this executive.
+    pub fn signal_level(&self, signal: tandem_config::SignalIndex) -> Option<bool> {
+        let s = self.cell.signals.get(signal.0)?;
+        match s.direction {
+            tandem_config::SignalDirection::Input => self.inputs.level(signal.0),
+            tandem_config::SignalDirection::Output => {
+                let levels = self.outputs.status(s.device.0)?.levels;
+                Some(levels & (1u32 << (s.channel.saturating_sub(1) & 31)) != 0)
+            }
+        }
+    }
+
+    /// Hands each edge of an input signal since the last call to `f` (what the process image
+    /// sampled, in order of the boundaries that sampled them), then forgets them.
+    pub fn drain_input_edges(&mut self, f: impl FnMut(&InputSignalEdge)) {
+        self.inputs.drain(f);
     }
 
     /// Hands each switch of an output device's channel since the last call to `f` (what the
@@ -1206,6 +1287,9 @@ impl<'c> Executive<'c> {
                     self.objects.homing[i],
                 )
             });
+        }
+        if self.inputs.any() {
+            self.input_sense(t, log)?;
         }
         for k in 0..self.object_axes.len() {
             let i = AxisIndex(self.object_axes[k]);

@@ -53,6 +53,7 @@
 pub mod drives;
 mod error;
 pub mod exec;
+mod inputs;
 mod notes;
 mod objects;
 mod outputs;

@@ -652,7 +652,7 @@ impl Objects {
         action: Action,
     ) -> Result<(), ErrorId> {
         match action {
-            Action::DriveFault { .. } => Err(ErrorId::IllegalObject),
+            Action::DriveFault { .. } | Action::SetInput { .. } => Err(ErrorId::IllegalObject),
             Action::OutputCam {
                 enable,
                 on_position,

@@ -27,6 +27,7 @@ const EXAMPLES: &[&str] = &[
     "press",
     "servo",
     "analog",
+    "inputs",
 ];
 
 fn root() -> PathBuf {

@@ -6,7 +6,7 @@
 use super::{node_named, pick, Ctx};
 use crate::cell::{
     AnalogDriveConnection, AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind,
-    DigitalOutputParams, DriveConnection, Node, MAX_CHANNELS,
+    DigitalInputParams, DigitalOutputParams, DriveConnection, Node, MAX_CHANNELS,
 };
 use crate::error::{ConfigError, Problem};
 use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
@@ -25,13 +25,15 @@ enum Kind {
     Servo,
     DigitalOutput,
     Analog,
+    DigitalInput,
 }
 
 /// The device kinds by name.
-const DEVICE_KINDS: [(&str, Kind); 3] = [
+const DEVICE_KINDS: [(&str, Kind); 4] = [
     ("sim_servo", Kind::Servo),
     ("sim_digital_output", Kind::DigitalOutput),
     ("sim_analog_drive", Kind::Analog),
+    ("sim_digital_input", Kind::DigitalInput),
 ];
 
 /// How an axis reaches its drive (`[axes.<name>.drive] type`).
@@ -99,6 +101,18 @@ pub(super) fn devices(
                     )
                 })?;
                 DeviceKind::SimAnalogDrive(params)
+            }
+            Kind::DigitalInput => {
+                if let Some(k) = servo_key_given(d).or_else(|| analog_key_given(d)) {
+                    return Err(at(k, Problem::NotForKind("sim_digital_input")));
+                }
+                // The same keys as an output terminal: `channels` and `timestamped`.
+                let p =
+                    output_params(d).map_err(|(k, p)| cx.at_or_table(&["devices", name, k], p))?;
+                DeviceKind::SimDigitalInput(DigitalInputParams {
+                    channels: p.channels,
+                    timestamped: p.timestamped,
+                })
             }
         };
         out.push(DeviceEntry {
@@ -338,8 +352,8 @@ pub(super) fn drives(
                         .then_some(inertia),
                 }))
             }
-            // Refused by `bound_device`.
-            DeviceKind::SimDigitalOutput(_) => continue,
+            // Refused by `Bound::device` (not a drive).
+            DeviceKind::SimDigitalOutput(_) | DeviceKind::SimDigitalInput(_) => continue,
         };
     }
     Ok(())

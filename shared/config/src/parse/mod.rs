@@ -168,7 +168,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     let mut encoders = encoder::encoders(cx, &raw, &axes, &nodes)?;
     let cams = cam::cams(cx, &raw, dir)?;
     leading_values(cx, &raw, &mut axes, &mut encoders, &nodes)?;
-    let signals = signal::signals(cx, &raw, &devices)?;
+    let signals = signal::signals(cx, &raw, &devices, &axes)?;
     let mut objects = objects::objects(cx, &raw, &axes, &nodes)?;
     let bindings = signal::Bindings {
         nodes: &nodes,
@@ -183,6 +183,8 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         &mut objects.output_cams,
         &mut objects.cam_tracks,
     )?;
+    let inputs = signal::inputs(cx, &raw, &bindings, &objects.measuring_inputs)?;
+    signal::activate_limits(&raw, &inputs, &mut axes);
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: raw.cell.base_tick_us as i64 * 1000,
@@ -208,6 +210,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         measuring_inputs: objects.measuring_inputs,
         devices,
         signals,
+        inputs,
     })
 }
 

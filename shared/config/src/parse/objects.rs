@@ -377,34 +377,7 @@ fn sensor(
 ) -> Result<SensorEntry, ConfigError> {
     let a = "measuring_inputs";
     let f = s.field(a, i);
-    if !(x.position.is_finite() && x.position.abs() <= 1e12) {
-        return Err(f((
-            "sensor.position",
-            Problem::Invalid("must be within ±1e12"),
-        )));
-    }
-    if !(x.width.is_finite() && x.width > 0.0) {
-        return Err(f((
-            "sensor.width",
-            Problem::Invalid("must be a positive number"),
-        )));
-    }
-    if !(x.dead_time.is_finite() && (0.0..=1.0).contains(&x.dead_time)) {
-        return Err(f(("sensor.dead_time", Problem::Invalid("must be 0..1 s"))));
-    }
-    if !(x.jitter.is_finite() && (0.0..=1.0).contains(&x.jitter)) {
-        return Err(f(("sensor.jitter", Problem::Invalid("must be 0..1 s"))));
-    }
-    let direction = pick(
-        "sensor.direction",
-        &x.direction,
-        &[
-            ("positive", SensorDirection::Positive),
-            ("negative", SensorDirection::Negative),
-            ("both", SensorDirection::Both),
-        ],
-    )
-    .map_err(&f)?;
+    let mark = mark(x, axis).map_err(&f)?;
     let carrier = match &x.axis {
         None => axis,
         Some(n) => {
@@ -419,6 +392,42 @@ fn sensor(
             j
         }
     };
+    Ok(SensorEntry {
+        axis: carrier,
+        ..mark
+    })
+}
+
+/// The mark of a simulated sensor on `carrier`, its numbers checked; an error names the key
+/// under the table that holds `sensor`.
+pub(super) fn mark(
+    x: &SensorSection,
+    carrier: AxisIndex,
+) -> Result<SensorEntry, super::FieldError> {
+    if !(x.position.is_finite() && x.position.abs() <= 1e12) {
+        return Err(("sensor.position", Problem::Invalid("must be within ±1e12")));
+    }
+    if !(x.width.is_finite() && x.width > 0.0) {
+        return Err((
+            "sensor.width",
+            Problem::Invalid("must be a positive number"),
+        ));
+    }
+    if !(x.dead_time.is_finite() && (0.0..=1.0).contains(&x.dead_time)) {
+        return Err(("sensor.dead_time", Problem::Invalid("must be 0..1 s")));
+    }
+    if !(x.jitter.is_finite() && (0.0..=1.0).contains(&x.jitter)) {
+        return Err(("sensor.jitter", Problem::Invalid("must be 0..1 s")));
+    }
+    let direction = pick(
+        "sensor.direction",
+        &x.direction,
+        &[
+            ("positive", SensorDirection::Positive),
+            ("negative", SensorDirection::Negative),
+            ("both", SensorDirection::Both),
+        ],
+    )?;
     Ok(SensorEntry {
         axis: carrier,
         position: x.position,

@@ -1,25 +1,33 @@
-//! `[signals.<name>]` and the `output` of `[[output_cams]]` and `[[cam_tracks]]`: which channel
-//! of which device each named signal is, and which object drives it.
+//! `[signals.<name>]`, the `output` of `[[output_cams]]` and `[[cam_tracks]]`, the `input` of
+//! `[[measuring_inputs]]` and `[axes.<name>.inputs]`: which channel of which device each named
+//! signal is, which object drives an output, and what an input feeds.
 //!
 //! Bindings refused, each naming the key: an unknown device or a device without channels
 //! (`signals.<name>.device`), a channel the device does not have or one already bound to
-//! another signal (`signals.<name>.channel`), an unknown signal, a signal of another node than
-//! the object's axis, or a signal another object already drives (`<array>[i].output`).
+//! another signal (`signals.<name>.channel`), a sensor on an output or on an axis of another
+//! node (`signals.<name>.sensor`), an unknown signal, a signal of another node than the
+//! object's axis, an input where an output is needed or the reverse, a signal another object
+//! already drives (`<array>[i].output`), a plain input for a measuring input, an input bound
+//! twice (`measuring_inputs[i].input`, `axes.<name>.inputs.<switch>`), and a switch given both
+//! as a signal and as a simulated position (`axes.<name>.hw_limits.max`, ...).
 
 use super::Ctx;
 use crate::cell::{
-    AxisEntry, CamTrackEntry, DeviceEntry, DeviceIndex, DeviceKind, Node, OutputCamEntry,
-    SignalEntry, SignalIndex, SignalType,
+    AxisEntry, AxisIndex, AxisInputs, CamTrackEntry, DeviceEntry, DeviceIndex, DriveConnection,
+    InputBindings, MeasuringInputEntry, Node, OutputCamEntry, SignalDirection, SignalEntry,
+    SignalIndex, SignalType,
 };
 use crate::error::{ConfigError, Problem};
-use crate::schema::CellFile;
+use crate::schema::{CellFile, SensorSection};
+use tandem_motion::objects::measuring::MeasuringRoute;
 
-/// `[signals.<name>]`: each signal on an existing channel of a digital output device, one
-/// signal per channel.
+/// `[signals.<name>]`: each signal on an existing channel of a digital input or output device,
+/// one signal per channel; an input may have a simulated sensor on an axis of its node.
 pub(super) fn signals(
     cx: Ctx<'_>,
     raw: &CellFile,
     devices: &[DeviceEntry],
+    axes: &[AxisEntry],
 ) -> Result<Vec<SignalEntry>, ConfigError> {
     let mut out: Vec<SignalEntry> = Vec::new();
     for (name, s) in &raw.signals {
@@ -39,22 +47,22 @@ pub(super) fn signals(
                 )
             })?;
         let dev = &devices[k];
-        let DeviceKind::SimDigitalOutput(p) = &dev.kind else {
+        let Some((channels, timestamped, direction)) = dev.kind.channels() else {
             let problem = Problem::DeviceKind {
                 device: dev.name.clone(),
                 kind: dev.kind.name(),
-                needs: "a device with channels (`sim_digital_output`)",
+                needs: "a device with channels (`sim_digital_output`, `sim_digital_input`)",
             };
             return Err(at("device", problem));
         };
         let channel = u8::try_from(s.channel)
             .ok()
-            .filter(|c| (1..=p.channels).contains(c))
+            .filter(|c| (1..=channels).contains(c))
             .ok_or_else(|| {
                 let problem = Problem::ChannelRange {
                     device: dev.name.clone(),
                     channel: s.channel,
-                    channels: p.channels,
+                    channels,
                 };
                 at("channel", problem)
             })?;
@@ -69,18 +77,77 @@ pub(super) fn signals(
             };
             return Err(at("channel", problem));
         }
+        let sensor = match &s.sensor {
+            None => None,
+            Some(x) => Some(sensor(cx, name, x, direction, (dev, axes))?),
+        };
         out.push(SignalEntry {
             name: name.clone(),
             device: DeviceIndex(k),
             channel,
-            signal_type: if p.timestamped {
+            signal_type: if timestamped {
                 SignalType::TimestampedBool
             } else {
                 SignalType::Bool
             },
+            direction,
+            sensor,
         });
     }
     Ok(out)
+}
+
+/// `[signals.<name>.sensor]`: a mark on an axis of the node of the input's device `dev`.
+fn sensor(
+    cx: Ctx<'_>,
+    name: &str,
+    x: &SensorSection,
+    direction: SignalDirection,
+    (dev, axes): (&DeviceEntry, &[AxisEntry]),
+) -> Result<crate::cell::SensorEntry, ConfigError> {
+    let at = |k: &str, p| cx.at_or_table(&["signals", name, "sensor", k], p);
+    if direction == SignalDirection::Output {
+        return Err(cx.at(
+            &["signals", name, "sensor"],
+            Problem::SignalDirection {
+                signal: name.into(),
+                is: direction.name(),
+                needs: "an input to carry a simulated sensor",
+            },
+        ));
+    }
+    let axis_name = x.axis.as_deref().ok_or_else(|| {
+        cx.at(
+            &["signals", name, "sensor"],
+            Problem::Missing("axis (the axis whose load carries the mark)"),
+        )
+    })?;
+    let a = axes
+        .iter()
+        .position(|a| a.name == axis_name)
+        .ok_or_else(|| {
+            at(
+                "axis",
+                Problem::Unknown {
+                    what: "axis",
+                    name: axis_name.into(),
+                    known: Some(axes.iter().map(|a| a.name.clone()).collect()),
+                },
+            )
+        })?;
+    if axes[a].node != dev.node {
+        return Err(at(
+            "axis",
+            Problem::SensorNode {
+                sensor_axis: axis_name.into(),
+                axis: format!("the device `{}`", dev.name),
+            },
+        ));
+    }
+    super::objects::mark(x, AxisIndex(a)).map_err(|(k, p)| {
+        let key = k.strip_prefix("sensor.").unwrap_or(k);
+        at(key, p)
+    })
 }
 
 /// What the `output` keys are checked against.
@@ -128,6 +195,17 @@ impl Bindings<'_> {
                 object_node: node_name(node).unwrap_or_default(),
             }));
         }
+        if let Some(x) = self
+            .signals
+            .get(k)
+            .filter(|x| x.direction != SignalDirection::Output)
+        {
+            return Err(at(Problem::SignalDirection {
+                signal: name.into(),
+                is: x.direction.name(),
+                needs: "an output (a channel of a `sim_digital_output`)",
+            }));
+        }
         if let Some(Some(other)) = by.get(k) {
             return Err(at(Problem::SignalDriven {
                 signal: name.into(),
@@ -169,4 +247,190 @@ pub(super) fn outputs(
         }
     }
     Ok(())
+}
+
+/// Where an input signal is bound, for [`Bindings::input`].
+struct InputUse<'k> {
+    /// The node the consumer runs on.
+    node: usize,
+    /// The binding's key, as an error names it and a second binding quotes it.
+    key: &'k str,
+    /// The consumer needs a timestamped input (a measuring input).
+    timestamped: bool,
+}
+
+impl Bindings<'_> {
+    /// The input signal named `name` for a consumer `u`; `at` locates errors; `by[k]` names
+    /// the key already binding signal `k`.
+    fn input(
+        &self,
+        name: &str,
+        u: &InputUse<'_>,
+        at: &dyn Fn(Problem) -> ConfigError,
+        by: &mut [Option<String>],
+    ) -> Result<SignalIndex, ConfigError> {
+        let k = self
+            .signals
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| {
+                at(Problem::Unknown {
+                    what: "signal",
+                    name: name.into(),
+                    known: Some(self.signals.iter().map(|s| s.name.clone()).collect()),
+                })
+            })?;
+        let s = &self.signals[k];
+        if s.direction != SignalDirection::Input {
+            return Err(at(Problem::SignalDirection {
+                signal: name.into(),
+                is: s.direction.name(),
+                needs: "an input (a channel of a `sim_digital_input`)",
+            }));
+        }
+        if u.timestamped && s.signal_type != SignalType::TimestampedBool {
+            return Err(at(Problem::SignalType {
+                signal: name.into(),
+                needs: "a timestamped input (`timestamped = true` on its device): a measuring \
+                        input takes each edge's time",
+            }));
+        }
+        let device_node = self.devices.get(s.device.0).map_or(u.node, |d| d.node);
+        if device_node != u.node {
+            let node_name = |n: usize| self.nodes.get(n).map(|x| x.name.clone());
+            return Err(at(Problem::SignalNode {
+                signal: name.into(),
+                signal_node: node_name(device_node).unwrap_or_default(),
+                object_node: node_name(u.node).unwrap_or_default(),
+            }));
+        }
+        if let Some(Some(other)) = by.get(k) {
+            return Err(at(Problem::InputBound {
+                signal: name.into(),
+                by: other.clone(),
+            }));
+        }
+        if let Some(slot) = by.get_mut(k) {
+            *slot = Some(u.key.into());
+        }
+        Ok(SignalIndex(k))
+    }
+}
+
+/// What the input signals feed: the `input` of every measuring input (a timestamped input of
+/// its axis's node, route `timer_di`, no sensor of its own) and `[axes.<name>.inputs]` (inputs
+/// of the axis's node, on the simulated drive, each switch given once). An input signal is
+/// bound at most once. A bound limit switch activates the hardware limit monitoring
+/// (`PositionLimits_HW.Active`) unless `[axes.<name>.hw_limits] active = false`.
+pub(super) fn inputs(
+    cx: Ctx<'_>,
+    raw: &CellFile,
+    b: &Bindings<'_>,
+    measuring: &[MeasuringInputEntry],
+) -> Result<InputBindings, ConfigError> {
+    let mut by: Vec<Option<String>> = vec![None; b.signals.len()];
+    let mut out = InputBindings {
+        axes: vec![AxisInputs::default(); b.axes.len()],
+        measuring_inputs: vec![None; measuring.len()],
+    };
+    for (i, (entry, s)) in measuring.iter().zip(&raw.measuring_inputs).enumerate() {
+        let Some(name) = &s.input else {
+            continue;
+        };
+        let at = |p| cx.in_array("measuring_inputs", i, "input", p);
+        if entry.config.route != MeasuringRoute::TimerDi {
+            return Err(at(Problem::Invalid(
+                "an input signal is measured on route `timer_di` (a timestamped digital input)",
+            )));
+        }
+        if s.sensor.is_some() {
+            let other = format!(
+                "`input = \"{name}\"`: the input's edges come from the signal; a simulated \
+                 sensor goes on the signal (`[signals.{name}.sensor]`)"
+            );
+            return Err(cx.in_array("measuring_inputs", i, "sensor", Problem::Conflict { other }));
+        }
+        let key = format!("measuring_inputs[{i}].input");
+        let u = InputUse {
+            node: b.node_of(entry.axis),
+            key: &key,
+            timestamped: true,
+        };
+        out.measuring_inputs[i] = Some(b.input(name, &u, &at, &mut by)?);
+    }
+    for (i, (entry, (axis, a))) in b.axes.iter().zip(raw.axes.iter()).enumerate() {
+        let Some(t) = &a.inputs else {
+            continue;
+        };
+        out.axes[i] = axis_inputs(cx, b, (axis, a, entry), t, &mut by)?;
+    }
+    Ok(out)
+}
+
+/// A limit switch bound to an input signal activates the axis's hardware limit monitoring
+/// (`PositionLimits_HW.Active`) unless its `[axes.<name>.hw_limits]` says otherwise.
+pub(super) fn activate_limits(raw: &CellFile, inputs: &InputBindings, axes: &mut [AxisEntry]) {
+    for ((entry, a), bound) in axes.iter_mut().zip(raw.axes.values()).zip(&inputs.axes) {
+        if (bound.limit_positive.is_some() || bound.limit_negative.is_some())
+            && a.hw_limits.is_none()
+        {
+            entry.config.hw_limits_active = true;
+        }
+    }
+}
+
+/// `[axes.<name>.inputs]` of one axis: each switch an input of the axis's node, given neither
+/// by the drive nor as a simulated position.
+fn axis_inputs(
+    cx: Ctx<'_>,
+    b: &Bindings<'_>,
+    (axis, a, entry): (&str, &crate::schema::AxisSection, &AxisEntry),
+    t: &crate::schema::AxisInputsSection,
+    by: &mut [Option<String>],
+) -> Result<AxisInputs, ConfigError> {
+    if matches!(entry.drive, DriveConnection::Cia402(_)) {
+        let other = "`drive.type = \"cia402\"`: the drive's digital inputs (0x60FD) give the \
+                     limit switches and the reference cam"
+            .to_string();
+        return Err(cx.at(&["axes", axis, "inputs"], Problem::Conflict { other }));
+    }
+    let hw = a.hw_limits.as_ref();
+    let simulated = [
+        (
+            "limit_positive",
+            hw.and_then(|h| h.max).map(|_| ["hw_limits", "max"]),
+        ),
+        (
+            "limit_negative",
+            hw.and_then(|h| h.min).map(|_| ["hw_limits", "min"]),
+        ),
+        (
+            "reference_cam",
+            a.plant.reference_cam.map(|_| ["plant", "reference_cam"]),
+        ),
+    ];
+    let given = [&t.limit_positive, &t.limit_negative, &t.reference_cam];
+    let mut bound = [None; 3];
+    for (k, ((switch, position), name)) in simulated.iter().zip(given).enumerate() {
+        let Some(name) = name else {
+            continue;
+        };
+        if let Some([table, key]) = position {
+            let other = format!("`inputs.{switch} = \"{name}\"`: the switch is that input signal");
+            return Err(cx.at(&["axes", axis, table, key], Problem::Conflict { other }));
+        }
+        let key = format!("axes.{axis}.inputs.{switch}");
+        let at = |p| cx.at(&["axes", axis, "inputs", switch], p);
+        let u = InputUse {
+            node: entry.node,
+            key: &key,
+            timestamped: false,
+        };
+        bound[k] = Some(b.input(name, &u, &at, by)?);
+    }
+    Ok(AxisInputs {
+        limit_positive: bound[0],
+        limit_negative: bound[1],
+        reference_cam: bound[2],
+    })
 }

@@ -71,4 +71,12 @@ pub enum Action {
         /// The error code, or 0.
         code: u16,
     },
+    /// The simulated input signal named by the entry set to `value` at the entry's time
+    /// exactly; with `pulse_ns > 0`, back to `!value` that long after.
+    SetInput {
+        /// The level from the entry's time.
+        value: bool,
+        /// Length of the pulse (ns); 0: the level stays.
+        pulse_ns: i64,
+    },
 }

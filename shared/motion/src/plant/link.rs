@@ -138,6 +138,18 @@ pub struct DriveOutputs {
     pub homing_latch: Option<HomingLatch>,
 }
 
+/// Switch levels read from input signals of the node's process image, in place of the
+/// plant's simulated switch positions (`None`: the plant's own switch).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct SwitchInputs {
+    /// The positive hardware limit switch.
+    pub limit_positive: Option<bool>,
+    /// The negative hardware limit switch.
+    pub limit_negative: Option<bool>,
+    /// The reference cam.
+    pub reference_cam: Option<bool>,
+}
+
 /// The simulated drive and the sensors of its plant (the axis in simulation).
 #[derive(Clone, Debug)]
 pub struct SimPlant {
@@ -145,6 +157,10 @@ pub struct SimPlant {
     plant: Plant,
     /// The physical position of the last sample, for the edges since then.
     last: f64,
+    /// Switches from input signals, set before each sample.
+    inputs: SwitchInputs,
+    /// The reference cam's level at the last sample (for an input signal's edge).
+    cam_level: bool,
 }
 
 impl SimPlant {
@@ -161,7 +177,22 @@ impl SimPlant {
             drive: SimDrive::new(model, cycle, stop_deceleration, p0),
             plant,
             last: p0,
+            inputs: SwitchInputs::default(),
+            cam_level: false,
         }
+    }
+
+    /// Takes the switches given as input signals for the coming samples.
+    pub fn set_switch_inputs(&mut self, s: SwitchInputs) {
+        self.inputs = s;
+    }
+
+    /// Whether the reference cam is active now: its input signal, or the plant's cam at the
+    /// drive's position.
+    pub fn reference_cam_now(&self) -> bool {
+        self.inputs
+            .reference_cam
+            .unwrap_or_else(|| self.plant.on_reference_cam(self.drive.actual().p))
     }
 
     /// The sensors of the plant (reference cam, zero marks, hardware limits).
@@ -180,9 +211,24 @@ impl SimPlant {
         let actual = self.drive.actual();
         let (prev, p) = (self.last, actual.p);
         self.last = p;
+        let inputs = self.inputs;
+        let mut signals = AxisSignals::of_plant(&self.plant, prev, p);
+        if let Some(level) = inputs.reference_cam {
+            // Inferred: an input signal's edge is known to the sample; the position is that
+            // of the sample at which the level is first seen low.
+            signals.reference_cam_left = (self.cam_level && !level).then_some(p);
+            signals.reference_cam = level;
+        }
+        self.cam_level = signals.reference_cam;
+        if let Some(on) = inputs.limit_positive {
+            signals.limit_positive = on;
+        }
+        if let Some(on) = inputs.limit_negative {
+            signals.limit_negative = on;
+        }
         DriveInputs {
             actual,
-            signals: AxisSignals::of_plant(&self.plant, prev, p),
+            signals,
             state: DriveState::Operational,
             in_limitation: false,
         }

@@ -1708,7 +1708,7 @@ impl Axis {
     /// Whether the reference cam is active now (when a homing job starts between cycles).
     fn on_reference_cam_now(&self) -> bool {
         match &self.link {
-            DriveLink::Simulation(p) => p.plant().on_reference_cam(p.actual().p),
+            DriveLink::Simulation(p) => p.reference_cam_now(),
             DriveLink::Connected { inputs, .. } => inputs.signals.reference_cam,
         }
     }
@@ -1733,6 +1733,15 @@ impl Axis {
                 ..DriveOutputs::default()
             },
         };
+    }
+
+    /// Sets the switches read from input signals of the process image for the coming cycle,
+    /// in place of the simulated plant's (ignored on a connected drive, whose inputs carry
+    /// them).
+    pub fn set_switch_inputs(&mut self, s: crate::plant::link::SwitchInputs) {
+        if let DriveLink::Simulation(p) = &mut self.link {
+            p.set_switch_inputs(s);
+        }
     }
 
     /// Sets the inputs of a connected drive for the coming cycle (ignored in simulation).
