@@ -312,3 +312,77 @@ fn disable_drops_the_enable_output_only_after_a_zero_setpoint() {
     assert_eq!(r.state(), AxisState::Disabled);
     assert!(!r.log().contains("alarm"), "{}", r.log());
 }
+
+/// `config/analog.toml` with a reference cam from 40 to 50 mm and zero marks every 10 mm at
+/// 5 mm + k·10 mm (one per leadscrew turn), homing on `mark`.
+fn homing_cell(mark: &str) -> Cell {
+    let keys = format!(
+        r#"
+[axes.slide.plant]
+reference_cam = [40.0, 50.0]
+zero_mark_period = 10.0
+zero_mark_offset = 5.0
+
+[axes.slide.homing]
+active_mark = "{mark}"
+passive_mark = "{mark}"
+approach_velocity = 50.0
+referencing_velocity = 10.0
+home_position = 7.5
+home_position_offset = 2.0
+"#
+    );
+    cell(move |s| format!("{s}\n{keys}"))
+}
+
+/// Homes the analog axis with `mode` (a passive mode carried over the marks by a move of
+/// 100 mm): the axis's homing offset (its position minus the physical one).
+fn home_analog(mark: &str, mode: u8) -> f64 {
+    let cell = homing_cell(mark);
+    let mut r = Run::new(&cell);
+    r.power(true);
+    r.until(50, "enabled", |r| r.state() == AxisState::Standstill);
+    r.cmd(Command::Home {
+        mode,
+        position: 6.0,
+    });
+    if matches!(mode, 2 | 8 | 10) {
+        r.cmd(Command::MoveRelative {
+            distance: 100.0,
+            dynamics: Dynamics {
+                velocity: 20.0,
+                acceleration: 1000.0,
+                deceleration: 1000.0,
+                jerk: 0.0,
+            },
+        });
+    }
+    let what = format!("homed: mode {mode}, {mark}");
+    r.until(8000, &what, |r| r.log().contains("MC_Home job 2: Done"));
+    assert!(!r.log().contains("alarm"), "{}", r.log());
+    r.exec.axis(AxisIndex(0)).unwrap().position_offset()
+}
+
+/// MC_Home 2, 3 and 5 on an analog drive: the encoder's zero mark and the reference cam's edge
+/// are latched where the plant has them (the simulated measuring input of the encoder), so the
+/// homing offset is exact: the homed mark position minus the mark.
+#[test]
+fn homing_on_an_analog_drive_latches_the_cam_edge_and_the_zero_mark() {
+    // Active, mode 3: the mark becomes Position - home_position_offset = 4 mm; mode 5:
+    // home_position - home_position_offset = 5.5 mm. The cam is left upwards at 50 mm; the
+    // next zero mark is at 55 mm.
+    let cases = [
+        ("digital_input", 3u8, 4.0 - 50.0),
+        ("cam_and_zero_mark", 3, 4.0 - 55.0),
+        ("cam_and_zero_mark", 5, 5.5 - 55.0),
+        // Passive, mode 2: no home position offset; the mark becomes Position = 6 mm.
+        ("cam_and_zero_mark", 2, 6.0 - 55.0),
+    ];
+    for (mark, mode, expected) in cases {
+        let offset = home_analog(mark, mode);
+        assert!(
+            (offset - expected).abs() < 1e-9,
+            "mode {mode}, {mark}: offset {offset}, expected {expected}"
+        );
+    }
+}
