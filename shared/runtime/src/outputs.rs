@@ -530,6 +530,26 @@ mod tests {
     }
 
     #[test]
+    fn an_edge_already_past_switches_at_the_next_boundary_and_is_counted() {
+        // Timestamped: due before the boundary that carries it: at once, late, not lost.
+        let mut term = terminal(true);
+        term.queue(event(3 * T - 300, 1, true));
+        assert_eq!(run(&mut term, 3, 3), [(3 * T, 1, true, true)]);
+        assert_eq!((term.status.late, term.status.switches), (1, 1));
+        // Plain: at the first boundary at or after it; late only a cycle or more after it.
+        let mut term = terminal(false);
+        term.queue(event(3 * T - 300, 1, true));
+        term.queue(event(4 * T - T, 2, true));
+        assert_eq!(
+            run(&mut term, 3, 3),
+            [(3 * T, 1, true, false), (3 * T, 2, true, false)]
+        );
+        term.queue(event(3 * T, 1, false));
+        assert_eq!(run(&mut term, 4, 4), [(4 * T, 1, false, true)]);
+        assert_eq!(term.status.late, 1);
+    }
+
+    #[test]
     fn a_full_queue_counts_what_it_drops() {
         let mut term = terminal(true);
         term.queue = Vec::with_capacity(1);

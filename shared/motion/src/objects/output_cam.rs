@@ -20,10 +20,11 @@
 //! start for edges caused by an FB call, a homing jump or a validity change. Edges are sorted by
 //! time and never go back in time: an edge whose compensated time would fall before the previous
 //! edge of the output is reported at that previous edge's time (a zero-length pulse, when the
-//! compensations exceed the cam's length in time). The caller that wants leads longer than its
-//! look-ahead passes a motion that runs ahead of the output (S7 computes the switching times
+//! compensations exceed the cam's length in time). Edges may therefore carry times before
+//! `t0_ns`. A caller whose output must switch at the edge times passes a motion that runs
+//! ahead of the output: [`SwitchingAhead::predict`] gives it (S7 computes the switching times
 //! two servo cycles ahead, S7-1500T Measuring input and cam functions V5.0 function manual, 3.2
-//! 'Output cam technology object'); edges may therefore carry times before `t0_ns`.
+//! 'Output cam technology object').
 //!
 //! # Switching rules
 //!
