@@ -12,6 +12,9 @@ use tandem_motion::objects::output_cam::{
     OutputCamType, PositionType, SwitchingAhead,
 };
 
+use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
+
 const T: i64 = 1_000_000;
 
 /// A parabola: `p0 + v0 t + a t² / 2` at `t` (s).
@@ -121,5 +124,65 @@ fn an_actual_value_cam_reports_the_exact_crossing_less_its_compensation() {
             (off.time_ns as f64 - want_off).abs() <= 1.0,
             "{off:?} {want_off}"
         );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 200,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(0x5a_0011),
+        ..ProptestConfig::default()
+    })]
+
+    /// Any constant-acceleration motion moving forward, any cam, any compensations, any
+    /// look-ahead: both edges at the exact crossing less their compensation (1 ns), each
+    /// reported at least one cycle after the boundary after its step.
+    #[test]
+    fn edges_are_the_exact_crossings_less_the_compensations(
+        v0 in 5.0f64..500.0,
+        a in 0.0f64..2000.0,
+        on in 1.0f64..50.0,
+        len in 0.5f64..50.0,
+        on_comp in 0.0f64..0.006,
+        off_comp in 0.0f64..0.006,
+        setpoint in any::<bool>(),
+    ) {
+        // Before the cam for the first 30 ms (longer than any look-ahead here).
+        let law = (-1.0 - v0 * 0.03 - 0.5 * a * 0.03 * 0.03, v0, a);
+        let position_type = if setpoint { PositionType::Setpoint } else { PositionType::Actual };
+        let mut config = OutputCamConfig::new(OutputCamType::Distance);
+        config.position_type = position_type;
+        config.parameters = OutputCamParameters {
+            on_compensation: on_comp,
+            off_compensation: off_comp,
+            hysteresis: 0.0,
+        };
+        let mut cam = OutputCam::new(config).unwrap();
+        cam.call(1, &McOutputCam::distance(on, on + len).with_direction(CamDirection::Both));
+        // Λ = (2 + ceil(c / T)) · T, the setpoint 2 cycles behind the load.
+        let c_ns = (on_comp.max(off_comp) * 1e9).ceil() as i64;
+        let lambda = 2 * T + (c_ns + T - 1) / T * T;
+        let ahead = SwitchingAhead::new(position_type, lambda, 2 * T);
+        let delay = ahead.horizon_ns - ahead.extrapolation_ns;
+        let mut edges = CamEdges::default();
+        let mut seen = Vec::new();
+        let end_ns = crossing(law, on + len) as i64 + 20 * T;
+        for k in 0..end_ns / T {
+            cam.step(&ahead.predict(&cycle(k, law)), &mut edges);
+            for e in edges.as_slice() {
+                prop_assert!(e.time_ns >= (k + 2) * T, "{:?} at step {}", e, k);
+                seen.push(*e);
+            }
+        }
+        let on_edge = seen.iter().find(|e| e.on).unwrap();
+        let off_edge = seen.iter().rfind(|e| !e.on).unwrap();
+        // The position the edge switches on: the setpoint reaches the load `delay` later.
+        let want_on = crossing(law, on) + delay as f64 - on_comp * 1e9;
+        let want_off = crossing(law, on + len) + delay as f64 - off_comp * 1e9;
+        // An edge is never before its predecessor (a lead longer than the cam: a zero pulse).
+        let want_off = want_off.max(on_edge.time_ns as f64);
+        prop_assert!((on_edge.time_ns as f64 - want_on).abs() <= 1.0, "{:?} {}", on_edge, want_on);
+        prop_assert!((off_edge.time_ns as f64 - want_off).abs() <= 1.0, "{:?} {}", off_edge, want_off);
     }
 }
