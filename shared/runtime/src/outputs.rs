@@ -19,11 +19,11 @@
 //! ```
 //!
 //! `c` the larger of its on and off compensations ([`OutputDeviceStatus::look_ahead_ns`]
-//! reports the largest `Λ` of a device's node). A
-//! setpoint cam's motion is its setpoint shifted by the setpoint's transport delay to the load
-//! `D` = [`SETPOINT_DELAY_CYCLES`] cycles and extrapolated the remaining `Λ - D`; an
-//! actual-value cam's is its actual value extrapolated `Λ` with the actual velocity and
-//! acceleration. The edge times the object reports (log, trace, [`ObjectEdge`]) are the times
+//! reports the largest `Λ` of a device's node). A setpoint cam's motion is its setpoint
+//! shifted by the setpoint's transport delay to the load `D` = [`SETPOINT_DELAY_CYCLES`]
+//! cycles and extrapolated the remaining `Λ - D`; an actual-value cam's is its actual value
+//! extrapolated `Λ` with the actual velocity and acceleration. Objects that drive no signal
+//! step with the cycle just computed, as before. The edge times the object reports (log, trace, [`ObjectEdge`]) are the times
 //! its output must switch, and an edge at `e` is due on its channel at exactly `e`. With
 //! `e >= t - T + Λ - c >= t + T` no edge is due before the boundary that writes it. An edge
 //! that is due already (the second edge within one cycle on a timestamped device, or an edge
