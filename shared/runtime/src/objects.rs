@@ -17,7 +17,7 @@ use tandem_motion::objects::measuring::{
     MeasuringInput, MeasuringJobKind, MeasuringState, MeasuringWindow,
 };
 use tandem_motion::objects::output_cam::{
-    CamDirection, CamEdges, McOutputCam, OutputCam, OutputCamMode, PositionType,
+    CamDirection, CamEdges, McOutputCam, OutputCam, OutputCamMode, PositionType, SwitchingAhead,
 };
 use tandem_motion::plant::sensor::{InputEdge, InputEdges, SimulatedSensor};
 
@@ -132,18 +132,34 @@ pub(crate) fn cycle_motion(
     CycleMotion { setpoint, actual }
 }
 
-/// An output cam of the executive and the time of its last edge.
+/// An output cam of the executive, the time of its last edge and, when it drives an output,
+/// its look-ahead.
 #[derive(Debug)]
 pub(crate) struct SimCam {
     cam: OutputCam,
     last_edge: Option<i64>,
+    ahead: Option<SwitchingAhead>,
 }
 
-/// A cam track of the executive and the time of its last edge.
+/// A cam track of the executive, the time of its last edge and, when it drives an output, its
+/// look-ahead.
 #[derive(Debug)]
 pub(crate) struct SimTrack {
     track: CamTrack,
     last_edge: Option<i64>,
+    ahead: Option<SwitchingAhead>,
+}
+
+/// The motion an object on `position_type` steps with: the cycle's, or, for an object that
+/// drives an output, the motion predicted over its look-ahead (its edges are then the times
+/// the output switches; see [`crate::outputs`]).
+fn switching_motion(
+    motion: &CycleMotion,
+    position_type: PositionType,
+    ahead: Option<SwitchingAhead>,
+) -> AxisMotion {
+    let m = motion.of(position_type);
+    ahead.map_or(*m, |a| a.predict(m))
 }
 
 /// A measuring input of the executive: the engine object, its sensor, the scripted edges and
@@ -307,7 +323,8 @@ impl CycleObject for SimCam {
         edges: &mut CamEdges,
     ) -> i64 {
         edges.clear();
-        self.cam.step(motion.of(e.config.position_type), edges);
+        let m = switching_motion(motion, e.config.position_type, self.ahead);
+        self.cam.step(&m, edges);
         motion.setpoint.t1_ns
     }
     fn alarm(&self) -> Option<AlarmInstance> {
@@ -350,7 +367,8 @@ impl CycleObject for SimTrack {
         edges: &mut CamEdges,
     ) -> i64 {
         edges.clear();
-        self.track.step(motion.of(e.config.position_type), edges);
+        let m = switching_motion(motion, e.config.position_type, self.ahead);
+        self.track.step(&m, edges);
         motion.setpoint.t1_ns
     }
     fn alarm(&self) -> Option<AlarmInstance> {
@@ -563,6 +581,12 @@ impl Objects {
             cams.push(SimCam {
                 cam: OutputCam::new(c.config).map_err(refused("output cam", &c.name))?,
                 last_edge: None,
+                ahead: crate::outputs::switching_ahead(
+                    cell,
+                    c.output,
+                    c.config.position_type,
+                    &c.config.parameters,
+                ),
             });
         }
         let mut tracks = Vec::new();
@@ -570,6 +594,12 @@ impl Objects {
             tracks.push(SimTrack {
                 track: CamTrack::new(c.config, c.data).map_err(refused("cam track", &c.name))?,
                 last_edge: None,
+                ahead: crate::outputs::switching_ahead(
+                    cell,
+                    c.output,
+                    c.config.position_type,
+                    &c.data.parameters,
+                ),
             });
         }
         let n_objects =

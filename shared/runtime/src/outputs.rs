@@ -2,28 +2,33 @@
 //! (`kind = "sim_digital_output"`) and the stage that takes each output cam's and cam track's
 //! edges of a step to the channel of the signal it drives (`output = "<signal>"`).
 //!
-//! # The output timeline and the look-ahead
+//! # Switching ahead: the edge time is the switching time
 //!
-//! An object steps at `t` with the motion of its cycle `[t - T, t]`, so its edges carry times
-//! at or before `t`, earlier still by their on or off compensation (lead). A device can only
-//! switch what it was told before: the process image writes outputs at the boundary after the
-//! step that computed them, `t + T`. The output timeline therefore runs a look-ahead `Λ`
-//! behind the edge times: an edge at `e` is due on its channel at `e + Λ`, with
+//! A device can only switch what it was told before: the process image writes outputs at the
+//! boundary after the step that computed them, `t + T`. S7-1500T therefore computes the exact
+//! switching time two position-control cycles before the output, and shifts setpoint cams so
+//! that they fire when the setpoint reaches the drive (S7-1500T Measuring input and cam
+//! functions V5.0 function manual, 3.2 'Output cam technology object'). tandem does the same:
+//! an output cam or cam track that drives a signal is stepped at `t` with the motion of
+//! `[t - T + Λ, t + Λ]` predicted from its cycle `[t - T, t]`
+//! ([`tandem_motion::objects::output_cam::SwitchingAhead`], set up by [`switching_ahead`]),
+//! with the object's look-ahead
 //!
 //! ```text
 //! Λ = (2 + ceil(c / T)) · T
 //! ```
 //!
-//! per node, `c` the largest on or off compensation of the node's objects that drive a
-//! signal. With `e >= t - T - c`, `e + Λ >= t + T`: no edge is ever due before the boundary it
-//! is written at. The two cycles are the S7-1500T rule that switching times are computed two
-//! position-control cycles before the output (S7-1500T Measuring input and cam functions V5.0
-//! function manual, 3.2 'Output cam technology object'); they are also
-//! the two cycles of transport delay from a setpoint to the load on a drive of the process
-//! image ([`crate::drives`]), so an uncompensated setpoint cam switches when the load passes
-//! its position. Inferred: tandem has no trajectory prediction, so a compensation lengthens
-//! `Λ` instead of reaching further ahead; the edges keep their exact times relative to each
-//! other.
+//! `c` the larger of its on and off compensations ([`OutputDeviceStatus::look_ahead_ns`]
+//! reports the largest `Λ` of a device's node). A setpoint cam's motion is its setpoint
+//! shifted by the setpoint's transport delay to the load `D` = [`SETPOINT_DELAY_CYCLES`]
+//! cycles and extrapolated the remaining `Λ - D`; an actual-value cam's is its actual value
+//! extrapolated `Λ` with the actual velocity and acceleration. Objects that drive no signal
+//! step with the cycle just computed, as before. The edge times the object reports (log, trace, [`ObjectEdge`]) are the times
+//! its output must switch, and an edge at `e` is due on its channel at exactly `e`. With
+//! `e >= t - T + Λ - c >= t + T` no edge is due before the boundary that writes it. An edge
+//! that is due already (the second edge within one cycle on a timestamped device, or an edge
+//! held back to its predecessor's time by the object) switches at once at the next boundary,
+//! counted as late, never lost.
 //!
 //! # The order within one step at `t`, after the objects stepped
 //!
@@ -40,18 +45,27 @@
 //!      the level of its last edge; a channel whose edges cancel within the cycle does not
 //!      switch (the last one written wins, S7-1500T Measuring input and cam functions V5.0
 //!      function manual, 3.3 'Cam track technology object', DQ module).
-//! 2. The step's edges join their devices' pending events, due at `e + Λ`.
+//! 2. The step's edges join their devices' pending events, due at their time `e`.
 //!
 //! Every switch is recorded ([`OutputSwitch`]) with the instant the channel changed, for tests
 //! and traces. Nothing here allocates after [`Outputs::new`].
 
 use crate::objects::ObjectEdge;
-use tandem_config::{Cell, DeviceKind};
-use tandem_motion::objects::output_cam::EDGE_CAPACITY;
+use tandem_config::{Cell, DeviceKind, SignalIndex};
+use tandem_motion::objects::output_cam::{
+    OutputCamParameters, PositionType, SwitchingAhead, EDGE_CAPACITY,
+};
 
 /// Cycles of look-ahead without compensation: S7 computes switching times two
 /// position-control cycles before the output.
 pub const LOOK_AHEAD_CYCLES: i64 = 2;
+
+/// Cycles from a setpoint computed to the load moving by it: the transport delay of a drive of
+/// the process image ([`crate::drives`]: a setpoint computed at `t` acts from `t + T` and shows
+/// in the actual value read at `t + 2T`). Setpoint cams are shifted by it. Inferred: the same
+/// two cycles for an axis on the simulated drive model and for a virtual axis, so that an
+/// uncompensated setpoint cam switches at the same instants on every kind of axis.
+pub const SETPOINT_DELAY_CYCLES: i64 = 2;
 
 /// Most switches kept between two [`crate::exec::Executive::drain_output_switches`]; more are
 /// counted in [`OutputDeviceStatus::unreported`].
@@ -71,10 +85,10 @@ pub struct OutputSwitch {
     pub on: bool,
     /// The instant the channel switched (ns, cell clock).
     pub time_ns: i64,
-    /// The edge time the object computed (ns), compensation applied.
+    /// The edge time the object computed (ns), compensation applied: the time the output
+    /// must switch.
     pub edge_ns: i64,
-    /// The instant it was due: `edge_ns` plus the look-ahead (the `StartTime` a timestamped
-    /// device is given).
+    /// The instant it was due (the `StartTime` a timestamped device is given): `edge_ns`.
     pub scheduled_ns: i64,
     /// The boundary whose frame carried it to the device.
     pub written_ns: i64,
@@ -91,7 +105,8 @@ pub struct OutputDeviceStatus {
     /// Timestamped: the `StartTime` of the task the device holds, not yet executed.
     #[doc(alias = "StartTime")]
     pub task_start_ns: Option<i64>,
-    /// The look-ahead `Λ` of its node (ns).
+    /// The largest look-ahead `Λ` of its node's objects that drive a signal (ns): how far
+    /// ahead of the cycle just computed they predict their switching times.
     pub look_ahead_ns: i64,
     /// Switches so far.
     pub switches: u64,
@@ -108,7 +123,7 @@ pub struct OutputDeviceStatus {
 /// An edge due on a channel.
 #[derive(Copy, Clone, Debug)]
 struct Event {
-    /// When it is due: the edge time plus the look-ahead.
+    /// When it is due: the edge time.
     at_ns: i64,
     edge_ns: i64,
     channel: u8,
@@ -247,23 +262,57 @@ pub(crate) struct Outputs {
     terminals: Vec<Terminal>,
     /// Per device of the cell: its terminal here.
     of_device: Vec<Option<usize>>,
-    /// Per object (output cams, then cam tracks): its terminal, channel and look-ahead.
-    bindings: Vec<Option<(usize, u8, i64)>>,
+    /// Per object (output cams, then cam tracks): its terminal and channel.
+    bindings: Vec<Option<(usize, u8)>>,
     /// The switches since the last drain.
     switches: Vec<OutputSwitch>,
 }
 
-/// The look-ahead of node `node` (ns): [`LOOK_AHEAD_CYCLES`] plus its objects' largest
-/// compensation that drive a signal, in whole cycles.
+/// The look-ahead of an output cam or cam track on `position_type` that drives `output`: `Λ`
+/// of the node of the output's device (see the module documentation), or `None` when it
+/// drives no digital output (it then steps with the cycle just computed).
+pub(crate) fn switching_ahead(
+    cell: &Cell,
+    output: Option<SignalIndex>,
+    position_type: PositionType,
+    parameters: &OutputCamParameters,
+) -> Option<SwitchingAhead> {
+    let signal = cell.signals.get(output?.0)?;
+    let device = cell.devices.get(signal.device.0)?;
+    if !matches!(device.kind, DeviceKind::SimDigitalOutput(_)) {
+        return None;
+    }
+    let cycle = cell.nodes.get(device.node).map_or(1, |n| n.cycle_ns.max(1));
+    Some(SwitchingAhead::new(
+        position_type,
+        look_ahead_of(lead(parameters), cycle),
+        SETPOINT_DELAY_CYCLES.saturating_mul(cycle),
+    ))
+}
+
+/// An object's largest compensation (s).
+fn lead(p: &OutputCamParameters) -> f64 {
+    p.on_compensation.max(p.off_compensation)
+}
+
+/// `Λ` (ns) for compensation `c` (s) on a cycle of `cycle` ns: [`LOOK_AHEAD_CYCLES`] plus `c`
+/// in whole cycles.
+fn look_ahead_of(c: f64, cycle: i64) -> i64 {
+    // Compensations are at most 1e9 s (checked by the configuration): the cycles fit an i64.
+    let c_cycles = (c * 1e9 / cycle as f64).ceil() as i64;
+    LOOK_AHEAD_CYCLES
+        .saturating_add(c_cycles.max(0))
+        .saturating_mul(cycle)
+}
+
+/// The look-ahead of node `node` (ns): the largest of its objects that drive a signal
+/// ([`LOOK_AHEAD_CYCLES`] plus the largest compensation, in whole cycles).
 fn look_ahead(cell: &Cell, node: usize) -> i64 {
     let cycle = cell.nodes.get(node).map_or(1, |n| n.cycle_ns.max(1));
-    let on_node = |s: Option<tandem_config::SignalIndex>| {
+    let on_node = |s: Option<SignalIndex>| {
         s.and_then(|s| cell.signals.get(s.0))
             .and_then(|s| cell.devices.get(s.device.0))
             .is_some_and(|d| d.node == node)
-    };
-    let lead = |p: &tandem_motion::objects::output_cam::OutputCamParameters| {
-        p.on_compensation.max(p.off_compensation)
     };
     let c = cell
         .output_cams
@@ -277,11 +326,7 @@ fn look_ahead(cell: &Cell, node: usize) -> i64 {
                 .map(|c| lead(&c.data.parameters)),
         )
         .fold(0.0, f64::max);
-    // Compensations are at most 1e9 s (checked by the configuration): the cycles fit an i64.
-    let c_cycles = (c * 1e9 / cycle as f64).ceil() as i64;
-    LOOK_AHEAD_CYCLES
-        .saturating_add(c_cycles.max(0))
-        .saturating_mul(cycle)
+    look_ahead_of(c, cycle)
 }
 
 impl Outputs {
@@ -326,11 +371,10 @@ impl Outputs {
                 },
             });
         }
-        let bind = |s: Option<tandem_config::SignalIndex>| {
+        let bind = |s: Option<SignalIndex>| {
             let s = cell.signals.get(s?.0)?;
             let k = of_device.get(s.device.0).copied().flatten()?;
-            let look_ahead_ns = terminals.get(k)?.status.look_ahead_ns;
-            Some((k, s.channel, look_ahead_ns))
+            Some((k, s.channel))
         };
         let bindings = cell
             .output_cams
@@ -356,13 +400,12 @@ impl Outputs {
             }
         }
         for e in edges.iter() {
-            let Some(Some((k, channel, look_ahead_ns))) = self.bindings.get(e.object).copied()
-            else {
+            let Some(Some((k, channel))) = self.bindings.get(e.object).copied() else {
                 continue;
             };
             if let Some(term) = self.terminals.get_mut(k) {
                 term.queue(Event {
-                    at_ns: e.edge.time_ns.saturating_add(look_ahead_ns),
+                    at_ns: e.edge.time_ns,
                     edge_ns: e.edge.time_ns,
                     channel,
                     on: e.edge.on,
@@ -407,7 +450,7 @@ mod tests {
     fn event(at_ns: i64, channel: u8, on: bool) -> Event {
         Event {
             at_ns,
-            edge_ns: at_ns - 2 * T,
+            edge_ns: at_ns,
             channel,
             on,
         }
@@ -484,6 +527,26 @@ mod tests {
             [(4 * T, 2, true, false), (5 * T, 2, false, false)]
         );
         assert_eq!((term.status.superseded, term.status.switches), (2, 2));
+    }
+
+    #[test]
+    fn an_edge_already_past_switches_at_the_next_boundary_and_is_counted() {
+        // Timestamped: due before the boundary that carries it: at once, late, not lost.
+        let mut term = terminal(true);
+        term.queue(event(3 * T - 300, 1, true));
+        assert_eq!(run(&mut term, 3, 3), [(3 * T, 1, true, true)]);
+        assert_eq!((term.status.late, term.status.switches), (1, 1));
+        // Plain: at the first boundary at or after it; late only a cycle or more after it.
+        let mut term = terminal(false);
+        term.queue(event(3 * T - 300, 1, true));
+        term.queue(event(4 * T - T, 2, true));
+        assert_eq!(
+            run(&mut term, 3, 3),
+            [(3 * T, 1, true, false), (3 * T, 2, true, false)]
+        );
+        term.queue(event(3 * T, 1, false));
+        assert_eq!(run(&mut term, 4, 4), [(4 * T, 1, false, true)]);
+        assert_eq!(term.status.late, 1);
     }
 
     #[test]

@@ -3,8 +3,10 @@
 //!
 //! A rotary axis runs forward and back at several speeds for 12 s; a distance cam with on and
 //! off compensation, a time cam and a cam track with compensations each drive one channel.
-//! - Timestamped outputs switch at exactly the logged edge time plus the node's look-ahead
-//!   (to the ns), none late, and the StartTime is never in the past when its frame carries it.
+//! - Timestamped outputs switch at exactly the logged edge time (to the ns), none late: the
+//!   objects that drive an output compute their edges ahead (over their look-ahead), so every
+//!   edge is at least one cycle after the step that computed it and the StartTime is never in
+//!   the past when its frame carries it.
 //! - Plain outputs switch at the first boundary at or after that instant: never before it,
 //!   less than one cycle after it, and a channel whose edges cancel within one write does not
 //!   switch (an independent model of the boundaries gives the same switches).
@@ -261,16 +263,16 @@ fn device_of(cell: &Cell, name: &str) -> usize {
     cell.signals[signal.0].device.0
 }
 
-/// The logged edges of each object with the device it drives, due (plus `look_ahead`) at
-/// least two cycles before `end`.
-fn per_device(cell: &Cell, r: &Run, look_ahead: i64) -> Vec<(usize, Vec<Logged>)> {
+/// The logged edges of each object with the device it drives, due at least two cycles before
+/// `end`.
+fn per_device(cell: &Cell, r: &Run) -> Vec<(usize, Vec<Logged>)> {
     ["dist_cam", "time_cam", "glue"]
         .iter()
         .map(|name| {
             let edges = r
                 .edges
                 .iter()
-                .filter(|e| e.object == *name && e.t_ns + look_ahead <= r.end - 2 * T)
+                .filter(|e| e.object == *name && e.t_ns <= r.end - 2 * T)
                 .cloned()
                 .collect();
             (device_of(cell, name), edges)
@@ -285,8 +287,8 @@ fn timestamped_outputs_switch_at_the_edge_times_to_the_ns() {
     // 2 cycles plus the largest compensation (3 ms), in cycles.
     let look_ahead = (LOOK_AHEAD_CYCLES + 3) * T;
     let mut total = 0;
-    let mut before_cycle = 0;
-    for (device, edges) in per_device(&cell, &r, look_ahead) {
+    let mut first_boundary = 0;
+    for (device, edges) in per_device(&cell, &r) {
         let switches: Vec<&OutputSwitch> =
             r.switches.iter().filter(|s| s.device == device).collect();
         assert!(edges.len() >= 40, "{} edges on {device}", edges.len());
@@ -294,28 +296,34 @@ fn timestamped_outputs_switch_at_the_edge_times_to_the_ns() {
         for (s, e) in switches.iter().zip(&edges) {
             assert_eq!(s.edge_ns, e.t_ns, "{e:?} {s:?}");
             assert_eq!(s.on, e.on, "{e:?} {s:?}");
-            assert_eq!(s.scheduled_ns, e.t_ns + look_ahead);
+            // The switching time is the edge time the object reported, to the ns.
+            assert_eq!(s.scheduled_ns, e.t_ns, "{e:?} {s:?}");
             assert_eq!(
-                s.time_ns,
-                e.t_ns + look_ahead,
-                "switched at the edge's instant"
+                s.time_ns, e.t_ns,
+                "switched at the edge's time: {e:?} {s:?}"
             );
             assert!(!s.late, "{s:?}");
+            // Computed ahead: at or after the boundary after the step that computed it.
+            assert!(e.t_ns >= e.step + T, "an edge in the past: {e:?}");
             // Written at a boundary after the step that computed the edge, never with a
             // StartTime in the past.
             assert!(s.written_ns >= e.step + T, "{e:?} {s:?}");
             assert_eq!(s.written_ns % T, 0);
             assert!(s.written_ns <= s.scheduled_ns, "{s:?}");
-            before_cycle += usize::from(e.t_ns < e.step - T);
+            first_boundary += usize::from(e.t_ns < e.step + 2 * T);
         }
         total += edges.len();
     }
-    println!("timestamped: {total} edges exact, {before_cycle} before their cycle's start");
+    println!(
+        "timestamped: {total} edges exact, {first_boundary} due before the second boundary \
+         after their step"
+    );
     assert!(total >= 400, "{total} edges");
-    // The compensations put edges before the cycle that computed them: covered too.
+    // The compensations put edges as early as they can be written (within the cycle after
+    // the first boundary): the tightest case is covered.
     assert!(
-        before_cycle >= 50,
-        "{before_cycle} edges before their cycle"
+        first_boundary >= 50,
+        "{first_boundary} edges due within a cycle of the first boundary"
     );
     // The look-ahead every device of the node reports.
     let exec = Executive::new(&cell, None).unwrap();
@@ -325,16 +333,16 @@ fn timestamped_outputs_switch_at_the_edge_times_to_the_ns() {
 }
 
 /// The independent model of a plain output: each edge written at the first boundary at or
-/// after its instant; per boundary, a channel switches to the level of its last edge if that
+/// after its time; per boundary, a channel switches to the level of its last edge if that
 /// differs from its level before. (time, on, edge time) per switch.
-fn plain_model(edges: &[Logged], look_ahead: i64) -> Vec<(i64, bool, i64)> {
+fn plain_model(edges: &[Logged]) -> Vec<(i64, bool, i64)> {
     let mut out = Vec::new();
     let mut level = false;
     let mut k = 0;
     while k < edges.len() {
-        let b = (edges[k].t_ns + look_ahead + T - 1).div_euclid(T) * T;
+        let b = (edges[k].t_ns + T - 1).div_euclid(T) * T;
         let mut last = &edges[k];
-        while k < edges.len() && edges[k].t_ns + look_ahead <= b {
+        while k < edges.len() && edges[k].t_ns <= b {
             last = &edges[k];
             k += 1;
         }
@@ -351,16 +359,15 @@ fn plain_outputs_switch_within_one_cycle_after_the_edge_and_never_before() {
     let src = CELL.replace("timestamped = true", "timestamped = false");
     let cell = tandem_config::parse("cell.toml", &src).unwrap();
     let r = run(&cell, SCRIPT);
-    let look_ahead = (LOOK_AHEAD_CYCLES + 3) * T;
     let mut total = 0;
-    for (device, edges) in per_device(&cell, &r, look_ahead) {
+    for (device, edges) in per_device(&cell, &r) {
         let switches: Vec<&OutputSwitch> =
             r.switches.iter().filter(|s| s.device == device).collect();
         for s in &switches {
             assert_eq!(s.time_ns % T, 0, "at a boundary: {s:?}");
             assert!(s.time_ns >= s.scheduled_ns, "never before its time: {s:?}");
             assert!(s.time_ns < s.scheduled_ns + T, "within one cycle: {s:?}");
-            assert_eq!(s.scheduled_ns, s.edge_ns + look_ahead);
+            assert_eq!(s.scheduled_ns, s.edge_ns, "due at the edge's time: {s:?}");
             assert_eq!(s.written_ns, s.time_ns);
             assert!(!s.late);
         }
@@ -375,7 +382,7 @@ fn plain_outputs_switch_within_one_cycle_after_the_edge_and_never_before() {
             .iter()
             .map(|s| (s.time_ns, s.on, s.edge_ns))
             .collect();
-        assert_eq!(got, plain_model(&edges, look_ahead), "device {device}");
+        assert_eq!(got, plain_model(&edges), "device {device}");
         assert!(got.len() >= 40);
         total += got.len();
     }
@@ -397,9 +404,8 @@ fn narrow() -> String {
 fn edges_closer_than_a_cycle_switch_at_the_next_boundary_on_a_timestamped_output() {
     let cell = tandem_config::parse("cell.toml", &narrow()).unwrap();
     let r = run(&cell, SCRIPT);
-    let look_ahead = (LOOK_AHEAD_CYCLES + 3) * T;
     let track = device_of(&cell, "glue");
-    let (_, edges) = per_device(&cell, &r, look_ahead)
+    let (_, edges) = per_device(&cell, &r)
         .into_iter()
         .find(|(d, _)| *d == track)
         .unwrap();
@@ -413,7 +419,7 @@ fn edges_closer_than_a_cycle_switch_at_the_next_boundary_on_a_timestamped_output
     let mut late = 0;
     for (s, e) in switches.iter().zip(&edges) {
         assert_eq!((s.edge_ns, s.on), (e.t_ns, e.on));
-        let at = e.t_ns + look_ahead;
+        let at = e.t_ns;
         let w = free.max(e.step + T);
         let (time, next_free) = if at > w {
             (at, (at + T - 1).div_euclid(T) * T)
@@ -451,9 +457,8 @@ fn pulses_narrower_than_a_cycle_vanish_on_a_plain_output() {
     let src = narrow().replace("timestamped = true", "timestamped = false");
     let cell = tandem_config::parse("cell.toml", &src).unwrap();
     let r = run(&cell, SCRIPT);
-    let look_ahead = (LOOK_AHEAD_CYCLES + 3) * T;
     let track = device_of(&cell, "glue");
-    let (_, edges) = per_device(&cell, &r, look_ahead)
+    let (_, edges) = per_device(&cell, &r)
         .into_iter()
         .find(|(d, _)| *d == track)
         .unwrap();
@@ -463,7 +468,7 @@ fn pulses_narrower_than_a_cycle_vanish_on_a_plain_output() {
         .filter(|s| s.device == track)
         .map(|s| (s.time_ns, s.on, s.edge_ns))
         .collect();
-    let want = plain_model(&edges, look_ahead);
+    let want = plain_model(&edges);
     assert_eq!(got, want);
     println!(
         "narrow, plain: {} edges, {} switches",

@@ -21,6 +21,22 @@
 //! extrapolated position is the actual position plus velocity times (acquisition time + cycle +
 //! following-axis time). No allocation; time is the cycle.
 
+use crate::kinematics::profile::State;
+
+/// The state `dt` seconds after `s` (`dt` may be negative) at the constant acceleration of
+/// `s`: `p + v·dt + a·dt²/2`, `v + a·dt`, `a`. Exact for motion of constant velocity or
+/// constant acceleration. The same extrapolation the leading values use after their newest
+/// sample; output cams and cam tracks that drive a signal predict the position they switch on
+/// with it (see [`crate::objects::output_cam::SwitchingAhead`]).
+#[inline]
+pub fn constant_acceleration(s: State, dt: f64) -> State {
+    State {
+        p: s.p + dt * (s.v + 0.5 * dt * s.a),
+        v: s.v + dt * s.a,
+        a: s.a,
+    }
+}
+
 /// Which velocity the leading value carries (`Extrapolation.Settings.ExtrapolatedVelocityMode`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum VelocityMode {
@@ -225,6 +241,20 @@ impl Extrapolator {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn constant_acceleration_is_exact_on_a_parabola() {
+        let at = |t: f64| State {
+            p: 3.0 + 2.0 * t + 0.5 * -7.0 * t * t,
+            v: 2.0 - 7.0 * t,
+            a: -7.0,
+        };
+        for (t, dt) in [(0.0, 0.004), (0.3, -0.002), (1.0, 0.0)] {
+            let e = constant_acceleration(at(t), dt);
+            let x = at(t + dt);
+            assert!((e.p - x.p).abs() < 1e-12 && (e.v - x.v).abs() < 1e-12 && e.a == x.a);
+        }
+    }
 
     #[test]
     fn filter_lag_is_compensated_at_constant_velocity() {

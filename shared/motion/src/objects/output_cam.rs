@@ -20,10 +20,11 @@
 //! start for edges caused by an FB call, a homing jump or a validity change. Edges are sorted by
 //! time and never go back in time: an edge whose compensated time would fall before the previous
 //! edge of the output is reported at that previous edge's time (a zero-length pulse, when the
-//! compensations exceed the cam's length in time). The caller that wants leads longer than its
-//! look-ahead passes a motion that runs ahead of the output (S7 computes the switching times
+//! compensations exceed the cam's length in time). Edges may therefore carry times before
+//! `t0_ns`. A caller whose output must switch at the edge times passes a motion that runs
+//! ahead of the output: [`SwitchingAhead::predict`] gives it (S7 computes the switching times
 //! two servo cycles ahead, S7-1500T Measuring input and cam functions V5.0 function manual, 3.2
-//! 'Output cam technology object'); edges may therefore carry times before `t0_ns`.
+//! 'Output cam technology object').
 //!
 //! # Switching rules
 //!
@@ -63,6 +64,7 @@ use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance};
 use crate::catalog::error_id::ErrorId;
 use crate::kinematics::crossing::{point_crossings, Path, PathEvent, RangeSet};
 use crate::kinematics::cycle_motion::AxisMotion;
+use crate::kinematics::extrapolation::constant_acceleration;
 use crate::kinematics::timed_list::{Timed, TimedList};
 use crate::objects::measuring::MeasuringConfigError;
 
@@ -156,6 +158,90 @@ pub fn combine(
         }
     }
     (start, cur)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Switching ahead
+// ---------------------------------------------------------------------------------------------
+
+/// The look-ahead of an output cam or cam track that drives an output: the motion it is
+/// stepped with runs ahead of the cycle just computed, so that the edge times it reports are
+/// the times the output must switch.
+///
+/// S7-1500T computes the exact switching time two position-control cycles before the output;
+/// setpoint cams are shifted so that they fire when the setpoint reaches the drive (S7-1500T
+/// Measuring input and cam functions V5.0 function manual, 3.2 'Output cam technology object').
+/// Given the motion of the cycle `[t0, t1]` of the position the object switches on,
+/// [`Self::predict`] returns the motion of `[t0 + H, t1 + H]` (`H` the horizon):
+///
+/// - **Setpoint**: the setpoint reaches the load `D` later (its transport delay: two cycles on a
+///   drive of the process image), so the load's position at `τ` is the setpoint of `τ - D`. For
+///   `H = D` that is the cycle's setpoint itself, shifted in time (exact); for `H > D` (a
+///   compensation longer than the cycles of the look-ahead) the setpoint at both ends is
+///   extrapolated `H - D` ahead with its constant acceleration.
+/// - **Actual value**: the actual position at both ends extrapolated `H` ahead with the actual
+///   velocity and acceleration ([`crate::kinematics::extrapolation::constant_acceleration`]).
+///
+/// Exact for motion of constant velocity or constant acceleration (the quintic Hermite between
+/// the two extrapolated states reproduces a parabola). The predicted motions of consecutive
+/// cycles join (each end is extrapolated from the same sample the next cycle's start is), so
+/// an object walks a continuous path; a prediction error moves an edge, it never loses or
+/// repeats one. Jump and validity are those of the cycle. Inferred: the reference does not say
+/// how S7 predicts; this is the extrapolation of actual-value coupling without its filters.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct SwitchingAhead {
+    /// `H` (ns): how far the predicted motion runs ahead of the cycle.
+    pub horizon_ns: i64,
+    /// How far the states are extrapolated (ns): `H - D` for a setpoint, `H` for an actual
+    /// value.
+    pub extrapolation_ns: i64,
+}
+
+impl SwitchingAhead {
+    /// The look-ahead of an object on `position_type` for an output that needs its edges
+    /// `horizon_ns` ahead, the setpoint reaching the load `setpoint_delay_ns` after it is
+    /// computed. A setpoint cam's horizon is at least that delay (its edges are never earlier
+    /// than the load passing the position, less the compensation). Negative values count as 0.
+    pub fn new(position_type: PositionType, horizon_ns: i64, setpoint_delay_ns: i64) -> Self {
+        let horizon_ns = horizon_ns.max(0);
+        let delay = setpoint_delay_ns.max(0);
+        match position_type {
+            PositionType::Setpoint => {
+                let horizon_ns = horizon_ns.max(delay);
+                Self {
+                    horizon_ns,
+                    extrapolation_ns: horizon_ns - delay,
+                }
+            }
+            PositionType::Actual => Self {
+                horizon_ns,
+                extrapolation_ns: horizon_ns,
+            },
+        }
+    }
+
+    /// The motion of `[t0 + H, t1 + H]` predicted from the motion `m` of `[t0, t1]` (see the
+    /// type's documentation). Interior knots are extrapolated alike.
+    pub fn predict(&self, m: &AxisMotion) -> AxisMotion {
+        let mut p = *m;
+        p.t0_ns = m.t0_ns.saturating_add(self.horizon_ns);
+        p.t1_ns = m.t1_ns.saturating_add(self.horizon_ns);
+        if self.extrapolation_ns == 0 {
+            return p;
+        }
+        let dt = self.extrapolation_ns as f64 * 1e-9;
+        let ahead = |s| constant_acceleration(s, dt);
+        let mut q = AxisMotion::new(p.t0_ns, p.t1_ns, ahead(m.start), ahead(m.end))
+            .with_modulo(m.modulo)
+            .with_valid(m.valid);
+        if let Some(d) = m.jump {
+            q = q.with_jump(d);
+        }
+        for k in m.knots() {
+            q.push_knot(k.dt, ahead(k.state));
+        }
+        q
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
