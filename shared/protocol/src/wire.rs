@@ -393,7 +393,8 @@ pub struct SignalEvent {
     /// timestamped input, the sampling boundary on a plain one); the instant an output switched.
     pub t_ns: i64,
     /// An input: the boundary whose sample carried the edge; an output: the edge time the
-    /// output cam or cam track computed (before the look-ahead).
+    /// output cam or cam track computed, its switching time (computed ahead; `t_ns` differs
+    /// from it on a plain output or when late).
     pub ref_ns: i64,
     /// The signal's index in the cell (`[signals.<name>]` in name order).
     pub signal: u32,

@@ -111,7 +111,8 @@ width = 20.0
     };
 
     let log = std::fs::read_to_string(rec.join("packer.log")).unwrap();
-    // The glue valve: each edge switched at exactly its logged time plus the look-ahead.
+    // The glue valve: each edge switched at exactly its logged time (the cam track computes its
+    // switching times ahead, docs/io.md 'Outputs').
     let glue = logged(&log, "glue", "output");
     let valve = of("glue_valve");
     assert!(glue.len() >= 20, "{log}");
@@ -123,7 +124,7 @@ width = 20.0
             v["time_ns"].as_i64().unwrap(),
             v["edge_ns"].as_i64().unwrap(),
         );
-        assert_eq!(t, edge + LOOK_AHEAD, "{v}");
+        assert_eq!(t, edge, "{v}");
         let on = v["level"].as_bool().unwrap();
         assert!(glue.contains(&(edge, on)), "{v} not in the log");
     }
