@@ -463,6 +463,8 @@ pub struct Executive<'c> {
     status: Vec<AxisStatus>,
     /// Per axis: `status` is older than the axis' last step (see [`Executive::snapshot`]).
     stale: Vec<bool>,
+    /// The step copies each axis' status right after stepping it ([`Executive::want_status`]).
+    copy_status: bool,
     /// Per axis: it may have job events or alarms to log (set when it steps with some, when it
     /// takes a command, and while alarms were seen); the others are not looked at.
     news: Vec<bool>,
@@ -536,6 +538,7 @@ impl<'c> Executive<'c> {
             last_cycle: status.clone(),
             status,
             stale: vec![false; cell.axes.len()],
+            copy_status: false,
             news: vec![false; cell.axes.len()],
             encoder_status,
             plan: StepPlan::with_capacity(axes.len()),
@@ -571,6 +574,16 @@ impl<'c> Executive<'c> {
             self.snapshot(i);
         }
         &self.status
+    }
+
+    /// The next step copies the status of each axis it steps right after the axis' step, while
+    /// the axis is in the caches, instead of when [`Executive::status`] reads it: for a caller
+    /// that reads every status after that step (a node's telemetry). The statuses are the same
+    /// (a status is that of the step until read: commands and registrations copy it before
+    /// they change the axis); only the time of the copy differs, and with a thousand axes the
+    /// first axes' state has left the caches by the end of the step.
+    pub fn want_status(&mut self) {
+        self.copy_status = true;
     }
 
     /// The status of axis `i` after the last step, as [`Executive::status`] has it.
@@ -1063,6 +1076,9 @@ impl<'c> Executive<'c> {
                 self.axes[i].step(t);
                 holds &= plan.planned_with(i, &self.axes[i]);
                 self.news[i] |= self.axes[i].has_events() || self.axes[i].alarm_pending();
+                if self.copy_status {
+                    self.status[i] = self.axes[i].status_value();
+                }
                 if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
                     last = None;
                 }
@@ -1075,6 +1091,9 @@ impl<'c> Executive<'c> {
                 self.axes[i].step(t);
                 holds &= plan.planned_with(i, &self.axes[i]);
                 self.news[i] |= self.axes[i].has_events() || self.axes[i].alarm_pending();
+                if self.copy_status {
+                    self.status[i] = self.axes[i].status_value();
+                }
             }
         }
         plan.valid &= holds;
@@ -1131,12 +1150,13 @@ impl<'c> Executive<'c> {
     /// The job events and new alarms of the owned axes; their status is copied when read.
     fn axis_events(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
+        let copied = std::mem::take(&mut self.copy_status);
         for (i, axis) in self.axes.iter_mut().enumerate() {
             if !self.owned.axes[i] {
                 continue;
             }
-            // Its status is copied when read.
-            self.stale[i] = true;
+            // Its status is copied when read, unless the step copied it (the axes it stepped).
+            self.stale[i] = !(copied && self.due[self.node_of[i]]);
             // Without job events nor a pending alarm since the last step, nor alarms seen then,
             // there is nothing to log (and the axis is not looked at).
             if !std::mem::take(&mut self.news[i]) {
