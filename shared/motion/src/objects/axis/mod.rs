@@ -312,6 +312,10 @@ pub struct Axis {
     lead: [Option<crate::objects::leading::LeadingValue>; 2],
     /// Whether `status` holds the status (so that a cycle need not look at it).
     status_kept: Cell<bool>,
+    /// The drive (every cycle samples and steps it) and the configuration (its per-cycle
+    /// fields first), next to the state so that a cycle's lines are mostly consecutive.
+    link: DriveLink,
+    cfg: AxisConfig,
     sync_pending: Option<sync::SyncJob>,
     sync: Option<sync::SyncJob>,
     prof: Profile,
@@ -326,8 +330,6 @@ pub struct Axis {
     sup_prof: Profile,
     phasing_prof: Profile,
     offset_prof: Profile,
-    cfg: AxisConfig,
-    link: DriveLink,
     /// The actual value prepared for actual-value coupling (run only while a follower may use
     /// it: [`Axis::set_actual_value_output`]).
     extrapolator: Extrapolator,
