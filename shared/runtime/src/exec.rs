@@ -173,11 +173,14 @@ struct LeaderRead {
     source: Option<LeaderSource>,
 }
 
-/// One owned axis in the step order, with the leaders it reads.
+/// One owned axis in the step order, with the leaders it reads: `reads` entries of
+/// [`StepPlan::reads`] from `first` (12 bytes: the step reads the order of a thousand axes
+/// every cycle, and most axes read no leader).
 #[derive(Debug, Clone, Copy)]
 struct Planned {
-    axis: usize,
-    reads: [Option<LeaderRead>; 2],
+    axis: u32,
+    first: u32,
+    reads: u32,
 }
 
 /// The order in which the owned axes step, and where each reads its leaders, planned from the
@@ -188,6 +191,8 @@ struct StepPlan {
     leaders: Vec<[Option<LeaderId>; 2]>,
     /// Owned axes, leaders before their followers, with the leaders each reads.
     order: Vec<Planned>,
+    /// The leaders the axes of `order` read, in that order.
+    reads: Vec<LeaderRead>,
     /// Owned axes caught in a coupling loop: stepped last, without leading values.
     unreached: Vec<usize>,
     /// Per axis: taken into `order` (while planning).
@@ -203,6 +208,7 @@ impl StepPlan {
         Self {
             leaders: Vec::with_capacity(n),
             order: Vec::with_capacity(n),
+            reads: Vec::with_capacity(2 * n),
             unreached: Vec::with_capacity(n),
             taken: vec![false; n],
             valid: false,
@@ -1058,8 +1064,13 @@ impl<'c> Executive<'c> {
         // Every axis is due when every node is (one node, or the cycles meet).
         let all_due = self.due.iter().all(|d| *d);
         for p in &plan.order {
-            let i = p.axis;
-            for read in p.reads.iter().flatten() {
+            let i = p.axis as usize;
+            let (first, n) = (p.first as usize, p.reads as usize);
+            let reads = match n {
+                0 => &[],
+                _ => plan.reads.get(first..first + n).unwrap_or(&[]),
+            };
+            for read in reads {
                 let lv = match read.source {
                     Some(src) if src.buffer.is_none() => match last {
                         Some((s, v)) if s == src => v,
@@ -1126,6 +1137,7 @@ impl<'c> Executive<'c> {
         let n_axes = self.axes.len();
         let mut plan = std::mem::take(&mut self.plan);
         plan.order.clear();
+        plan.reads.clear();
         plan.unreached.clear();
         plan.leaders.clear();
         plan.leaders.extend(self.axes.iter().map(Axis::leaders));
@@ -1145,13 +1157,19 @@ impl<'c> Executive<'c> {
                 if !ready {
                     continue;
                 }
-                let reads = needs.map(|l| {
-                    l.map(|id| LeaderRead {
+                // (Within the capacity of two reads per axis: no allocation. Indices of axes
+                // and reads fit in u32: a cell's axes are counted in thousands.)
+                let first = plan.reads.len() as u32;
+                plan.reads
+                    .extend(needs.iter().flatten().map(|&id| LeaderRead {
                         id,
                         source: cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
-                    })
+                    }));
+                plan.order.push(Planned {
+                    axis: i as u32,
+                    first,
+                    reads: plan.reads.len() as u32 - first,
                 });
-                plan.order.push(Planned { axis: i, reads });
                 taken[i] = true;
                 progress = true;
             }
