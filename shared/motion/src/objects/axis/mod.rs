@@ -265,9 +265,10 @@ struct Power {
 /// writes lies together (a node steps a thousand axes a millisecond: their state does not stay
 /// in the caches between two cycles): the job events' counts (at the end of the queue), the
 /// state, the running jobs and the synchronous jobs' discriminants; then what followers and
-/// running jobs read; then what is read seldom.
+/// running jobs read; then what is read seldom. Aligned to a cache line, so that every axis of
+/// a `Vec` has the same lines (and no axis shares one with the next).
 #[derive(Clone, Debug)]
-#[repr(C)]
+#[repr(C, align(64))]
 pub struct Axis {
     /// Job events (their counts last: next to the state below).
     events: EventQueue,
