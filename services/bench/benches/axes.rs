@@ -432,10 +432,15 @@ fn engine_only(
             // The bench checks the node's run for rejections; here only the time counts.
             let _ = exec.apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log);
         }
+        // As the node: the step copies the statuses the telemetry reads after it.
+        let read = run.read_status.is_some_and(|n| k % n.max(1) == 0);
+        if read {
+            exec.want_status();
+        }
         exec.step(t, &mut log).map_err(|e| e.to_string())?;
         exec.drain_job_notes(|_| {});
         exec.drain_io_notes(|_| {});
-        if run.read_status.is_some_and(|n| k % n.max(1) == 0) {
+        if read {
             read_statuses(&mut exec);
         }
         let (cpu1, t1) = (rt::thread_cpu_ns(), rt::now_ns());

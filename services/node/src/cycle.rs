@@ -267,8 +267,14 @@ impl<'c> NodeCycle<'c> {
         }
     }
 
-    /// Step: the technology objects, as `tandem sim` steps them.
+    /// Step: the technology objects, as `tandem sim` steps them. When the record stage reads
+    /// every status after it (a telemetry snapshot, a trace row), the step copies each axis'
+    /// status while the axis is in the caches.
     fn step(&mut self, t: i64) {
+        let h = &self.health;
+        if h.cycles % h.telemetry_every.max(1) == 0 || self.links.rows.is_some() {
+            self.exec.want_status();
+        }
         if self.exec.step(t, &mut self.log).is_err() {
             self.health.step_errors += 1;
         }

@@ -175,11 +175,14 @@ struct LeaderRead {
     source: Option<LeaderSource>,
 }
 
-/// One owned axis in the step order, with the leaders it reads.
+/// One owned axis in the step order, with the leaders it reads: `reads` entries of
+/// [`StepPlan::reads`] from `first` (12 bytes: the step reads the order of a thousand axes
+/// every cycle, and most axes read no leader).
 #[derive(Debug, Clone, Copy)]
 struct Planned {
-    axis: usize,
-    reads: [Option<LeaderRead>; 2],
+    axis: u32,
+    first: u32,
+    reads: u32,
 }
 
 /// The order in which the owned axes step, and where each reads its leaders, planned from the
@@ -190,6 +193,8 @@ struct StepPlan {
     leaders: Vec<[Option<LeaderId>; 2]>,
     /// Owned axes, leaders before their followers, with the leaders each reads.
     order: Vec<Planned>,
+    /// The leaders the axes of `order` read, in that order.
+    reads: Vec<LeaderRead>,
     /// Owned axes caught in a coupling loop: stepped last, without leading values.
     unreached: Vec<usize>,
     /// Per axis: taken into `order` (while planning).
@@ -205,6 +210,7 @@ impl StepPlan {
         Self {
             leaders: Vec::with_capacity(n),
             order: Vec::with_capacity(n),
+            reads: Vec::with_capacity(2 * n),
             unreached: Vec::with_capacity(n),
             taken: vec![false; n],
             valid: false,
@@ -465,6 +471,8 @@ pub struct Executive<'c> {
     status: Vec<AxisStatus>,
     /// Per axis: `status` is older than the axis' last step (see [`Executive::snapshot`]).
     stale: Vec<bool>,
+    /// The step copies each axis' status right after stepping it ([`Executive::want_status`]).
+    copy_status: bool,
     /// Per axis: it may have job events or alarms to log (set when it steps with some, when it
     /// takes a command, and while alarms were seen); the others are not looked at.
     news: Vec<bool>,
@@ -553,6 +561,7 @@ impl<'c> Executive<'c> {
             last_cycle: status.clone(),
             status,
             stale: vec![false; cell.axes.len()],
+            copy_status: false,
             news: vec![false; cell.axes.len()],
             encoder_status,
             plan: StepPlan::with_capacity(axes.len()),
@@ -588,6 +597,16 @@ impl<'c> Executive<'c> {
             self.snapshot(i);
         }
         &self.status
+    }
+
+    /// The next step copies the status of each axis it steps right after the axis' step, while
+    /// the axis is in the caches, instead of when [`Executive::status`] reads it: for a caller
+    /// that reads every status after that step (a node's telemetry). The statuses are the same
+    /// (a status is that of the step until read: commands and registrations copy it before
+    /// they change the axis); only the time of the copy differs, and with a thousand axes the
+    /// first axes' state has left the caches by the end of the step.
+    pub fn want_status(&mut self) {
+        self.copy_status = true;
     }
 
     /// The status of axis `i` after the last step, as [`Executive::status`] has it.
@@ -1136,9 +1155,16 @@ impl<'c> Executive<'c> {
         // leader come one after another, and the value changes only when the leader steps.
         let mut last: Option<(LeaderSource, Option<LeadingValue>)> = None;
         let mut holds = true;
+        // Every axis is due when every node is (one node, or the cycles meet).
+        let all_due = self.due.iter().all(|d| *d);
         for p in &plan.order {
-            let i = p.axis;
-            for read in p.reads.iter().flatten() {
+            let i = p.axis as usize;
+            let (first, n) = (p.first as usize, p.reads as usize);
+            let reads = match n {
+                0 => &[],
+                _ => plan.reads.get(first..first + n).unwrap_or(&[]),
+            };
+            for read in reads {
                 let lv = match read.source {
                     Some(src) if src.buffer.is_none() => match last {
                         Some((s, v)) if s == src => v,
@@ -1151,28 +1177,51 @@ impl<'c> Executive<'c> {
                     Some(src) => self.leading_value(src, t),
                     None => None,
                 };
-                self.axes[i].set_leading_value(read.id, lv);
+                if let Some(a) = self.axes.get_mut(i) {
+                    a.set_leading_value(read.id, lv);
+                }
             }
-            if self.due[self.node_of[i]] {
-                self.axes[i].step(t);
-                holds &= plan.planned_with(i, &self.axes[i]);
-                self.news[i] |= self.axes[i].has_events() || self.axes[i].alarm_pending();
+            if all_due || self.due[self.node_of[i]] {
+                holds &= self.step_axis(i, t, &plan);
                 if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
                     last = None;
                 }
+            } else if let Some(stale) = self.stale.get_mut(i) {
+                // Not stepped: its status is copied when read (a command may have changed it).
+                *stale = true;
             }
         }
         // Not empty only with a coupling loop, which commands cannot create (16#8019): the
         // axis then runs without its leading value and raises "leader missing".
         for &i in &plan.unreached {
-            if self.due[self.node_of[i]] {
-                self.axes[i].step(t);
-                holds &= plan.planned_with(i, &self.axes[i]);
-                self.news[i] |= self.axes[i].has_events() || self.axes[i].alarm_pending();
+            if all_due || self.due[self.node_of[i]] {
+                holds &= self.step_axis(i, t, &plan);
+            } else if let Some(stale) = self.stale.get_mut(i) {
+                *stale = true;
             }
         }
+        self.copy_status = false;
         plan.valid &= holds;
         self.plan = plan;
+    }
+
+    /// Steps owned axis `i` at `t` and notes what the step changed: job events or alarms to
+    /// look at, its status (copied now when [`Executive::want_status`] asked, else stale: copied
+    /// when read). Whether the axis still has the leaders `plan` was made with.
+    // Inlined into both loops of `step_axes` (called out of line it costs 20 instructions per
+    // axis more: the loops' state spills around the call).
+    #[inline(always)]
+    fn step_axis(&mut self, i: usize, t: i64, plan: &StepPlan) -> bool {
+        let Some(axis) = self.axes.get_mut(i) else {
+            return true;
+        };
+        axis.step(t);
+        self.news[i] |= axis.has_events() || axis.alarm_pending();
+        if self.copy_status {
+            self.status[i] = axis.status_value();
+        }
+        self.stale[i] = !self.copy_status;
+        plan.planned_with(i, axis)
     }
 
     /// Plans the order of the owned axes from their current leaders: passes over the axes in
@@ -1182,6 +1231,7 @@ impl<'c> Executive<'c> {
         let n_axes = self.axes.len();
         let mut plan = std::mem::take(&mut self.plan);
         plan.order.clear();
+        plan.reads.clear();
         plan.unreached.clear();
         plan.leaders.clear();
         plan.leaders.extend(self.axes.iter().map(Axis::leaders));
@@ -1201,13 +1251,19 @@ impl<'c> Executive<'c> {
                 if !ready {
                     continue;
                 }
-                let reads = needs.map(|l| {
-                    l.map(|id| LeaderRead {
+                // (Within the capacity of two reads per axis: no allocation. Indices of axes
+                // and reads fit in u32: a cell's axes are counted in thousands.)
+                let first = plan.reads.len() as u32;
+                plan.reads
+                    .extend(needs.iter().flatten().map(|&id| LeaderRead {
                         id,
                         source: cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
-                    })
+                    }));
+                plan.order.push(Planned {
+                    axis: i as u32,
+                    first,
+                    reads: plan.reads.len() as u32 - first,
                 });
-                plan.order.push(Planned { axis: i, reads });
                 taken[i] = true;
                 progress = true;
             }
@@ -1222,15 +1278,14 @@ impl<'c> Executive<'c> {
         self.plan = plan;
     }
 
-    /// The job events and new alarms of the owned axes; their status is copied when read.
+    /// The job events and new alarms of the owned axes (their status was marked in
+    /// [`Executive::step_axes`]).
     fn axis_events(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
         for (i, axis) in self.axes.iter_mut().enumerate() {
             if !self.owned.axes[i] {
                 continue;
             }
-            // Its status is copied when read.
-            self.stale[i] = true;
             // Without job events nor a pending alarm since the last step, nor alarms seen then,
             // there is nothing to log (and the axis is not looked at).
             if !std::mem::take(&mut self.news[i]) {

@@ -101,14 +101,24 @@ pub struct Actual {
     pub balanced: f64,
 }
 
+/// Setpoints of the history kept in the drive itself: the position-loop model and a delay
+/// model without delay need two; other delays keep theirs on the heap. (Inline, the history
+/// of most axes shares the cache lines of the drive's state instead of needing a line of its
+/// own every cycle, and the ring of two is indexed `head ^ back`, without a division.)
+const INLINE_HISTORY: usize = 2;
+
 /// The simulated drive of one axis.
 #[derive(Clone, Debug)]
 pub struct SimDrive {
     model: DriveModel,
     cycle: f64,
     stop_deceleration: f64,
-    /// Setpoint history (p, v) for the delay model and the balancing dead time, newest last.
-    hist: Vec<(f64, f64)>,
+    /// Setpoint history (p, v) for the delay model and the balancing dead time, a ring of `n`
+    /// entries with the newest at `head`: in `inline` for up to [`INLINE_HISTORY`] entries,
+    /// else in `heap`.
+    inline: [(f64, f64); INLINE_HISTORY],
+    heap: Vec<(f64, f64)>,
+    n: usize,
     head: usize,
     p: f64,
     v: f64,
@@ -126,12 +136,19 @@ impl SimDrive {
         let n = match model {
             DriveModel::Delay { delay } => (delay / cycle).ceil() as usize + 2,
             DriveModel::PositionLoop { .. } => 2,
-        };
+        }
+        .max(2);
         Self {
             model,
             cycle,
             stop_deceleration,
-            hist: vec![(p0, 0.0); n.max(2)],
+            inline: [(p0, 0.0); INLINE_HISTORY],
+            heap: if n > INLINE_HISTORY {
+                vec![(p0, 0.0); n]
+            } else {
+                Vec::new()
+            },
+            n,
             head: 0,
             p: p0,
             v: 0.0,
@@ -142,6 +159,15 @@ impl SimDrive {
                 DriveModel::PositionLoop { t_vtc, .. } if t_vtc > 0.0 => (-cycle / t_vtc).exp(),
                 _ => 0.0,
             },
+        }
+    }
+
+    /// The setpoint history to write, `n` entries.
+    fn history_mut(&mut self) -> &mut [(f64, f64)] {
+        if self.n > INLINE_HISTORY {
+            &mut self.heap
+        } else {
+            &mut self.inline
         }
     }
 
@@ -159,9 +185,37 @@ impl SimDrive {
         self.prev_p
     }
 
+    /// The setpoint `back` cycles before the newest (the ring index without a division).
     fn hist_at(&self, back: usize) -> (f64, f64) {
-        let n = self.hist.len();
-        self.hist[(self.head + n - (back % n)) % n]
+        if self.n <= INLINE_HISTORY {
+            // Two entries: the other one is the older.
+            return self.inline[(self.head ^ back) & 1];
+        }
+        let n = self.n;
+        let back = if back < n { back } else { back % n };
+        let i = if self.head >= back {
+            self.head - back
+        } else {
+            self.head + n - back
+        };
+        self.heap.get(i).copied().unwrap_or_default()
+    }
+
+    /// Makes `sp` the newest setpoint of the history.
+    fn push(&mut self, sp: (f64, f64)) {
+        if self.n <= INLINE_HISTORY {
+            self.head ^= 1;
+            self.inline[self.head & 1] = sp;
+            return;
+        }
+        self.head = if self.head + 1 >= self.n {
+            0
+        } else {
+            self.head + 1
+        };
+        if let Some(h) = self.heap.get_mut(self.head) {
+            *h = sp;
+        }
     }
 
     /// Applies the setpoint `(p, v)` (physical) for one cycle and integrates the plant to the
@@ -171,9 +225,7 @@ impl SimDrive {
     pub fn step(&mut self, sp_p: f64, sp_v: f64, enabled: bool, position_controlled: bool) {
         let dt = self.cycle;
         self.prev_p = self.p;
-        let n = self.hist.len();
-        self.head = (self.head + 1) % n;
-        self.hist[self.head] = (sp_p, sp_v);
+        self.push((sp_p, sp_v));
         if !enabled {
             let dv = self.stop_deceleration * dt;
             let v1 = if self.v.abs() <= dv {
@@ -185,9 +237,8 @@ impl SimDrive {
             self.v = v1;
             self.v_cmd = v1;
             self.balanced = self.p;
-            for h in self.hist.iter_mut() {
-                *h = (self.p, 0.0);
-            }
+            let p = self.p;
+            self.history_mut().fill((p, 0.0));
             return;
         }
         match self.model {
@@ -233,9 +284,7 @@ impl SimDrive {
 
     /// Resets the plant to rest at `p` (for tests and restarts).
     pub fn reset(&mut self, p: f64) {
-        for h in self.hist.iter_mut() {
-            *h = (p, 0.0);
-        }
+        self.history_mut().fill((p, 0.0));
         self.p = p;
         self.prev_p = p;
         self.v = 0.0;
@@ -297,5 +346,63 @@ mod tests {
         // Constant velocity with full precontrol: the actual follows the balanced setpoint.
         assert!((a.balanced - a.p).abs() < 1e-6, "fe {}", a.balanced - a.p);
         assert!((a.v - 50.0).abs() < 1e-6);
+    }
+
+    /// The inline ring of two (position loop): the balanced setpoint passes the setpoint of
+    /// the cycle before through the velocity-loop model, bit for bit as the formula with the
+    /// previous setpoint kept by hand, also across a disable (which refills the history).
+    #[test]
+    fn position_loop_reads_the_previous_setpoint() {
+        let dt = 0.001;
+        let (kv, kpc, t_vtc) = (80.0, 0.9, 0.003);
+        let mut d = SimDrive::new(DriveModel::PositionLoop { kv, kpc, t_vtc }, dt, 500.0, 1.0);
+        let e = (-dt / t_vtc).exp();
+        let (mut p, mut v, mut v_cmd, mut balanced, mut prev_sp) = (1.0, 0.0, 0.0, 1.0, 1.0);
+        for k in 0..400 {
+            let sp = (1.0 + (k as f64 * 0.01).sin(), (k as f64 * 0.02).cos());
+            let enabled = !(200..210).contains(&k);
+            d.step(sp.0, sp.1, enabled, true);
+            if enabled {
+                let v1 = v_cmd + (v - v_cmd) * e;
+                p += v_cmd * dt + (v - v_cmd) * t_vtc * (1.0 - e);
+                v = v1;
+                balanced = prev_sp + (balanced - prev_sp) * e;
+                v_cmd = kpc * sp.1 + kv * (balanced - p);
+                prev_sp = sp.0;
+            } else {
+                let dv = 500.0 * dt;
+                let v1 = if v.abs() <= dv {
+                    0.0
+                } else {
+                    v - dv.copysign(v)
+                };
+                p += 0.5 * (v + v1) * dt;
+                v = v1;
+                v_cmd = v1;
+                balanced = p;
+                prev_sp = p;
+            }
+            let a = d.actual();
+            assert_eq!(
+                (a.p.to_bits(), a.v.to_bits(), a.balanced.to_bits()),
+                (p.to_bits(), v.to_bits(), balanced.to_bits()),
+                "cycle {k}"
+            );
+        }
+    }
+
+    /// The delay model without delay keeps its ring inline: the actual value is the newest
+    /// setpoint carried one cycle on.
+    #[test]
+    fn delay_model_without_delay_extrapolates_one_cycle() {
+        let dt = 0.001;
+        let mut d = SimDrive::new(DriveModel::Delay { delay: 0.0 }, dt, 10.0, 0.0);
+        for k in 0..50 {
+            let (sp_p, sp_v) = (k as f64 * 0.3, 300.0 - k as f64);
+            d.step(sp_p, sp_v, true, true);
+            let a = d.actual();
+            assert_eq!(a.p.to_bits(), (sp_p + sp_v * dt).to_bits(), "cycle {k}");
+            assert_eq!(a.v.to_bits(), sp_v.to_bits());
+        }
     }
 }

@@ -268,9 +268,10 @@ struct Power {
 /// writes lies together (a node steps a thousand axes a millisecond: their state does not stay
 /// in the caches between two cycles): the job events' counts (at the end of the queue), the
 /// state, the running jobs and the synchronous jobs' discriminants; then what followers and
-/// running jobs read; then what is read seldom.
+/// running jobs read; then what is read seldom. Aligned to a cache line, so that every axis of
+/// a `Vec` has the same lines (and no axis shares one with the next).
 #[derive(Clone, Debug)]
-#[repr(C)]
+#[repr(C, align(64))]
 pub struct Axis {
     /// Job events (their counts last: next to the state below).
     events: EventQueue,
@@ -317,6 +318,10 @@ pub struct Axis {
     lead: [Option<crate::objects::leading::LeadingValue>; 2],
     /// Whether `status` holds the status (so that a cycle need not look at it).
     status_kept: Cell<bool>,
+    /// The drive (every cycle samples and steps it) and the configuration (its per-cycle
+    /// fields first), next to the state so that a cycle's lines are mostly consecutive.
+    link: DriveLink,
+    cfg: AxisConfig,
     sync_pending: Option<sync::SyncJob>,
     sync: Option<sync::SyncJob>,
     prof: Profile,
@@ -331,8 +336,6 @@ pub struct Axis {
     sup_prof: Profile,
     phasing_prof: Profile,
     offset_prof: Profile,
-    cfg: AxisConfig,
-    link: DriveLink,
     /// The actual value prepared for actual-value coupling (run only while a follower may use
     /// it: [`Axis::set_actual_value_output`]).
     extrapolator: Extrapolator,
