@@ -31,6 +31,7 @@ mod commands;
 mod cycle;
 mod error;
 mod logring;
+mod lvhealth;
 mod ports;
 mod recorder;
 mod report;
