@@ -27,6 +27,7 @@
 //! }
 //! ```
 
+mod audit;
 mod commands;
 mod cycle;
 mod error;

@@ -330,6 +330,10 @@ pub struct CommandJson {
     /// Parameters by name: numbers, booleans, or names (leader `node/axis`, cam).
     #[serde(default)]
     pub params: serde_json::Map<String, serde_json::Value>,
+    /// Who sends it (docs/gateway.md, "Command rate"); a Zenoh attachment `sender=<name>`
+    /// does the same for a text payload.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sender: Option<String>,
 }
 
 /// A parameter of a [`CommandJson`] the command line cannot carry.

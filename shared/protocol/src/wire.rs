@@ -128,12 +128,20 @@ impl Text {
 /// A command for an object of a node: `<object> <instruction> [--param value]...`, parsed by
 /// the node with the script's instruction table.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.CommandRequest.v1")]
+#[type_name("tandem.CommandRequest.v2")]
 #[repr(C)]
 pub struct CommandRequest {
     /// The command line.
     pub text: Text,
+    /// Who sends it (v2): `tandem cmd` fills in `<user>@<machine>`, the gateway the sender a
+    /// Zenoh query names; empty counts as `anonymous`. The node rates, logs and audits
+    /// commands by it (docs/gateway.md, "Command rate", "Audit trail"). Not authenticated
+    /// until the mTLS work binds it to the certificate subject.
+    pub sender: Text,
 }
+
+/// The sender of a command with an empty [`CommandRequest::sender`].
+pub const ANONYMOUS: &str = "anonymous";
 
 /// [`CommandReply::outcome`]: accepted; an Execute-type instruction's job id is in `job`.
 pub const OUTCOME_ACCEPTED: u32 = 0;
