@@ -13,7 +13,9 @@
 //!   the cycle on the cell clock, so the numbers go on increasing across its restarts and a
 //!   forged number cannot lie beyond the time window;
 //! - its motion is not reachable from the last accepted sample within the leader's dynamic
-//!   limits ([`Refused::Jump`]).
+//!   limits ([`Refused::Jump`]): velocity beyond `MaxVelocity`, position beyond what that
+//!   velocity covers in the time between, velocity change beyond the acceleration limit, and
+//!   (setpoint coupling) position off the kinematics: `|p_b - p_a - v_a·Δt| > amax·Δt²/2`.
 //!
 //! No sample can lock the gate: the window follows the receiver's clock, and a leader that
 //! really jumped (homed with a new position, restarted at another position) is followed again
@@ -55,6 +57,10 @@ pub struct GateConfig {
     /// Largest plausible change of velocity per second (the largest of `MaxAcceleration`,
     /// `MaxDeceleration` and the emergency deceleration, times the slack; infinite: unchecked).
     pub max_acceleration: f64,
+    /// Check the position against the kinematics (setpoint coupling): with `|a| <= amax`
+    /// between two samples, `|p_b - p_a - v_a·Δt| <= amax·Δt²/2`. Off for an actual value,
+    /// whose filtered position and velocity need not agree so closely.
+    pub kinematic: bool,
 }
 
 impl GateConfig {
@@ -75,6 +81,7 @@ impl GateConfig {
             behind_ns: cycle_ns.saturating_mul(n),
             max_velocity,
             max_acceleration,
+            kinematic: true,
         }
     }
 }
@@ -98,13 +105,16 @@ pub fn gate_config(cell: &Cell, leader: Leader, coupling: Coupling) -> GateConfi
         }),
         Leader::Encoder(_) => (f64::INFINITY, f64::INFINITY),
     };
-    GateConfig::new(
-        cell.leader_cycle_ns(leader),
-        cell.leading(leader).tolerance_ns,
-        LEADING_BUFFER,
-        v,
-        a,
-    )
+    GateConfig {
+        kinematic: coupling == Coupling::Setpoint,
+        ..GateConfig::new(
+            cell.leader_cycle_ns(leader),
+            cell.leading(leader).tolerance_ns,
+            LEADING_BUFFER,
+            v,
+            a,
+        )
+    }
 }
 
 /// Why the gate refused a sample.
@@ -327,7 +337,9 @@ impl LeadingValueGate {
         let v_ok = b.v.abs() <= c.max_velocity + tol(b.v);
         let p_ok = (b.p - a.p).abs() <= c.max_velocity * dt + tol(b.p);
         let a_ok = (b.v - a.v).abs() <= c.max_acceleration * dt + tol(b.v);
-        v_ok && p_ok && a_ok
+        let k_ok = !c.kinematic
+            || (b.p - a.p - a.v * dt).abs() <= 0.5 * c.max_acceleration * dt * dt + tol(b.p);
+        v_ok && p_ok && a_ok && k_ok
     }
 
     /// The last accepted sample.
@@ -471,6 +483,24 @@ mod tests {
         assert!(matches!(g.check(1003 * MS, &s), Err(Refused::Jump { .. })));
         assert_eq!(g.check(1004 * MS, &at(1004, 50.0)), Ok(Verdict::Accepted));
         assert_eq!(g.counts.jump, 3);
+    }
+
+    #[test]
+    fn a_small_offset_off_the_kinematics_is_refused_even_after_a_few_cycles() {
+        let mut g = gate();
+        g.check(1000 * MS, &at(1000, 50.0)).unwrap();
+        // 4 ms later, 0.2 off the constant-velocity path: within MaxVelocity * 4 ms (0.4 above
+        // the 0.2 travelled), but more than amax·Δt²/2 = 0.008.
+        let mut s = at(1004, 50.0);
+        s.p += 0.2;
+        assert!(matches!(g.check(1004 * MS, &s), Err(Refused::Jump { .. })));
+        // Without the kinematic check (actual-value coupling) it passes.
+        let mut g = LeadingValueGate::new(GateConfig {
+            kinematic: false,
+            ..GateConfig::new(MS, 4 * MS, 256, 100.0, 1000.0)
+        });
+        g.check(1000 * MS, &at(1000, 50.0)).unwrap();
+        assert_eq!(g.check(1004 * MS, &s), Ok(Verdict::Accepted));
     }
 
     #[test]
