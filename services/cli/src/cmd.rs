@@ -18,6 +18,22 @@ use tracing::{debug, info_span};
 /// How long a node is given to answer a command (or the timeout, if shorter).
 const REPLY_WITHIN: Duration = Duration::from_secs(5);
 
+/// Who sends the commands of this process (docs/gateway.md, "Command rate"): `$TANDEM_SENDER`
+/// if set, else `<user>@<machine>`. Not authenticated: the mTLS work binds it to the
+/// certificate's subject.
+pub fn sender() -> String {
+    if let Ok(s) = std::env::var("TANDEM_SENDER") {
+        if !s.trim().is_empty() {
+            return s;
+        }
+    }
+    let user = std::env::var("USER").unwrap_or_else(|_| "unknown".to_string());
+    let machine = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|h| h.trim().to_string())
+        .unwrap_or_else(|_| "localhost".to_string());
+    format!("{user}@{machine}")
+}
+
 /// What `tandem cmd` sends and how it waits.
 #[derive(Debug, Clone)]
 pub struct CmdRequest {
@@ -120,6 +136,7 @@ impl Ports {
             .client
             .send_copy(CommandRequest {
                 text: Text::new(text),
+                sender: Text::new(&sender()),
             })
             .map_err(CliError::port("sending the command"))?;
         let within = REPLY_WITHIN.min(timeout);

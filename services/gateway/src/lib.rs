@@ -53,7 +53,8 @@ use tandem_config::{Cell, Coupling, Leader};
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
 use tandem_protocol::keys;
-use tandem_protocol::wire::{CommandRequest, Text, EVENT_JOB, EVENT_LOG};
+use tandem_protocol::rate::SenderRates;
+use tandem_protocol::wire::{CommandRequest, Text, ANONYMOUS, EVENT_JOB, EVENT_LOG};
 use tandem_rt as rt;
 use tracing::{debug, error, info, warn};
 use zenoh::qos::{CongestionControl, Priority};
@@ -82,6 +83,10 @@ pub struct Counters {
     pub malformed: AtomicU64,
     /// Command queries answered.
     pub commands: AtomicU64,
+    /// Command queries answered `busy` because their sender exceeded its rate.
+    pub commands_busy: AtomicU64,
+    /// Zenoh samples on the key of a leader this host publishes (a forged copy): dropped.
+    pub lv_forged: AtomicU64,
     /// Largest clock offset to another host seen in the last round (ns, absolute).
     pub clock_offset_ns: AtomicI64,
     /// Clock offsets above the warning threshold.
@@ -436,6 +441,12 @@ fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
             .map_err(GatewayError::port("publisher"))?;
         publishers.push((cell.leader_name(*l), actual, *l, p));
     }
+    // The leaders this host publishes: a sample of one from another host is forged.
+    let local: Vec<(&str, bool)> = plan
+        .out
+        .iter()
+        .map(|(l, cp, _)| (cell.leader_name(*l), *cp == Coupling::Actual))
+        .collect();
     // Every leading value of the cell, so that a malformed one on any lv key is counted.
     let sub = session
         .declare_subscriber(keys::leading_values(&cell.name))
@@ -457,6 +468,12 @@ fn lv_in(x: &Ctx) -> Result<(), GatewayError> {
             .iter()
             .find(|(n, a, _, _)| *n == leader && *a == actual)
         else {
+            if local.iter().any(|(n, a)| *n == leader && *a == actual) {
+                // A remote copy of a leader this host publishes: forged, never bridged.
+                c.lv_forged.fetch_add(1, Ordering::Relaxed);
+                debug!(key, "a leader of this host, from another: dropped");
+                continue;
+            }
             // A leader nobody here follows: not ours to forward (but still checked).
             if decoded.is_err() {
                 c.malformed.fetch_add(1, Ordering::Relaxed);
@@ -492,7 +509,8 @@ type CommandClient = iceoryx2::port::client::Client<
 fn commands(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "commands")?;
-    let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(64);
+    let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(COMMAND_QUEUE);
+    let mut rates = SenderRates::new(cell.command_rate_hz, cell.command_burst);
     let mut queryables = Vec::new();
     let mut clients: HashMap<String, CommandClient> = HashMap::new();
     for n in &plan.nodes {
@@ -502,8 +520,16 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
             session
                 .declare_queryable(keys::commands(&cell.name, name))
                 .callback(move |q| {
-                    // A full queue drops the query: its sender gets no reply and times out.
-                    let _ = tx.try_send(q);
+                    // Never dropped unanswered: a full queue answers `busy` at once.
+                    if let Err(mpsc::TrySendError::Full(q)) = tx.try_send(q) {
+                        reply_json(
+                            &q,
+                            &ReplyJson::failed(
+                                "busy",
+                                "the gateway's command queue is full; try again".to_string(),
+                            ),
+                        );
+                    }
                 })
                 .wait()
                 .map_err(GatewayError::zenoh("queryable"))?,
@@ -521,22 +547,64 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
             continue;
         };
         c.commands.fetch_add(1, Ordering::Relaxed);
-        let reply = answer(&q, cell, host, &clients, c);
-        let body = serde_json::to_string(&reply).unwrap_or_default();
-        if let Err(e) = q.reply(q.key_expr().clone(), body).wait() {
-            warn!(key = q.key_expr().as_str(), error = %e, "the reply to a command query could not be sent");
-        }
+        let sender = query_sender(&q);
+        let reply = if rates.admit(&sender, tandem_rt::now_ns()) {
+            answer(&q, (cell, host), &sender, &clients, c)
+        } else {
+            c.commands_busy.fetch_add(1, Ordering::Relaxed);
+            ReplyJson::failed(
+                "busy",
+                format!(
+                    "busy: more than {} commands per second from `{sender}`; try again",
+                    cell.command_rate_hz
+                ),
+            )
+        };
+        reply_json(&q, &reply);
     }
     drop(queryables);
     Ok(())
+}
+
+/// Queries waiting for the command thread; more are answered `busy` at once.
+const COMMAND_QUEUE: usize = 4096;
+
+/// Sends `reply` to query `q` (a failure is logged: the querier times out).
+fn reply_json(q: &zenoh::query::Query, reply: &ReplyJson) {
+    let body = serde_json::to_string(reply).unwrap_or_default();
+    if let Err(e) = q.reply(q.key_expr().clone(), body).wait() {
+        warn!(key = q.key_expr().as_str(), error = %e, "the reply to a command query could not be sent");
+    }
+}
+
+/// Who sends query `q`: its attachment `sender=<name>`, else the `sender` of its JSON payload,
+/// else `anonymous` (docs/gateway.md, "Command rate"; not authenticated: Zenoh 1.x tells a
+/// queryable nothing of the querier, the mTLS work binds it to the certificate subject).
+fn query_sender(q: &zenoh::query::Query) -> String {
+    let from_attachment = q.attachment().and_then(|a| {
+        a.try_to_string()
+            .ok()
+            .and_then(|t| t.strip_prefix("sender=").map(|s| s.trim().to_string()))
+    });
+    let from_json = || {
+        q.payload()
+            .and_then(|p| p.try_to_string().ok().map(|t| t.to_string()))
+            .filter(|t| t.trim_start().starts_with('{'))
+            .and_then(|t| serde_json::from_str::<json::CommandJson>(&t).ok())
+            .and_then(|c| c.sender)
+    };
+    from_attachment
+        .or_else(from_json)
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| ANONYMOUS.to_string())
 }
 
 /// The reply to one command query, in a `command` span (node, object, instruction, job):
 /// the node's, or why it was not forwarded.
 fn answer(
     q: &zenoh::query::Query,
-    cell: &Cell,
-    host: &str,
+    (cell, host): (&Cell, &str),
+    sender: &str,
     clients: &HashMap<String, CommandClient>,
     c: &Counters,
 ) -> ReplyJson {
@@ -547,6 +615,7 @@ fn answer(
     };
     let span = tracing::info_span!(
         "command",
+        sender,
         node = node_name,
         object,
         instruction = tracing::field::Empty,
@@ -566,7 +635,7 @@ fn answer(
             "invalid",
             format!("node `{node_name}` is not on host `{host}`"),
         ),
-        (Ok(line), Some(client)) => forward(client, &format!("{object} {line}")),
+        (Ok(line), Some(client)) => forward(client, &format!("{object} {line}"), sender),
     };
     span.record("job", reply.job);
     debug!(
@@ -594,9 +663,10 @@ fn command_line(q: &zenoh::query::Query) -> Result<String, String> {
 }
 
 /// Sends one command line to a node and waits up to 5 s for its reply.
-fn forward(client: &CommandClient, line: &str) -> ReplyJson {
+fn forward(client: &CommandClient, line: &str, sender: &str) -> ReplyJson {
     let pending = match client.send_copy(CommandRequest {
         text: Text::new(line),
+        sender: Text::new(sender),
     }) {
         Ok(p) => p,
         Err(e) => return ReplyJson::failed("unreachable", format!("sending to the node: {e}")),
@@ -802,6 +872,8 @@ fn put_counters(session: &zenoh::Session, cell: &Cell, host: &str, c: &Counters)
         "lv_in": c.lv_in.load(Ordering::Relaxed),
         "malformed": c.malformed.load(Ordering::Relaxed),
         "commands": c.commands.load(Ordering::Relaxed),
+        "commands_busy": c.commands_busy.load(Ordering::Relaxed),
+        "lv_forged": c.lv_forged.load(Ordering::Relaxed),
         "clock_offset_us": c.clock_offset_ns.load(Ordering::Relaxed) as f64 * 1e-3,
         "clock_warnings": c.clock_warnings.load(Ordering::Relaxed),
     });

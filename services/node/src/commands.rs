@@ -2,6 +2,7 @@
 //! off the cyclic path, queues them for the cyclic thread and answers each with its result.
 //! Each command runs in a `command` span (object, instruction, job).
 
+use crate::audit::Audit;
 use crate::error::NodeError;
 use crate::owns;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -12,7 +13,10 @@ use tandem_config::Cell;
 use tandem_protocol::ipc;
 use tandem_protocol::json::error_id_text;
 use tandem_protocol::names;
-use tandem_protocol::wire::{CommandReply, Text, OUTCOME_ACCEPTED, OUTCOME_BUSY, OUTCOME_INVALID};
+use tandem_protocol::rate::SenderRates;
+use tandem_protocol::wire::{
+    CommandReply, CommandRequest, Text, ANONYMOUS, OUTCOME_ACCEPTED, OUTCOME_BUSY, OUTCOME_INVALID,
+};
 use tandem_rt as rt;
 use tracing::{debug, info, info_span, warn, Span};
 
@@ -97,6 +101,57 @@ fn log_reply(span: &Span, reply: &CommandReply) {
     }
 }
 
+/// A command queued for the cycle, waiting for its result.
+struct Pending {
+    id: u64,
+    active: ActiveRequest,
+    span: Span,
+    request: CommandRequest,
+}
+
+/// The server side of one command request.
+type ActiveRequest = iceoryx2::active_request::ActiveRequest<
+    iceoryx2::prelude::ipc::Service,
+    CommandRequest,
+    (),
+    CommandReply,
+    (),
+>;
+
+/// The entry of command `text` of `sender` if it is within the sender's rate and understood;
+/// otherwise it is answered (`busy` or `invalid`) and audited here.
+fn admit(
+    cell: &Cell,
+    node: &str,
+    (sender, text): (&str, &str),
+    rates: &mut SenderRates,
+    active: &ActiveRequest,
+    audit: &mut Audit,
+) -> Option<ScriptEntry> {
+    let refused = if !rates.admit(sender, rt::now_ns()) {
+        refusal(
+            OUTCOME_BUSY,
+            &format!(
+                "busy: more than {} commands per second from `{sender}`; try again",
+                cell.command_rate_hz
+            ),
+        )
+    } else {
+        match parse(cell, node, text) {
+            Ok(entry) => return Some(entry),
+            Err(m) => {
+                info!(command = text, sender, "not understood: {m}");
+                refusal(OUTCOME_INVALID, &m)
+            }
+        }
+    };
+    audit.record(sender, text, &refused);
+    if active.send_copy(refused).is_err() {
+        warn!(command = text, sender, "the reply could not be sent");
+    }
+    None
+}
+
 /// The command loop.
 fn serve(
     cell: &Cell,
@@ -117,35 +172,42 @@ fn serve(
         port,
     )
     .map_err(|e| NodeError::port(port, e))?;
-    let mut pending = Vec::new();
+    let n = cell.node(node);
+    let mut audit = Audit::open(n.and_then(|n| cell.node_retain_dir(n)));
+    let mut rates = SenderRates::new(cell.command_rate_hz, cell.command_burst);
+    let mut pending: Vec<Pending> = Vec::new();
     let mut id = 0u64;
     while !stop.load(Ordering::SeqCst) && !rt::termination_requested() {
         while let Ok(Some(active)) = server.receive() {
             id += 1;
-            let text = active.payload().text;
-            let text = text.as_str();
-            let entry = match parse(cell, node, text) {
-                Ok(entry) => entry,
-                Err(m) => {
-                    info!(command = text, "not understood: {m}");
-                    if active.send_copy(refusal(OUTCOME_INVALID, &m)).is_err() {
-                        warn!(command = text, "the reply could not be sent");
-                    }
-                    continue;
-                }
+            let req = *active.payload();
+            let sender = match req.sender.as_str() {
+                "" => ANONYMOUS,
+                s => s,
+            };
+            let text = req.text.as_str();
+            let Some(entry) = admit(cell, node, (sender, text), &mut rates, &active, &mut audit)
+            else {
+                continue;
             };
             let span = info_span!(
                 "command",
+                sender,
                 object = %entry.axis,
                 instruction = entry.instruction,
                 job = tracing::field::Empty
             );
             match links.queue.try_send(Queued { id, entry }) {
-                Ok(()) => pending.push((id, active, span)),
+                Ok(()) => pending.push(Pending {
+                    id,
+                    active,
+                    span,
+                    request: req,
+                }),
                 Err(TrySendError::Full(_)) => {
                     let _in = span.enter();
-                    warn!("the command queue is full");
                     let busy = refusal(OUTCOME_BUSY, "the node's command queue is full; try again");
+                    audit.record(sender, text, &busy);
                     if active.send_copy(busy).is_err() {
                         warn!("the reply could not be sent");
                     }
@@ -154,15 +216,21 @@ fn serve(
             }
         }
         while let Ok(d) = links.done.try_recv() {
-            if let Some(i) = pending.iter().position(|(x, _, _)| *x == d.id) {
-                let (_, active, span) = pending.swap_remove(i);
-                log_reply(&span, &d.reply);
-                if active.send_copy(d.reply).is_err() {
-                    let _in = span.enter();
+            if let Some(i) = pending.iter().position(|x| x.id == d.id) {
+                let p = pending.swap_remove(i);
+                log_reply(&p.span, &d.reply);
+                let sender = match p.request.sender.as_str() {
+                    "" => ANONYMOUS,
+                    s => s,
+                };
+                audit.record(sender, p.request.text.as_str(), &d.reply);
+                if p.active.send_copy(d.reply).is_err() {
+                    let _in = p.span.enter();
                     warn!("the reply could not be sent");
                 }
             }
         }
+        audit.sync();
         // Commands are for people and supervisors: 5 ms is well below what they notice
         // and costs a fraction of a per cent of a core.
         std::thread::sleep(Duration::from_millis(5));

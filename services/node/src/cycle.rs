@@ -200,7 +200,7 @@ impl<'c> NodeCycle<'c> {
                 cpu0 = Some((cpu_time_ns(), rt::thread_cpu_ns()));
             }
             let mut marks = [wake; 5];
-            self.receive();
+            self.receive(wake - clock.epoch);
             marks[1] = rt::now_ns();
             self.commands(t);
             marks[2] = rt::now_ns();
@@ -225,19 +225,19 @@ impl<'c> NodeCycle<'c> {
         (self.report, self.health)
     }
 
-    /// Receive: the samples other nodes published go into their leaders' buffers.
-    fn receive(&mut self) {
-        for x in &self.ports.leaders_in {
+    /// Receive: the samples other nodes published pass their leader's plausibility gate
+    /// (receiver's clock `now`, engine time) and go into their leaders' buffers; refusals are
+    /// counted by kind.
+    fn receive(&mut self, now: i64) {
+        for x in &mut self.ports.leaders_in {
             while let Ok(Some(sample)) = x.port.receive() {
-                if self
-                    .exec
-                    .feed(x.leader, x.coupling, sample.payload().to_sample())
-                    .is_err()
-                {
-                    self.health.samples_rejected += 1;
-                }
+                let s = sample.payload().to_sample();
+                let fed = x.gate.check(now, &s).is_ok()
+                    && self.exec.feed(x.leader, x.coupling, s).is_ok();
+                self.health.samples_rejected += u64::from(!fed);
             }
         }
+        crate::lvhealth::count(&self.ports.leaders_in, &mut self.health);
     }
 
     /// Commands: the queued commands, each answered, then the script entries due at `t`.
@@ -285,9 +285,10 @@ impl<'c> NodeCycle<'c> {
     /// recorder).
     fn publish(&mut self, t: i64) {
         let mut failed = 0u64;
+        // The sequence number is the cycle on the cell clock (docs/processes.md, "Refused samples").
+        let seq = u64::try_from(t / self.health.cycle_ns.max(1)).unwrap_or(0);
         for x in &mut self.ports.leaders_out {
-            let s = self.exec.sample(x.leader, x.coupling, t, x.seq);
-            x.seq += 1;
+            let s = self.exec.sample(x.leader, x.coupling, t, seq);
             let sample = LeadingValueSample::from_sample(x.id, &s);
             failed += u64::from(x.port.send_copy(sample).is_err());
         }

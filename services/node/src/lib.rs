@@ -27,10 +27,12 @@
 //! }
 //! ```
 
+mod audit;
 mod commands;
 mod cycle;
 mod error;
 mod logring;
+mod lvhealth;
 mod ports;
 mod recorder;
 mod report;

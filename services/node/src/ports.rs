@@ -11,6 +11,7 @@ use tandem_protocol::names;
 use tandem_protocol::wire::{
     AxisTelemetry, Event, IoEvent, LeadingValueSample, NodeHealth, SignalEvent,
 };
+use tandem_runtime::lvgate::{gate_config, LeadingValueGate};
 
 /// A publisher of an object's output edges or measured values.
 pub(crate) type IoPublisher = Publisher<Service, IoEvent, ()>;
@@ -26,8 +27,6 @@ pub(crate) struct LeaderOut {
     pub(crate) coupling: Coupling,
     /// The port.
     pub(crate) port: Publisher<Service, LeadingValueSample, ()>,
-    /// The sequence number of the next sample.
-    pub(crate) seq: u64,
 }
 
 /// A subscriber to one remote leader's leading values.
@@ -39,6 +38,8 @@ pub(crate) struct LeaderIn {
     pub(crate) coupling: Coupling,
     /// The port.
     pub(crate) port: Subscriber<Service, LeadingValueSample, ()>,
+    /// The plausibility gate every received sample passes before the buffer.
+    pub(crate) gate: LeadingValueGate,
 }
 
 /// The ports of the cyclic thread. Fields drop in order: the ports before their iceoryx2 node.
@@ -168,7 +169,6 @@ impl Ports {
                     id: cell.leader_id(l),
                     coupling: c,
                     port: created(svc.publisher_builder().create(), &port)?,
-                    seq: 0,
                 });
             }
         }
@@ -196,6 +196,7 @@ impl Ports {
             out.push(LeaderIn {
                 leader: l,
                 coupling: c,
+                gate: LeadingValueGate::new(gate_config(cell, l, c)),
                 port: created(
                     svc.subscriber_builder().buffer_size(history).create(),
                     &port,

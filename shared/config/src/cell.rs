@@ -523,6 +523,10 @@ pub struct Cell {
     pub telemetry_hz: f64,
     /// Clock-offset warning threshold, as a share of the smallest cross-host delay.
     pub clock_warning_fraction: f64,
+    /// Commands per second each sender may send, sustained (`[cell] command_rate_hz`).
+    pub command_rate_hz: f64,
+    /// Commands a sender may send at once above that rate (`[cell] command_burst`).
+    pub command_burst: u32,
     /// The directory of the retained data: `[cell] retain_dir` (default `retain`), relative to
     /// the cell file's directory (to the current directory for a cell parsed from text).
     /// A node's records are in [`Cell::node_retain_dir`].

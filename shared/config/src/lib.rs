@@ -117,6 +117,23 @@ emergency_deceleration = 2000.0
     }
 
     #[test]
+    fn the_command_rate_has_defaults_and_is_checked() {
+        let c = parse("cell.toml", GOOD).unwrap();
+        assert_eq!((c.command_rate_hz, c.command_burst), (20.0, 40));
+        let with = |k: &str| GOOD.replacen("[cell]\n", &format!("[cell]\n{k}\n"), 1);
+        let c = parse("cell.toml", &with("command_rate_hz = 5.0")).unwrap();
+        assert_eq!(c.command_rate_hz, 5.0);
+        for (bad, key) in [
+            ("command_rate_hz = 0.0", "cell.command_rate_hz"),
+            ("command_rate_hz = 1e9", "cell.command_rate_hz"),
+            ("command_burst = 0", "cell.command_burst"),
+        ] {
+            let e = parse("cell.toml", &with(bad)).unwrap_err();
+            assert_eq!(e.key, key, "{bad}");
+        }
+    }
+
+    #[test]
     fn errors_name_file_line_and_key() {
         let bad = GOOD.replace("max_velocity = 100.0", "max_velocity = 0.0");
         let e = parse("cell.toml", &bad).unwrap_err();

@@ -577,6 +577,21 @@ pub struct CellSection {
     /// file's directory; default `retain`. Each node keeps its records in
     /// `<retain_dir>/<cell name>/<node name>/`.
     pub retain_dir: Option<String>,
+    /// Commands each sender may send per second, sustained (docs/gateway.md, "Command
+    /// rate"); more get the reply `busy`. Default 20.
+    #[serde(default = "default_command_rate_hz")]
+    pub command_rate_hz: f64,
+    /// Commands a sender may send at once above the sustained rate. Default 40.
+    #[serde(default = "default_command_burst")]
+    pub command_burst: u32,
+}
+
+fn default_command_rate_hz() -> f64 {
+    20.0
+}
+
+fn default_command_burst() -> u32 {
+    40
 }
 
 fn default_telemetry_hz() -> f64 {

@@ -220,6 +220,21 @@ pub struct Health {
     /// Trace rows dropped because the recorder was behind.
     #[serde(default)]
     pub trace_dropped: u64,
+    /// Leading-value samples refused as from the future.
+    #[serde(default)]
+    pub lv_future: u64,
+    /// Leading-value samples refused as older than the buffer keeps.
+    #[serde(default)]
+    pub lv_stale: u64,
+    /// Leading-value samples refused for their sequence number.
+    #[serde(default)]
+    pub lv_sequence: u64,
+    /// Leading-value samples refused as a jump beyond the leader's dynamic limits.
+    #[serde(default)]
+    pub lv_jump: u64,
+    /// Leaders followed again after a confirmed jump.
+    #[serde(default)]
+    pub lv_reanchored: u64,
 }
 
 impl Health {
@@ -246,6 +261,11 @@ impl Health {
             step_errors: h.step_errors,
             diag_dropped: h.diag_dropped,
             trace_dropped: h.trace_dropped,
+            lv_future: h.lv_future,
+            lv_stale: h.lv_stale,
+            lv_sequence: h.lv_sequence,
+            lv_jump: h.lv_jump,
+            lv_reanchored: h.lv_reanchored,
         }
     }
 }
@@ -310,6 +330,10 @@ pub struct CommandJson {
     /// Parameters by name: numbers, booleans, or names (leader `node/axis`, cam).
     #[serde(default)]
     pub params: serde_json::Map<String, serde_json::Value>,
+    /// Who sends it (docs/gateway.md, "Command rate"); a Zenoh attachment `sender=<name>`
+    /// does the same for a text payload.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sender: Option<String>,
 }
 
 /// A parameter of a [`CommandJson`] the command line cannot carry.

@@ -37,4 +37,5 @@ pub mod ipc;
 pub mod json;
 pub mod keys;
 pub mod names;
+pub mod rate;
 pub mod wire;

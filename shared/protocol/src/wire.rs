@@ -14,12 +14,14 @@ pub const LV_VALID: u32 = 1;
 /// One leading value of a leader (docs/processes.md, "Leading values"): at `t_ns` on the cell clock the leader was at
 /// (`p`, `v`, `a`). Positions are continuous; a modulo leader sends its modulo range with them.
 #[derive(Copy, Clone, Debug, PartialEq, ZeroCopySend)]
-#[type_name("tandem.LeadingValueSample.v1")]
+#[type_name("tandem.LeadingValueSample.v2")]
 #[repr(C)]
 pub struct LeadingValueSample {
     /// The time the value is valid for (ns, cell clock).
     pub t_ns: i64,
-    /// Sequence number, +1 per leader cycle.
+    /// Sequence number: the leader's cycle on the cell clock, `t_ns / cycle` (v2: so that it
+    /// goes on increasing across restarts of the publisher; receivers refuse a sample whose
+    /// number does not match its time, docs/processes.md "Refused samples").
     pub seq: u64,
     /// Position (continuous).
     pub p: f64,
@@ -126,12 +128,20 @@ impl Text {
 /// A command for an object of a node: `<object> <instruction> [--param value]...`, parsed by
 /// the node with the script's instruction table.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.CommandRequest.v1")]
+#[type_name("tandem.CommandRequest.v2")]
 #[repr(C)]
 pub struct CommandRequest {
     /// The command line.
     pub text: Text,
+    /// Who sends it (v2): `tandem cmd` fills in `<user>@<machine>`, the gateway the sender a
+    /// Zenoh query names; empty counts as `anonymous`. The node rates, logs and audits
+    /// commands by it (docs/gateway.md, "Command rate", "Audit trail"). Not authenticated
+    /// until the mTLS work binds it to the certificate subject.
+    pub sender: Text,
 }
+
+/// The sender of a command with an empty [`CommandRequest::sender`].
+pub const ANONYMOUS: &str = "anonymous";
 
 /// [`CommandReply::outcome`]: accepted; an Execute-type instruction's job id is in `job`.
 pub const OUTCOME_ACCEPTED: u32 = 0;
@@ -239,7 +249,7 @@ pub fn state_code(s: AxisState) -> u32 {
 
 /// A node's health, the header of each telemetry snapshot.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.NodeHealth.v2")]
+#[type_name("tandem.NodeHealth.v3")]
 #[repr(C)]
 pub struct NodeHealth {
     /// The cycle's engine time (ns); it runs on the cell clock at `epoch_ns + t_ns`.
@@ -260,7 +270,8 @@ pub struct NodeHealth {
     pub overruns: u64,
     /// Cycles run.
     pub cycles: u64,
-    /// Leading-value samples received that the buffer refused or that arrived out of order.
+    /// Leading-value samples refused: by the plausibility gate (every kind below and non-finite
+    /// values) or by the buffer.
     pub samples_rejected: u64,
     /// Leading values bridged by extrapolation because a sample was late.
     pub extrapolated: u64,
@@ -286,6 +297,17 @@ pub struct NodeHealth {
     pub trace_dropped: u64,
     /// Cycles between two telemetry snapshots (1: every cycle).
     pub telemetry_every: u64,
+    /// Leading-value samples refused as from the future (after the receiver's clock by more
+    /// than one leader cycle plus the tolerance).
+    pub lv_future: u64,
+    /// Samples refused as older than the buffer keeps.
+    pub lv_stale: u64,
+    /// Samples refused for a sequence number not matching their time or not increasing.
+    pub lv_sequence: u64,
+    /// Samples refused as a jump beyond the leader's dynamic limits.
+    pub lv_jump: u64,
+    /// Leaders followed again after a confirmed jump (three consistent samples).
+    pub lv_reanchored: u64,
 }
 
 /// One axis in a telemetry snapshot.

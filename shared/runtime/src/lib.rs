@@ -54,6 +54,7 @@ pub mod drives;
 mod error;
 pub mod exec;
 mod inputs;
+pub mod lvgate;
 mod notes;
 mod objects;
 mod outputs;

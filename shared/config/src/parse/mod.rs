@@ -197,6 +197,8 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         },
         telemetry_hz: raw.cell.telemetry_hz,
         clock_warning_fraction: raw.cell.clock_warning_fraction,
+        command_rate_hz: raw.cell.command_rate_hz,
+        command_burst: raw.cell.command_burst,
         retain_dir: dir
             .unwrap_or(Path::new(""))
             .join(raw.cell.retain_dir.as_deref().unwrap_or(DEFAULT_RETAIN_DIR)),
@@ -234,6 +236,19 @@ fn check_cell_section(cx: Ctx<'_>, raw: &CellFile) -> Result<(), ConfigError> {
         return Err(cx.at(
             &["cell", "clock_warning_fraction"],
             Problem::Invalid("must be a share above 0 and at most 1"),
+        ));
+    }
+    if !(c.command_rate_hz.is_finite() && c.command_rate_hz > 0.0 && c.command_rate_hz <= 10_000.0)
+    {
+        return Err(cx.at(
+            &["cell", "command_rate_hz"],
+            Problem::Invalid("must be a rate in Hz, above 0 and at most 10000"),
+        ));
+    }
+    if !(1..=100_000).contains(&c.command_burst) {
+        return Err(cx.at(
+            &["cell", "command_burst"],
+            Problem::Invalid("must be a number of commands from 1 to 100000"),
         ));
     }
     if c.retain_dir.as_deref().is_some_and(|d| d.trim().is_empty()) {
