@@ -164,14 +164,26 @@ mod tests {
             endpoint_address("tls/router.cell:1"),
             Some(("tls", "router.cell", 1))
         );
-        for bad in ["garbage", "tcp/10.0.0.1", "tcp/:7447", "tcp/a:70000", "/a:1"] {
+        for bad in [
+            "garbage",
+            "tcp/10.0.0.1",
+            "tcp/:7447",
+            "tcp/a:70000",
+            "/a:1",
+        ] {
             assert_eq!(endpoint_address(bad), None, "{bad}");
         }
         assert!(is_loopback("127.0.0.1") && is_loopback("::1") && is_loopback("localhost"));
         assert!(!is_loopback("10.0.0.1") && !is_loopback("0.0.0.0") && !is_loopback("::"));
         assert_eq!(common_name(Role::Operator, "alice"), "operator:alice");
         let s = Security::implied(Path::new("/c"));
-        assert_eq!(s.host_certificate("h1"), PathBuf::from("/c/pki/host-h1.pem"));
-        assert_eq!(s.host_private_key("h1"), PathBuf::from("/c/pki/host-h1.key"));
+        assert_eq!(
+            s.host_certificate("h1"),
+            PathBuf::from("/c/pki/host-h1.pem")
+        );
+        assert_eq!(
+            s.host_private_key("h1"),
+            PathBuf::from("/c/pki/host-h1.key")
+        );
     }
 }

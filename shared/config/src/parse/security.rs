@@ -46,10 +46,7 @@ pub(super) fn security(
                 _ => s.private_key = path,
             }
         }
-        for (key, names) in [
-            ("operators", &sec.operators),
-            ("observers", &sec.observers),
-        ] {
+        for (key, names) in [("operators", &sec.operators), ("observers", &sec.observers)] {
             for (i, n) in names.iter().enumerate() {
                 if !plain_name(n) || names[..i].contains(n) {
                     return Err(cx.at(&["security", key], Problem::NameTaken(n.clone())));
@@ -157,8 +154,16 @@ cycle_us = 1000
         )
         .unwrap_err();
         assert_eq!(e.key, "security.operators");
-        let e = parse("c.toml", &with("garbage", "\n[security]\nmode = \"plain\"\n")).unwrap_err();
-        assert!(e.to_string().contains("must be <protocol>/<address>:<port>"), "{e}");
+        let e = parse(
+            "c.toml",
+            &with("garbage", "\n[security]\nmode = \"plain\"\n"),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("must be <protocol>/<address>:<port>"),
+            "{e}"
+        );
     }
 
     #[test]
