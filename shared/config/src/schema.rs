@@ -626,8 +626,9 @@ fn default_ipc_budget_us() -> u64 {
 pub struct HostSection {
     /// Host name (`tandem up --host <name>`).
     pub name: String,
-    /// Zenoh endpoints its gateway listens on (`tcp/10.0.0.1:7447`); the other hosts' gateways
-    /// connect to them. Empty: multicast scouting finds the peers.
+    /// Zenoh endpoints its gateway listens on (`tls/10.0.0.1:7447`), exactly these; the other
+    /// hosts' gateways connect to them. Empty: it listens nowhere (it only dials); multicast
+    /// scouting only with `[security] multicast_scouting = true`.
     #[serde(default)]
     pub listen: Vec<String>,
 }
