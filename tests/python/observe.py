@@ -8,9 +8,17 @@ every edge of the nodes' signals (tandem/<cell>/<node>/<signal>/signal), in arri
 
   observe.py --cell line --connect tcp/10.0.0.1:7447 --seconds 4 \
       --command followers/feed "MC_Power" --command followers/feed "MC_MoveVelocity --velocity 50"
+
+A cell with [security] mode = "mtls" (docs/security.md) takes TLS endpoints and the client's
+certificate from `tandem certs`: --ca pki/ca.pem --cert pki/observer-hmi.pem --key
+pki/observer-hmi.key (or TANDEM_CA, TANDEM_CERT, TANDEM_KEY). With --ca alone the client dials
+without a certificate (what an outsider does: the gateways refuse it). With a certificate it
+subscribes to the observable keys one by one (the access control refuses `tandem/<cell>/**` as
+a whole); --subscribe KEY replaces them.
 """
 import argparse
 import json
+import os
 import sys
 import threading
 import time
@@ -26,13 +34,27 @@ def main():
     ap.add_argument("--command", nargs=2, action="append", default=[], metavar=("NODE/OBJECT", "TEXT"))
     ap.add_argument("--garbage", action="append", default=[], metavar="KEY",
                     help="put a malformed payload on this key first (the gateways must drop and count it)")
+    ap.add_argument("--ca", default=os.environ.get("TANDEM_CA"), help="the cell CA's certificate (mTLS)")
+    ap.add_argument("--cert", default=os.environ.get("TANDEM_CERT"), help="an operator's or observer's certificate")
+    ap.add_argument("--key", default=os.environ.get("TANDEM_KEY"), help="its private key")
+    ap.add_argument("--subscribe", action="append", default=[], metavar="KEY",
+                    help="subscribe to this key expression (repeatable) instead of the default")
     a = ap.parse_args()
 
     conf = zenoh.Config()
     conf.insert_json5("mode", '"peer"')
+    conf.insert_json5("listen/endpoints", "[]")
     if a.connect:
         conf.insert_json5("connect/endpoints", json.dumps(a.connect))
         conf.insert_json5("scouting/multicast/enabled", "false")
+    if a.ca:
+        conf.insert_json5("transport/link/protocols", json.dumps(["tls"]))
+        conf.insert_json5("scouting/gossip/enabled", "false")
+        conf.insert_json5("transport/link/tls/root_ca_certificate", json.dumps(a.ca))
+        if a.cert and a.key:
+            conf.insert_json5("transport/link/tls/enable_mtls", "true")
+            conf.insert_json5("transport/link/tls/connect_certificate", json.dumps(a.cert))
+            conf.insert_json5("transport/link/tls/connect_private_key", json.dumps(a.key))
     session = zenoh.open(conf)
 
     counts = {}
@@ -55,7 +77,12 @@ def main():
                 except ValueError:
                     signals.append({"malformed": True, "key": key})
 
-    sub = session.declare_subscriber(f"tandem/{a.cell}/**", on_sample)
+    c = a.cell
+    keys = a.subscribe or (
+        [f"tandem/{c}/*/*/state", f"tandem/{c}/*/health", f"tandem/{c}/*/*/events",
+         f"tandem/{c}/*/log", f"tandem/{c}/*/*/signal", f"tandem/{c}/gateway/*"]
+        if a.cert else [f"tandem/{c}/**"])
+    subs = [session.declare_subscriber(k, on_sample) for k in keys]
     t0 = time.monotonic()
     alive_events = []
 
@@ -84,7 +111,8 @@ def main():
 
     time.sleep(max(0.0, a.seconds - 1.5))
     alive = sorted(str(r.ok.key_expr) for r in session.liveliness().get(f"tandem/{a.cell}/alive/*", timeout=2.0) if r.ok is not None)
-    sub.undeclare()
+    for sub in subs:
+        sub.undeclare()
     alive_sub.undeclare()
     with lock:
         summary = {

@@ -740,7 +740,8 @@ deceleration = 3000.0\njerk = 30000.0\nemergency_deceleration = 8000.0\n";
 /// The two-host cell: leader `ping` on `na` (hA) followed on hB, leader `pong` on `nb` (hB)
 /// followed on hA.
 fn cell_toml(name: &str, addr: &[String; 2]) -> String {
-    let mut s = format!("[cell]\nname = \"{name}\"\n\n");
+    // Plain TCP between the gateways, written out (docs/security.md).
+    let mut s = format!("[cell]\nname = \"{name}\"\n\n[security]\nmode = \"plain\"\n\n");
     for (h, a) in ["hA", "hB"].iter().zip(addr) {
         s.push_str(&format!(
             "[[hosts]]\nname = \"{h}\"\nlisten = [\"tcp/{a}:{GATEWAY_PORT}\"]\n\n"

@@ -179,6 +179,25 @@ pub enum CliError {
     Client(tandem_client::ClientError),
     /// `status --zenoh`: hosts whose gateways are not alive.
     HostsUnreachable(Vec<String>),
+    /// `certs`: a key or certificate could not be made.
+    CertGen {
+        /// Which (`the CA`, `host:h1`).
+        what: String,
+        /// What rcgen said.
+        source: rcgen::Error,
+    },
+    /// `certs`: a file could not be written.
+    CertWrite {
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// `certs`: the output directory has a CA already; a new one would orphan every certificate
+    /// it signed.
+    CertsExist(PathBuf),
+    /// `--cert` without `--key` (or the reverse), or a client certificate without the CA.
+    TlsIncomplete(&'static str),
 }
 
 impl CliError {
@@ -205,7 +224,9 @@ impl CliError {
             | Self::UnknownNode { .. }
             | Self::Command(_)
             | Self::Invalid(_)
-            | Self::Refused { .. } => 2,
+            | Self::Refused { .. }
+            | Self::CertsExist(_)
+            | Self::TlsIncomplete(_) => 2,
             Self::CreateTrace { .. }
             | Self::Sim(_)
             | Self::NotRunning { .. }
@@ -213,12 +234,14 @@ impl CliError {
             | Self::NoAnswer { .. }
             | Self::Busy(_)
             | Self::JobTimeout { .. }
-            | Self::HostsUnreachable(_) => 3,
+            | Self::HostsUnreachable(_)
+            | Self::CertWrite { .. } => 3,
             Self::Ipc(_)
             | Self::IpcPort { .. }
             | Self::UnknownOutcome(_)
             | Self::CannotStart { .. }
-            | Self::Runtime(_) => 4,
+            | Self::Runtime(_)
+            | Self::CertGen { .. } => 4,
             Self::Client(e) => match e {
                 C::Rejected { .. } | C::JobFailed { .. } => 1,
                 C::Invalid(_) => 2,
@@ -274,6 +297,17 @@ impl fmt::Display for CliError {
                 write!(f, "{}: cannot create: {source}", path.display())
             }
             Self::Sim(e) => write!(f, "{e}"),
+            Self::CertGen { what, source } => write!(f, "{what}: {source}"),
+            Self::CertWrite { path, source } => {
+                write!(f, "{}: cannot write: {source}", path.display())
+            }
+            Self::CertsExist(p) => write!(
+                f,
+                "{} exists: a new CA would orphan every certificate the old one signed; \
+                 give another --out, or remove it on purpose",
+                p.display()
+            ),
+            Self::TlsIncomplete(m) => f.write_str(m),
             Self::Strict {
                 rejected,
                 axes_in_alarm,

@@ -39,6 +39,7 @@ macro_rules! out {
     };
 }
 
+pub mod certs;
 pub mod cmd;
 pub mod error;
 pub mod live;
@@ -82,7 +83,8 @@ fn cli() -> Command {
                 .about("One snapshot of the running nodes of this host: axes and node health (with --zenoh: of every host, through the gateways)")
                 .arg(cell_arg())
                 .arg(Arg::new("host").long("host"))
-                .arg(zenoh_arg()),
+                .arg(zenoh_arg())
+                .args(tls_args()),
         )
         .subcommand(
             Command::new("watch")
@@ -98,6 +100,7 @@ fn cli() -> Command {
                 ),
         )
         .subcommand(cmd_command())
+        .subcommand(certs_command())
         .subcommand(
             Command::new("check")
                 .about("Validate a cell file; errors name file, line and key")
@@ -193,6 +196,7 @@ fn cmd_command() -> Command {
         .about("Send an instruction to an object of a running node: tandem cmd <node>/<object> <instruction> [--param value]... [--wait]")
         .arg(cell_arg())
         .arg(zenoh_arg())
+        .args(tls_args())
         .arg(Arg::new("target").required(true).help("<node>/<object>"))
         .arg(Arg::new("instruction").required(true).help("e.g. MC_MoveAbsolute, MoveVelocity, gear_in"))
         .arg(
@@ -247,6 +251,14 @@ fn dispatch(
     let host = m.get_one::<String>("host").map(String::as_str);
     match name {
         "check" => offline::check(required(m, "cell")?, out),
+        "certs" => certs::certs(
+            &certs::CertsOptions {
+                cell: required(m, "cell")?.clone(),
+                out: m.get_one::<PathBuf>("out").cloned(),
+                days: m.get_one::<u32>("days").copied().unwrap_or(365),
+            },
+            out,
+        ),
         "sim" => offline::sim(&sim_options(m)?, out, err),
         "up" => {
             let cell = required(m, "cell")?;
@@ -255,7 +267,7 @@ fn dispatch(
         "status" => {
             let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
             match zenoh_endpoints(m) {
-                Some(e) => remote::status_zenoh(&cell, &e, out),
+                Some(e) => remote::status_zenoh(&cell, &e, &tls(m), out),
                 None => live::status(&cell, host, out),
             }
         }
@@ -270,7 +282,7 @@ fn dispatch(
             let cell = live::cell_path(m.get_one::<PathBuf>("cell"))?;
             let request = cmd_request(m)?;
             match zenoh_endpoints(m) {
-                Some(e) => remote::cmd_zenoh(&cell, &e, &request, out),
+                Some(e) => remote::cmd_zenoh(&cell, &e, &tls(m), &request, out),
                 None => cmd::cmd(&cell, &request, out),
             }
         }
@@ -366,6 +378,49 @@ fn zenoh_endpoints(m: &clap::ArgMatches) -> Option<Vec<String>> {
             .map(|v| v.filter(|e| *e != "scout").cloned().collect())
             .unwrap_or_default(),
     )
+}
+
+/// `tandem certs`'s arguments.
+fn certs_command() -> Command {
+    Command::new("certs")
+        .about("Create the cell's CA and the certificates of its hosts, operators and observers for [security] mode = \"mtls\" (docs/security.md)")
+        .arg(Arg::new("cell").required(true).value_parser(clap::value_parser!(PathBuf)))
+        .arg(
+            Arg::new("out")
+                .long("out")
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("Directory to write into (default: the directory of the cell's [security] ca); it must not hold a CA yet"),
+        )
+        .arg(
+            Arg::new("days")
+                .long("days")
+                .value_parser(clap::value_parser!(u32).range(1..=3650))
+                .help("Validity of the certificates in days (default 365)"),
+        )
+}
+
+/// `--ca`, `--cert`, `--key`: the client certificate of `--zenoh` for a cell in mTLS mode.
+fn tls_args() -> [Arg; 3] {
+    let path = |name: &'static str, help: &'static str| {
+        Arg::new(name)
+            .long(name)
+            .value_parser(clap::value_parser!(PathBuf))
+            .help(help)
+    };
+    [
+        path("ca", "With --zenoh on an mTLS cell: the cell CA's certificate (default: $TANDEM_CA, else the cell's [security] ca)"),
+        path("cert", "With --zenoh on an mTLS cell: an operator's or observer's certificate (default: $TANDEM_CERT)"),
+        path("key", "With --zenoh on an mTLS cell: its private key (default: $TANDEM_KEY)"),
+    ]
+}
+
+/// The `--ca`, `--cert`, `--key` given.
+fn tls(m: &clap::ArgMatches) -> remote::TlsArgs {
+    remote::TlsArgs {
+        ca: m.get_one::<PathBuf>("ca").cloned(),
+        cert: m.get_one::<PathBuf>("cert").cloned(),
+        key: m.get_one::<PathBuf>("key").cloned(),
+    }
 }
 
 fn cell_arg() -> Arg {

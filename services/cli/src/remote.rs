@@ -6,10 +6,70 @@ use crate::error::CliError;
 use crate::live::{load, table_row, HEADER};
 use std::io::Write;
 use std::path::Path;
+use std::path::PathBuf;
 use std::time::Duration;
-use tandem_config::Cell;
+use tandem_config::{Cell, SecurityMode};
 use tandem_runtime::exec::Secs;
 use tracing::debug;
+
+/// The certificate of `--zenoh` for a cell in mTLS mode: `--ca`, `--cert`, `--key`, else
+/// `$TANDEM_CA`, `$TANDEM_CERT`, `$TANDEM_KEY`; the CA defaults to the cell's `[security] ca`.
+#[derive(Debug, Clone, Default)]
+pub struct TlsArgs {
+    /// The cell CA's certificate.
+    pub ca: Option<PathBuf>,
+    /// An operator's or observer's certificate.
+    pub cert: Option<PathBuf>,
+    /// Its private key.
+    pub key: Option<PathBuf>,
+}
+
+impl TlsArgs {
+    /// `given`, else the environment variable `var`.
+    fn or_env(given: &Option<PathBuf>, var: &str) -> Option<PathBuf> {
+        given
+            .clone()
+            .or_else(|| std::env::var_os(var).map(PathBuf::from))
+    }
+
+    /// The client's TLS for `cell`: none for a plain cell; for an mTLS cell the certificate and
+    /// key are required.
+    pub fn resolve(&self, cell: &Cell) -> Result<Option<tandem_client::Tls>, CliError> {
+        if cell.security.mode == SecurityMode::Plain {
+            return Ok(None);
+        }
+        let cert = Self::or_env(&self.cert, "TANDEM_CERT");
+        let key = Self::or_env(&self.key, "TANDEM_KEY");
+        let ca = Self::or_env(&self.ca, "TANDEM_CA").unwrap_or_else(|| cell.security.ca.clone());
+        match (cert, key) {
+            (Some(certificate), Some(private_key)) => Ok(Some(tandem_client::Tls {
+                ca,
+                certificate,
+                private_key,
+            })),
+            _ => Err(CliError::TlsIncomplete(
+                "the cell's Zenoh links are mTLS ([security]): give an operator's or observer's \
+                 certificate with --cert and --key (or TANDEM_CERT and TANDEM_KEY), made by \
+                 `tandem certs`",
+            )),
+        }
+    }
+}
+
+/// Connects to the cell's gateways, with the client certificate when the cell runs mTLS.
+async fn connect(
+    cell: &Cell,
+    endpoints: &[String],
+    tls: &TlsArgs,
+) -> Result<tandem_client::Client, CliError> {
+    let t = tls.resolve(cell)?;
+    Ok(tandem_client::Client::connect_tls(
+        &cell.name,
+        &with_cell_endpoints(cell, endpoints),
+        t.as_ref(),
+    )
+    .await?)
+}
 
 /// The given endpoints plus every host's listen endpoints from the cell file (with none given
 /// and none in the cell: multicast scouting).
@@ -44,6 +104,7 @@ async fn close(c: tandem_client::Client) {
 pub fn cmd_zenoh(
     cell_path: &Path,
     endpoints: &[String],
+    tls: &TlsArgs,
     r: &CmdRequest,
     out: &mut impl Write,
 ) -> Result<(), CliError> {
@@ -55,8 +116,7 @@ pub fn cmd_zenoh(
     let line = r.line();
     let (target, instruction) = (&r.target, &r.instruction);
     runtime()?.block_on(async {
-        let c = tandem_client::Client::connect(&cell.name, &with_cell_endpoints(&cell, endpoints))
-            .await?;
+        let c = connect(&cell, endpoints, tls).await?;
         let result = if r.wait {
             c.execute(node, object, &line, r.timeout).await.map(|o| {
                 span.record("job", o.job);
@@ -85,12 +145,12 @@ pub fn cmd_zenoh(
 pub fn status_zenoh(
     cell_path: &Path,
     endpoints: &[String],
+    tls: &TlsArgs,
     out: &mut impl Write,
 ) -> Result<(), CliError> {
     let cell = load(cell_path)?;
     let (states, hosts) = runtime()?.block_on(async {
-        let c = tandem_client::Client::connect(&cell.name, &with_cell_endpoints(&cell, endpoints))
-            .await?;
+        let c = connect(&cell, endpoints, tls).await?;
         let window = Duration::from_secs_f64((3.0 / cell.telemetry_hz).max(0.3));
         let states = c.states(window).await?;
         let hosts = c.alive_hosts(Duration::from_secs(2)).await?;

@@ -226,6 +226,9 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), C
             String::new()
         }
     );
+    if o.gateway {
+        warn_if_plain(&cell, &host, out);
+    }
     let launch = Launch {
         cell_path,
         cell: &cell,
@@ -238,6 +241,37 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), C
     s.stop(out);
     outln!(out, "tandem up: all nodes stopped");
     result
+}
+
+/// Warns (on stdout and as a `tracing` warning) when the cell's Zenoh is plain,
+/// unauthenticated: on every start, so it is never forgotten (docs/security.md).
+fn warn_if_plain(cell: &Cell, host: &str, out: &mut impl Write) {
+    if cell.security.mode != tandem_config::SecurityMode::Plain {
+        return;
+    }
+    let h = cell.hosts.iter().position(|x| x == host).unwrap_or(0);
+    let listen = cell.host_listen.get(h).cloned().unwrap_or_default();
+    let why = if cell.security.declared {
+        "[security] mode = \"plain\""
+    } else {
+        "no [security] in the cell file"
+    };
+    let reach = if listen.is_empty() {
+        "it listens on no endpoint".to_string()
+    } else {
+        format!(
+            "anyone who reaches {} may observe, command and publish leading values",
+            listen.join(", ")
+        )
+    };
+    warn!(
+        mode = "plain",
+        "plain, unauthenticated Zenoh ({why}): {reach}; see docs/security.md for mTLS"
+    );
+    outln!(
+        out,
+        "WARNING: the gateway of host `{host}` runs plain, unauthenticated Zenoh ({why}): {reach}. Use [security] mode = \"mtls\" (docs/security.md)"
+    );
 }
 
 /// The processes of `up` and what it shows of them.

@@ -55,6 +55,15 @@ pub enum GatewayError {
         /// What iceoryx2 said.
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// A certificate or key of `[security]` cannot be read (mTLS mode).
+    Certificate {
+        /// What it is (`CA certificate`, `host certificate`, `host private key`).
+        what: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// What the OS said.
+        source: std::io::Error,
+    },
     /// One of the gateway's threads could not be started.
     Thread {
         /// The thread (`lv-out`, `commands`...).
@@ -68,7 +77,10 @@ impl GatewayError {
     /// The process exit code for this failure: 2 the cell or host is wrong, 1 it could not run.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Config(_) | Self::UnknownHost { .. } | Self::HostRequired { .. } => 2,
+            Self::Config(_)
+            | Self::UnknownHost { .. }
+            | Self::HostRequired { .. }
+            | Self::Certificate { .. } => 2,
             Self::ZenohConfig { .. }
             | Self::Zenoh { .. }
             | Self::Ipc(_)
@@ -118,6 +130,11 @@ impl fmt::Display for GatewayError {
             Self::Ipc(e) => write!(f, "{e}"),
             Self::IpcPort { port, source } => write!(f, "{port}: {source}"),
             Self::Thread { name, source } => write!(f, "cannot start the {name} thread: {source}"),
+            Self::Certificate { what, path, source } => write!(
+                f,
+                "{what} {}: {source} (create the certificates with `tandem certs`, docs/security.md)",
+                path.display()
+            ),
         }
     }
 }
@@ -129,7 +146,7 @@ impl std::error::Error for GatewayError {
             Self::Ipc(e) => Some(e),
             Self::ZenohConfig { source, .. } | Self::Zenoh { source, .. } => Some(source.as_ref()),
             Self::IpcPort { source, .. } => Some(source.as_ref()),
-            Self::Thread { source, .. } => Some(source),
+            Self::Thread { source, .. } | Self::Certificate { source, .. } => Some(source),
             Self::UnknownHost { .. } | Self::HostRequired { .. } => None,
         }
     }

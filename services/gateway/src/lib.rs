@@ -39,6 +39,7 @@
 //! }
 //! ```
 
+pub mod acl;
 mod error;
 
 pub use error::GatewayError;
@@ -49,7 +50,7 @@ use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tandem_config::{Cell, Coupling, Leader};
+use tandem_config::{Cell, Coupling, Leader, SecurityMode};
 use tandem_protocol::ipc::{self, IpcNode};
 use tandem_protocol::json::{self, AxisState, EventJson, Health, ReplyJson};
 use tandem_protocol::keys;
@@ -171,14 +172,19 @@ fn plan(cell: &Cell, h: usize) -> Plan {
     p
 }
 
-/// The Zenoh configuration of host `h`: peer mode, listening on the host's endpoints and
-/// connecting to the other hosts'; multicast scouting only when no endpoint is configured.
+/// Sets Zenoh configuration `key` to `value` (JSON5).
+fn set(c: &mut zenoh::Config, key: &'static str, value: String) -> Result<(), GatewayError> {
+    c.insert_json5(key, &value)
+        .map_err(|source| GatewayError::ZenohConfig { key, value, source })
+}
+
+/// The Zenoh configuration of host `h` (docs/security.md): peer mode; listening exactly on the
+/// host's endpoints (none: on nothing) and connecting to the other hosts'; multicast scouting
+/// only when `[security] multicast_scouting` asks for it. In mTLS mode: TLS links only, this
+/// host's certificate on both ends of every link, the client's certificate required, and the
+/// cell's access control ([`acl::access_control`]).
 pub fn zenoh_config(cell: &Cell, h: usize) -> Result<zenoh::Config, GatewayError> {
     let mut c = zenoh::Config::default();
-    let set = |c: &mut zenoh::Config, key: &'static str, value: String| {
-        c.insert_json5(key, &value)
-            .map_err(|source| GatewayError::ZenohConfig { key, value, source })
-    };
     set(&mut c, "mode", "\"peer\"".into())?;
     let listen = cell.host_listen.get(h).cloned().unwrap_or_default();
     let connect: Vec<String> = cell
@@ -189,18 +195,64 @@ pub fn zenoh_config(cell: &Cell, h: usize) -> Result<zenoh::Config, GatewayError
         .flat_map(|(_, l)| l.clone())
         .collect();
     let json = |v: &[String]| serde_json::to_string(v).unwrap_or_else(|_| "[]".into());
-    if !listen.is_empty() {
-        set(&mut c, "listen/endpoints", json(&listen))?;
-    }
+    // Explicit, even when empty: Zenoh's default for a peer is every interface.
+    set(&mut c, "listen/endpoints", json(&listen))?;
     if !connect.is_empty() {
         set(&mut c, "connect/endpoints", json(&connect))?;
         // Keep trying: the other hosts' gateways may start later.
         set(&mut c, "connect/timeout_ms", "-1".into())?;
     }
-    if !listen.is_empty() || !connect.is_empty() {
-        set(&mut c, "scouting/multicast/enabled", "false".into())?;
+    let scouting = cell.security.multicast_scouting;
+    set(&mut c, "scouting/multicast/enabled", scouting.to_string())?;
+    if cell.security.mode == SecurityMode::Mtls {
+        set(&mut c, "scouting/gossip/enabled", scouting.to_string())?;
+        mtls(&mut c, cell, h)?;
     }
     Ok(c)
+}
+
+/// The mTLS part of host `h`'s configuration: TLS links only, its certificate and key as
+/// both listener and connector, the cell's CA as the only issuer of clients, and the ACL.
+fn mtls(c: &mut zenoh::Config, cell: &Cell, h: usize) -> Result<(), GatewayError> {
+    let host = cell.hosts.get(h).map(String::as_str).unwrap_or_default();
+    let s = &cell.security;
+    let files = [
+        ("CA certificate", s.ca.clone()),
+        ("host certificate", s.host_certificate(host)),
+        ("host private key", s.host_private_key(host)),
+    ];
+    for (what, path) in &files {
+        if let Err(source) = std::fs::File::open(path) {
+            return Err(GatewayError::Certificate {
+                what,
+                path: path.clone(),
+                source,
+            });
+        }
+    }
+    let [(_, ca), (_, cert), (_, key)] = &files;
+    let file = |p: &std::path::Path| {
+        serde_json::to_string(&p.to_string_lossy()).unwrap_or_else(|_| "\"\"".into())
+    };
+    set(c, "transport/link/tls/root_ca_certificate", file(ca))?;
+    set(c, "transport/link/tls/listen_certificate", file(cert))?;
+    set(c, "transport/link/tls/listen_private_key", file(key))?;
+    set(c, "transport/link/tls/connect_certificate", file(cert))?;
+    set(c, "transport/link/tls/connect_private_key", file(key))?;
+    set(c, "transport/link/tls/enable_mtls", "true".into())?;
+    set(
+        c,
+        "transport/link/tls/verify_name_on_connect",
+        "true".into(),
+    )?;
+    set(
+        c,
+        "transport/link/tls/close_link_on_expiration",
+        "true".into(),
+    )?;
+    set(c, "transport/link/protocols", "[\"tls\"]".into())?;
+    set(c, "access_control", acl::access_control(cell).to_string())?;
+    Ok(())
 }
 
 /// Runs the gateway until SIGINT/SIGTERM or the end of its duration.
@@ -219,6 +271,13 @@ pub fn run(o: &Options) -> Result<Arc<Counters>, GatewayError> {
         );
     }
     let plan = Arc::new(plan(&cell, h));
+    if cell.security.mode == SecurityMode::Plain {
+        warn!(
+            mode = "plain",
+            "plain, unauthenticated Zenoh: anyone who reaches {:?} may observe, command and publish leading values (docs/security.md)",
+            cell.host_listen.get(h).cloned().unwrap_or_default()
+        );
+    }
     let session = zenoh::open(zenoh_config(&cell, h)?)
         .wait()
         .map_err(GatewayError::zenoh("opening the Zenoh session"))?;
@@ -975,4 +1034,103 @@ fn clock_offset(
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+
+    const CELL: &str = r#"
+[cell]
+name = "c"
+
+SECURITY
+
+[[hosts]]
+name = "h1"
+listen = ["PROTO/10.0.0.1:7447"]
+
+[[hosts]]
+name = "h2"
+listen = ["PROTO/10.0.0.2:7447"]
+
+[[nodes]]
+name = "n"
+cycle_us = 1000
+host = "h1"
+"#;
+
+    fn get(c: &zenoh::Config, key: &str) -> serde_json::Value {
+        serde_json::from_str(&c.get_json(key).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn mtls_listens_where_named_on_tls_only_with_both_certificates_and_the_acl() {
+        let dir = std::env::temp_dir().join(format!("tandem-gw-cfg-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("pki")).unwrap();
+        for f in ["ca.pem", "host-h1.pem", "host-h1.key"] {
+            std::fs::write(dir.join("pki").join(f), "x").unwrap();
+        }
+        let src = CELL
+            .replace("PROTO", "tls")
+            .replace("SECURITY", "[security]\nobservers = [\"hmi\"]");
+        std::fs::write(dir.join("c.toml"), &src).unwrap();
+        let cell = tandem_config::load(&dir.join("c.toml")).unwrap();
+        let c = zenoh_config(&cell, 0).unwrap();
+        assert_eq!(
+            get(&c, "listen/endpoints"),
+            serde_json::json!(["tls/10.0.0.1:7447"])
+        );
+        assert_eq!(
+            get(&c, "connect/endpoints"),
+            serde_json::json!(["tls/10.0.0.2:7447"])
+        );
+        assert_eq!(get(&c, "scouting/multicast/enabled"), false);
+        assert_eq!(get(&c, "scouting/gossip/enabled"), false);
+        assert_eq!(
+            get(&c, "transport/link/protocols"),
+            serde_json::json!(["tls"])
+        );
+        assert_eq!(get(&c, "transport/link/tls/enable_mtls"), true);
+        let pki = dir.join("pki");
+        assert_eq!(
+            get(&c, "transport/link/tls/connect_certificate"),
+            pki.join("host-h1.pem").to_string_lossy().as_ref()
+        );
+        assert_eq!(
+            get(&c, "transport/link/tls/root_ca_certificate"),
+            pki.join("ca.pem").to_string_lossy().as_ref()
+        );
+        assert_eq!(get(&c, "access_control/default_permission"), "deny");
+        assert_eq!(get(&c, "access_control/enabled"), true);
+        // Host h2's key is missing: refused by name before Zenoh opens anything.
+        let e = zenoh_config(&cell, 1).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert!(e.to_string().contains("host-h2.pem"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn plain_without_endpoints_listens_nowhere_and_does_not_scout() {
+        let src = "[cell]\nname = \"c\"\n\n[[nodes]]\nname = \"n\"\ncycle_us = 1000\n";
+        let cell = tandem_config::parse("c.toml", src).unwrap();
+        let c = zenoh_config(&cell, 0).unwrap();
+        assert_eq!(get(&c, "listen/endpoints"), serde_json::json!([]));
+        assert_eq!(get(&c, "scouting/multicast/enabled"), false);
+        assert_ne!(get(&c, "access_control/enabled"), true);
+        let src = CELL.replace("PROTO", "tcp").replace(
+            "SECURITY",
+            "[security]\nmode = \"plain\"\nmulticast_scouting = true",
+        );
+        let cell = tandem_config::parse("c.toml", &src).unwrap();
+        let c = zenoh_config(&cell, 1).unwrap();
+        assert_eq!(
+            get(&c, "listen/endpoints"),
+            serde_json::json!(["tcp/10.0.0.2:7447"])
+        );
+        assert_eq!(get(&c, "scouting/multicast/enabled"), true);
+        assert_ne!(get(&c, "transport/link/tls/enable_mtls"), true);
+        assert_ne!(get(&c, "access_control/enabled"), true);
+    }
 }

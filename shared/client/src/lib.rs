@@ -115,6 +115,44 @@ pub struct JobOutcome {
     pub events: Vec<EventJson>,
 }
 
+/// The certificate a client presents to the gateways of a cell in mTLS mode (made by `tandem
+/// certs`): the cell's CA, and an operator's or observer's certificate and key.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Tls {
+    /// The cell CA's certificate (PEM).
+    pub ca: std::path::PathBuf,
+    /// The client's certificate (PEM; CN `operator:<name>` or `observer:<name>`).
+    pub certificate: std::path::PathBuf,
+    /// The client's private key (PEM).
+    pub private_key: std::path::PathBuf,
+}
+
+impl Tls {
+    /// Sets the Zenoh keys of a mutually authenticated TLS client.
+    fn configure(&self, c: &mut zenoh::Config) -> Result<(), ClientError> {
+        let file = |p: &std::path::Path| serde_json::to_string(&p.to_string_lossy()).map_err(z);
+        for (key, value) in [
+            ("transport/link/protocols", "[\"tls\"]".to_string()),
+            ("scouting/gossip/enabled", "false".into()),
+            ("transport/link/tls/root_ca_certificate", file(&self.ca)?),
+            (
+                "transport/link/tls/connect_certificate",
+                file(&self.certificate)?,
+            ),
+            (
+                "transport/link/tls/connect_private_key",
+                file(&self.private_key)?,
+            ),
+            ("transport/link/tls/enable_mtls", "true".into()),
+            ("transport/link/tls/verify_name_on_connect", "true".into()),
+        ] {
+            c.insert_json5(key, &value)
+                .map_err(|e| ClientError::Zenoh(format!("{key} = {value}: {e}")))?;
+        }
+        Ok(())
+    }
+}
+
 /// A connection to one cell.
 #[derive(Debug)]
 pub struct Client {
@@ -128,16 +166,32 @@ fn z(e: impl core::fmt::Display) -> ClientError {
 
 impl Client {
     /// Connects to cell `cell` through the gateways at `endpoints` (`tcp/10.0.0.1:7447`);
-    /// with none, Zenoh's multicast scouting finds them.
+    /// with none, Zenoh's multicast scouting finds them. Plain Zenoh: for a cell with
+    /// `[security] mode = "mtls"` use [`Client::connect_tls`].
     pub async fn connect(cell: &str, endpoints: &[String]) -> Result<Client, ClientError> {
+        Self::connect_tls(cell, endpoints, None).await
+    }
+
+    /// Connects as [`Client::connect`] does; with `tls`, over TLS links only, presenting the
+    /// operator's or observer's certificate (mTLS, docs/security.md). The session never listens:
+    /// it only dials the gateways.
+    pub async fn connect_tls(
+        cell: &str,
+        endpoints: &[String],
+        tls: Option<&Tls>,
+    ) -> Result<Client, ClientError> {
         let mut config = zenoh::Config::default();
         config.insert_json5("mode", "\"peer\"").map_err(z)?;
+        config.insert_json5("listen/endpoints", "[]").map_err(z)?;
         if !endpoints.is_empty() {
             let list = serde_json::to_string(endpoints).map_err(z)?;
             config.insert_json5("connect/endpoints", &list).map_err(z)?;
             config
                 .insert_json5("scouting/multicast/enabled", "false")
                 .map_err(z)?;
+        }
+        if let Some(t) = tls {
+            t.configure(&mut config)?;
         }
         let session = zenoh::open(config).await.map_err(z)?;
         Ok(Client {

@@ -551,6 +551,8 @@ pub struct Cell {
     pub signals: Vec<SignalEntry>,
     /// What the input signals feed.
     pub inputs: InputBindings,
+    /// `[security]`: how the cell's Zenoh links are authenticated, who may do what.
+    pub security: crate::security::Security,
 }
 
 impl Cell {

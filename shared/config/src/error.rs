@@ -167,6 +167,16 @@ pub enum Problem {
     Command(CommandError),
     /// A required key that is missing.
     Missing(&'static str),
+    /// A Zenoh endpoint that is not `<protocol>/<address>:<port>` as the gateway needs it.
+    Endpoint {
+        /// The endpoint as written.
+        endpoint: String,
+        /// What is wrong with it.
+        why: &'static str,
+    },
+    /// A gateway endpoint reachable from the network in a cell without `[security]`: plain,
+    /// unauthenticated Zenoh must be asked for explicitly (docs/security.md).
+    PlainNotDeclared(String),
     /// A key of a drive of the process image on an axis with the simulated drive.
     OnlyWithDrive,
     /// A virtual axis bound to a drive.
@@ -350,6 +360,13 @@ impl fmt::Display for Problem {
         match self {
             Problem::Unreadable(e) => write!(f, "cannot read: {e}"),
             Problem::Missing(k) => write!(f, "`{k}` is required here"),
+            Problem::Endpoint { endpoint, why } => write!(f, "endpoint `{endpoint}`: {why}"),
+            Problem::PlainNotDeclared(e) => write!(
+                f,
+                "`{e}` is reachable from the network, and the cell has no [security]: add \
+                 [security] (mode = \"mtls\", certificates from `tandem certs`), or write \
+                 mode = \"plain\" there to run without authentication (docs/security.md)"
+            ),
             Problem::OnlyWithDrive => f.write_str(
                 "only for a drive of the process image (`[axes.<name>.drive] type = \"cia402\"`); \
                  this axis has the simulated drive",

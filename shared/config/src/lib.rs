@@ -51,6 +51,7 @@ mod error;
 mod parse;
 mod schema;
 pub mod script;
+pub mod security;
 
 pub use cell::{
     AnalogDriveConnection, AxisEntry, AxisIndex, AxisInputs, CamEntry, CamTrackEntry, Cell,
@@ -62,6 +63,7 @@ pub use cell::{
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};
+pub use security::{Role, Security, SecurityMode};
 
 #[cfg(test)]
 mod tests {

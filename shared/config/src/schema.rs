@@ -40,6 +40,31 @@ pub struct CellFile {
     /// `[signals.<name>]`: named signals, each bound to a channel of a device.
     #[serde(default)]
     pub signals: BTreeMap<String, SignalSection>,
+    /// `[security]`: how the Zenoh links are authenticated (docs/security.md).
+    pub security: Option<SecuritySection>,
+}
+
+/// `[security]`: mTLS with the cell's certificates (default), or plain Zenoh written out.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SecuritySection {
+    /// `mtls` (default) or `plain`.
+    pub mode: Option<String>,
+    /// The cell CA's certificate (PEM), relative to the cell file; default `pki/ca.pem`.
+    pub ca: Option<String>,
+    /// Each host's certificate, `{host}` standing for its name; default `pki/host-{host}.pem`.
+    pub certificate: Option<String>,
+    /// Each host's private key; default `pki/host-{host}.key`.
+    pub private_key: Option<String>,
+    /// The operators' names: certificates with CN `operator:<name>` may command.
+    #[serde(default)]
+    pub operators: Vec<String>,
+    /// The observers' names: certificates with CN `observer:<name>` may observe.
+    #[serde(default)]
+    pub observers: Vec<String>,
+    /// Zenoh's multicast scouting; default false.
+    #[serde(default)]
+    pub multicast_scouting: bool,
 }
 
 /// `[devices.<name>]`: a device in a node's process image. Its kind says which keys it has;
@@ -616,8 +641,9 @@ fn default_ipc_budget_us() -> u64 {
 pub struct HostSection {
     /// Host name (`tandem up --host <name>`).
     pub name: String,
-    /// Zenoh endpoints its gateway listens on (`tcp/10.0.0.1:7447`); the other hosts' gateways
-    /// connect to them. Empty: multicast scouting finds the peers.
+    /// Zenoh endpoints its gateway listens on (`tls/10.0.0.1:7447`), exactly these; the other
+    /// hosts' gateways connect to them. Empty: it listens nowhere (it only dials); multicast
+    /// scouting only with `[security] multicast_scouting = true`.
     #[serde(default)]
     pub listen: Vec<String>,
 }

@@ -100,6 +100,31 @@ pub fn alive_all(cell: &str) -> String {
     format!("tandem/{cell}/alive/*")
 }
 
+/// Every command key of the cell (what an operator may query).
+pub fn all_commands(cell: &str) -> String {
+    command(cell, "*", "*")
+}
+
+/// Every clock queryable of the cell (what the gateways ask each other).
+pub fn all_clocks(cell: &str) -> String {
+    clock(cell, "*")
+}
+
+/// Every key an observer may subscribe to, one expression per kind: the state of every object,
+/// every node's health, job events and log, every signal, every gateway's counters. A client
+/// of a cell with access control subscribes to these (or narrower ones): a broader expression
+/// such as `tandem/<c>/**` is refused as a whole (docs/security.md).
+pub fn observable(cell: &str) -> [String; 6] {
+    [
+        state(cell, "*", "*"),
+        health(cell, "*"),
+        events(cell, "*", "*"),
+        log(cell, "*"),
+        signals(cell),
+        gateway(cell, "*"),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -116,5 +141,17 @@ mod tests {
         let c = command("line", "followers", "feed");
         assert_eq!(parse_command("line", &c), Some(("followers", "feed")));
         assert_eq!(parse_command("line", "tandem/line/followers/cmd"), None);
+        assert_eq!(all_commands("line"), "tandem/line/*/*/cmd");
+        assert_eq!(
+            observable("line"),
+            [
+                "tandem/line/*/*/state",
+                "tandem/line/*/health",
+                "tandem/line/*/*/events",
+                "tandem/line/*/log",
+                "tandem/line/*/*/signal",
+                "tandem/line/gateway/*",
+            ]
+        );
     }
 }

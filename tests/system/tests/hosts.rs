@@ -142,6 +142,10 @@ const CELL: &str = r#"
 [cell]
 name = "CELLNAME"
 
+# Plain TCP between the namespaces, written out (tests/system/tests/security.rs runs mTLS).
+[security]
+mode = "plain"
+
 [[hosts]]
 name = "h1"
 listen = ["tcp/ADDR1:7447"]

@@ -7,6 +7,7 @@ mod cam;
 mod device;
 mod encoder;
 mod objects;
+mod security;
 mod signal;
 
 use crate::cell::{
@@ -185,6 +186,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     )?;
     let inputs = signal::inputs(cx, &raw, &bindings, &objects.measuring_inputs)?;
     signal::activate_limits(&raw, &inputs, &mut axes);
+    let security = security::security(cx, &raw, dir)?;
     Ok(Cell {
         name: raw.cell.name,
         base_tick_ns: raw.cell.base_tick_us as i64 * 1000,
@@ -213,6 +215,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         devices,
         signals,
         inputs,
+        security,
     })
 }
 
