@@ -802,24 +802,30 @@ fn glue_dots_three_per_blank_with_the_valve_lead() {
         col("conveyor.position"),
         col("conveyor.velocity"),
     );
-    // At line speed (500 mm/s) p(t) is known exactly: every on edge leads the dot's start by
-    // 2 ms, every off edge its end by 1 ms.
+    // At line speed (500 mm/s) p(t) is known exactly. The track drives the valve, so its edge
+    // times are switching times, computed ahead for the load: the setpoint reaches the load
+    // D = 2 cycles (2 ms) later (docs/io.md, "Outputs"). Every on edge leads the dot's start
+    // on the load by 2 ms, every off edge its end by 1 ms: the setpoint at edge + lead - D is
+    // at the dot's start or end.
     let r = rows.iter().find(|r| r[v] == "500").unwrap();
     let (t_a, p_a) = (ns(&r[t]), r[p].parse::<f64>().unwrap());
     let pos = |t_ns: i64| (p_a + (t_ns - t_a) as f64 * 1e-9 * 500.0).rem_euclid(600.0) % 200.0;
+    // The setpoint's transport delay to the load: 2 cycles of 1 ms (SETPOINT_DELAY_CYCLES in
+    // shared/runtime/src/outputs.rs).
+    const D_NS: i64 = 2_000_000;
     let on = log_times(&log, "output ON (cam");
     let off = log_times(&log, "output OFF (cam");
     let on: Vec<i64> = on.into_iter().filter(|x| *x > t_a).collect();
     let off: Vec<i64> = off.into_iter().filter(|x| *x > t_a).collect();
     for x in &on {
-        let q = pos(x + 2_000_000);
+        let q = pos(x + 2_000_000 - D_NS);
         assert!(
             [20.0, 90.0, 160.0].iter().any(|c| (q - c).abs() < 1e-6),
             "on at {x}: {q}"
         );
     }
     for x in &off {
-        let q = pos(x + 1_000_000);
+        let q = pos(x + 1_000_000 - D_NS);
         assert!(
             [30.0, 100.0, 175.0].iter().any(|c| (q - c).abs() < 1e-6),
             "off at {x}: {q}"
