@@ -139,6 +139,11 @@ const CELL: &str = r#"
 [cell]
 name = "CELLNAME"
 
+# Plain TCP between the namespaces, written out: the forger is an authenticated-transport
+# attacker's worst case (the ACL of tests/system/tests/security.rs would refuse its puts).
+[security]
+mode = "plain"
+
 [[hosts]]
 name = "h1"
 listen = ["tcp/ADDR1:7447"]
