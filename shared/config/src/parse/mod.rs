@@ -187,11 +187,18 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     let inputs = signal::inputs(cx, &raw, &bindings, &objects.measuring_inputs)?;
     signal::activate_limits(&raw, &inputs, &mut axes);
     let security = security::security(cx, &raw, dir)?;
+    let base_tick_ns = us_to_ns(cx, &["cell", "base_tick_us"], raw.cell.base_tick_us)?;
+    let ipc_budget_ns = us_to_ns(cx, &["cell", "ipc_budget_us"], raw.cell.ipc_budget_us)?;
+    let network_budget_ns = us_to_ns(
+        cx,
+        &["cell", "network_budget_us"],
+        raw.cell.network_budget_us,
+    )?;
     Ok(Cell {
         name: raw.cell.name,
-        base_tick_ns: raw.cell.base_tick_us as i64 * 1000,
-        ipc_budget_ns: raw.cell.ipc_budget_us as i64 * 1000,
-        network_budget_ns: raw.cell.network_budget_us as i64 * 1000,
+        base_tick_ns,
+        ipc_budget_ns,
+        network_budget_ns,
         host_listen: if raw.hosts.is_empty() {
             vec![Vec::new()]
         } else {
@@ -304,7 +311,7 @@ fn nodes(cx: Ctx<'_>, raw: &CellFile, hosts: &[String]) -> Result<Vec<Node>, Con
         if let Some(p) = n.realtime.priority.filter(|p| !(1..=99).contains(p)) {
             return Err(at("realtime", Problem::Priority(p)));
         }
-        if n.cycle_us == 0 || n.cycle_us % base != 0 {
+        if n.cycle_us > MAX_US || n.cycle_us == 0 || n.cycle_us % base != 0 {
             return Err(cx.at(
                 &["nodes"],
                 Problem::Cycle {
@@ -466,10 +473,15 @@ fn leading_values(
         .chain(encoders.iter_mut().map(|e| (e.node, &mut e.leading)));
     for ((table, name, section), (node, slot)) in sections.zip(slots) {
         let cycle = nodes[node].cycle_ns;
-        let delay_ns = section.map_or(0, |s| s.delay_us as i64 * 1000);
-        let tolerance_ns = section
-            .and_then(|s| s.tolerance_us)
-            .map_or(2 * cycle, |t| t as i64 * 1000);
+        let key = |k: &'static str| [table, name.as_str(), "leading_value", k];
+        let delay_ns = match section {
+            Some(s) => us_to_ns(cx, &key("delay_us"), s.delay_us)?,
+            None => 0,
+        };
+        let tolerance_ns = match section.and_then(|s| s.tolerance_us) {
+            Some(t) => us_to_ns(cx, &key("tolerance_us"), t)?,
+            None => 2 * cycle,
+        };
         let depth = (delay_ns + tolerance_ns) / cycle + 4;
         if depth > LEADING_BUFFER as i64 {
             let problem = Problem::LeadingBuffer {
@@ -487,6 +499,23 @@ fn leading_values(
     check_links(cx, raw, axes, encoders, nodes)
 }
 
+/// The longest time a `*_us` key may give: one hour. Larger values (up to 2^64 - 1 in the
+/// file) would wrap when turned into nanoseconds; no cycle, delay or budget is that long.
+const MAX_US: u64 = 3_600_000_000;
+
+/// A `*_us` key's value in ns, or the error naming the key at `path` when it is over
+/// [`MAX_US`].
+fn us_to_ns(cx: Ctx<'_>, path: &[&str], us: u64) -> Result<i64, ConfigError> {
+    if us > MAX_US {
+        return Err(cx.at_or_table(
+            path,
+            Problem::Invalid("must be at most 3600000000 µs (one hour)"),
+        ));
+    }
+    // At most 3.6e12 ns: no overflow.
+    Ok(us as i64 * 1000)
+}
+
 /// A follower on another node than its leader needs `D >= leader cycle + link budget +
 /// follower cycle`, the link being `ipc_budget_us` on one host and `network_budget_us`
 /// between hosts (the leading-value delay, docs/processes.md).
@@ -497,8 +526,10 @@ fn check_links(
     encoders: &[crate::cell::EncoderEntry],
     nodes: &[Node],
 ) -> Result<(), ConfigError> {
-    let ipc = raw.cell.ipc_budget_us as i64 * 1000;
-    let net = raw.cell.network_budget_us as i64 * 1000;
+    // Checked against MAX_US when the cell was built (`us_to_ns`); saturating here only so that
+    // this function cannot overflow on its own.
+    let ipc = (raw.cell.ipc_budget_us.min(MAX_US) as i64).saturating_mul(1000);
+    let net = (raw.cell.network_budget_us.min(MAX_US) as i64).saturating_mul(1000);
     let axis_names: Vec<&String> = raw.axes.keys().collect();
     let encoder_names: Vec<&String> = raw.encoders.keys().collect();
     for f in axes {
