@@ -10,7 +10,7 @@
 //!
 //! - `raw`: a Zenoh ping-pong of the 64-byte leading-value payload
 //!   ([`json::encode_leading_value`]) with the gateway's QoS (`Priority::RealTime`, express,
-//!   `CongestionControl::Drop`): peer mode, scouting off, the pong listening on
+//!   `CongestionControl::Block`): peer mode, scouting off, the pong listening on
 //!   `tcp/<addr B>:7447`, the ping connecting to it.
 //! - `tandem`: node → gateway → Zenoh → gateway → node and back. A generated two-host cell has
 //!   leader `ping` (node `na`, host `hA`) followed on `hB` and leader `pong` (node `nb`, host
@@ -170,7 +170,7 @@ impl RawEnd {
             .declare_publisher(key.clone())
             .priority(Priority::RealTime)
             .express(true)
-            .congestion_control(CongestionControl::Drop)
+            .congestion_control(CongestionControl::Block)
             .allowed_destination(Locality::Remote)
             .wait()
             .map_err(|e| format!("publisher {key}: {e}"))?;

@@ -447,11 +447,17 @@ fn lv_out(x: &Ctx) -> Result<(), GatewayError> {
             .create()
             .map_err(GatewayError::port("subscriber"))?;
         let key = keys::leading_value(&cell.name, cell.leader_name(*l), actual);
+        // Block, not Drop: an express message takes a whole batch of the link's real-time queue
+        // (two batches), so with Drop a stall of the link's task longer than 1 ms lost samples,
+        // which the follower then bridged by interpolation, off by up to jerk·Δt³ where the
+        // leader's jerk changed. A sample late by less than the delay D is still exact; this
+        // thread waits for the link instead, the iceoryx2 subscriber's buffer holds what
+        // arrives meanwhile, and the node never waits (docs/gateway.md).
         let publisher = session
             .declare_publisher(key.clone())
             .priority(Priority::RealTime)
             .express(true)
-            .congestion_control(CongestionControl::Drop)
+            .congestion_control(CongestionControl::Block)
             .allowed_destination(Locality::Remote)
             .wait()
             .map_err(GatewayError::zenoh(format!("publisher {key}")))?;

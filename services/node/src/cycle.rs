@@ -222,6 +222,7 @@ impl<'c> NodeCycle<'c> {
             self.report.cyclic_cpu_ns = rt::thread_cpu_ns() - thread;
         }
         self.health.extrapolated = self.exec.extrapolated;
+        self.health.lv_lost = self.exec.leading_lost();
         (self.report, self.health)
     }
 
@@ -445,6 +446,7 @@ impl<'c> NodeCycle<'c> {
         h.max_lateness_ns = h.max_lateness_ns.max(lateness);
         h.cycles += 1;
         h.extrapolated = self.exec.extrapolated;
+        h.lv_lost = self.exec.leading_lost();
         h.log_dropped = self.log.dropped + self.exec.notes_dropped;
         if (h.cycles - 1) % h.telemetry_every == 0 {
             self.telemetry();

@@ -324,6 +324,8 @@ fn cyclic(
         cycles = report.cycles,
         overruns = report.overruns,
         extrapolated = h.extrapolated,
+        lv_lost = h.lv_lost,
+        samples_rejected = h.samples_rejected,
         log_dropped = h.log_dropped,
         sends_failed = h.sends_failed,
         commands_unanswered = h.commands_unanswered,
@@ -331,11 +333,13 @@ fn cyclic(
         step_errors = h.step_errors,
         diag_dropped = h.diag_dropped,
         trace_dropped = h.trace_dropped,
-        "stopped after {} cycles ({} overruns, {} leading values extrapolated, {} log lines \
-         dropped); compute {}; lateness {}",
+        "stopped after {} cycles ({} overruns, {} leading values extrapolated, {} leading-value \
+         samples lost, {} refused, {} log lines dropped); compute {}; lateness {}",
         report.cycles,
         report.overruns,
         h.extrapolated,
+        h.lv_lost,
+        h.samples_rejected,
         h.log_dropped,
         report.compute.summary(),
         report.lateness.summary()

@@ -235,6 +235,9 @@ pub struct Health {
     /// Leaders followed again after a confirmed jump.
     #[serde(default)]
     pub lv_reanchored: u64,
+    /// Leading-value samples of remote leaders that never arrived (sequence gaps).
+    #[serde(default)]
+    pub lv_lost: u64,
 }
 
 impl Health {
@@ -266,6 +269,7 @@ impl Health {
             lv_sequence: h.lv_sequence,
             lv_jump: h.lv_jump,
             lv_reanchored: h.lv_reanchored,
+            lv_lost: h.lv_lost,
         }
     }
 }

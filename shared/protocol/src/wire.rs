@@ -249,7 +249,7 @@ pub fn state_code(s: AxisState) -> u32 {
 
 /// A node's health, the header of each telemetry snapshot.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.NodeHealth.v3")]
+#[type_name("tandem.NodeHealth.v4")]
 #[repr(C)]
 pub struct NodeHealth {
     /// The cycle's engine time (ns); it runs on the cell clock at `epoch_ns + t_ns`.
@@ -308,6 +308,9 @@ pub struct NodeHealth {
     pub lv_jump: u64,
     /// Leaders followed again after a confirmed jump (three consistent samples).
     pub lv_reanchored: u64,
+    /// Leading-value samples of remote leaders that never arrived (sequence gaps): a follower
+    /// reading inside a gap gets the interpolant between the samples around it.
+    pub lv_lost: u64,
 }
 
 /// One axis in a telemetry snapshot.

@@ -675,6 +675,18 @@ impl<'c> Executive<'c> {
         }
     }
 
+    /// Samples of the leaders read from other nodes that never arrived: sequence gaps seen
+    /// by their buffers. A follower reading inside such a gap gets the interpolant between
+    /// the samples around it, exact only where the leader's motion is a polynomial of degree
+    /// at most five across the gap.
+    pub fn leading_lost(&self) -> u64 {
+        self.buffers
+            .iter()
+            .filter(|b| !self.owned.leader(b.leader))
+            .map(|b| b.samples.lost())
+            .sum()
+    }
+
     /// The leaders (and couplings) this executive reads from other nodes.
     pub fn remote_leaders(&self) -> impl Iterator<Item = (Leader, Coupling)> + '_ {
         self.buffers
