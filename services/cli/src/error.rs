@@ -29,13 +29,6 @@ pub enum CliError {
     UnknownCommand(String),
     /// The cell file, or a script, is wrong (file, line, key and problem).
     Config(ConfigError),
-    /// A file could not be read.
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// What the OS said.
-        source: std::io::Error,
-    },
     /// The recording directory of `up --record` could not be created.
     RecordDir {
         /// The directory.
@@ -215,7 +208,6 @@ impl CliError {
             | Self::NoCell
             | Self::UnknownCommand(_)
             | Self::Config(_)
-            | Self::Read { .. }
             | Self::RecordDir { .. }
             | Self::UnknownHost { .. }
             | Self::HostRequired { .. }
@@ -291,7 +283,6 @@ impl fmt::Display for CliError {
             Self::NoCell => f.write_str("which cell? give --cell <cell.toml> or set TANDEM_CELL"),
             Self::UnknownCommand(name) => write!(f, "unknown command `{name}`"),
             Self::Config(e) => write!(f, "{e}"),
-            Self::Read { path, source } => write!(f, "{}: cannot read: {source}", path.display()),
             Self::RecordDir { path, source } => write!(f, "{}: {source}", path.display()),
             Self::CreateTrace { path, source } => {
                 write!(f, "{}: cannot create: {source}", path.display())
@@ -416,8 +407,7 @@ impl std::error::Error for CliError {
             Self::Config(e) => Some(e),
             Self::Ipc(e) => Some(e),
             Self::Client(e) => Some(e),
-            Self::Read { source, .. }
-            | Self::RecordDir { source, .. }
+            Self::RecordDir { source, .. }
             | Self::CreateTrace { source, .. }
             | Self::CannotStart { source, .. }
             | Self::Runtime(source) => Some(source),

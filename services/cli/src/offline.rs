@@ -42,11 +42,7 @@ pub struct SimOptions {
 /// quiet) to `out` and the summary to `err`.
 pub fn sim(o: &SimOptions, out: &mut impl Write, err: &mut impl Write) -> Result<(), CliError> {
     let cell = tandem_config::load(&o.cell)?;
-    let src = std::fs::read_to_string(&o.script).map_err(|source| CliError::Read {
-        path: o.script.clone(),
-        source,
-    })?;
-    let script = tandem_config::script::parse_cell(&o.script.display().to_string(), &src, &cell)?;
+    let script = tandem_config::script::load(&o.script, &cell)?;
     let file = std::fs::File::create(&o.trace).map_err(|source| CliError::CreateTrace {
         path: o.trace.clone(),
         source,

@@ -181,11 +181,7 @@ fn prepare(cell_path: &Path, o: &UpOptions) -> Result<(Cell, String, Vec<usize>)
         return Err(CliError::NoNodesHere);
     }
     if let Some(s) = &o.script {
-        let src = std::fs::read_to_string(s).map_err(|source| CliError::Read {
-            path: s.clone(),
-            source,
-        })?;
-        tandem_config::script::parse_cell(&s.display().to_string(), &src, &cell)?;
+        tandem_config::script::load(s, &cell)?;
     }
     if let Some(d) = &o.record {
         std::fs::create_dir_all(d).map_err(|source| CliError::RecordDir {

@@ -20,13 +20,6 @@ pub enum NodeError {
         /// The nodes the cell has.
         nodes: Vec<String>,
     },
-    /// The script file cannot be read.
-    ScriptRead {
-        /// The script file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
     /// The script is wrong.
     Script(ConfigError),
     /// The engine refused the cell's configuration.
@@ -52,11 +45,7 @@ impl NodeError {
     /// the node could not run (iceoryx2 resources, threads).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Cell(_)
-            | Self::UnknownNode { .. }
-            | Self::ScriptRead { .. }
-            | Self::Script(_)
-            | Self::Engine(_) => 2,
+            Self::Cell(_) | Self::UnknownNode { .. } | Self::Script(_) | Self::Engine(_) => 2,
             Self::Port { .. } | Self::Thread { .. } => 1,
         }
     }
@@ -80,9 +69,6 @@ impl fmt::Display for NodeError {
                 cell.display(),
                 nodes.join(", ")
             ),
-            Self::ScriptRead { path, source } => {
-                write!(f, "{}: cannot read: {source}", path.display())
-            }
             Self::Engine(e) => write!(f, "the engine refused the cell: {e}"),
             Self::Port { port, source } => write!(f, "{port}: {source}"),
             Self::Thread { thread, source } => {
@@ -97,7 +83,6 @@ impl Error for NodeError {
         match self {
             Self::Cell(e) | Self::Script(e) => Some(e),
             Self::UnknownNode { .. } => None,
-            Self::ScriptRead { source, .. } => Some(source),
             Self::Engine(e) => Some(e.as_ref()),
             Self::Port { source, .. } => Some(source),
             Self::Thread { source, .. } => Some(source),

@@ -122,11 +122,7 @@ fn load_script(o: &Options, cell: &Cell) -> Result<Option<Script>, NodeError> {
     let Some(p) = &o.script else {
         return Ok(None);
     };
-    let src = std::fs::read_to_string(p).map_err(|source| NodeError::ScriptRead {
-        path: p.clone(),
-        source,
-    })?;
-    tandem_config::script::parse_cell(&p.display().to_string(), &src, cell)
+    tandem_config::script::load(p, cell)
         .map(Some)
         .map_err(NodeError::Script)
 }

@@ -48,6 +48,18 @@ impl std::error::Error for ConfigError {
 pub enum Problem {
     /// The file cannot be read (the operating system's reason).
     Unreadable(String),
+    /// The file is larger than the reader takes ([`crate::read`]).
+    TooLarge {
+        /// The largest size read (bytes).
+        max: u64,
+    },
+    /// The file is not UTF-8 text: the first invalid byte, at the error's line.
+    NotUtf8 {
+        /// The byte's column in its line (1-based, in bytes).
+        column: usize,
+        /// The byte.
+        byte: u8,
+    },
     /// TOML syntax or schema (an unknown field, a wrong type), as the TOML parser says it.
     Syntax(String),
     /// A value outside what the key accepts; the text says what it must be.
@@ -95,6 +107,20 @@ pub enum Problem {
     AlsoAnAxis(String),
     /// An object name that is empty or already used.
     NameTaken(String),
+    /// A name that is not a plain name (1 to 64 letters, digits, `_` or `-`).
+    BadName {
+        /// What it names (`cell`, `axis`, `signal`, ...).
+        what: &'static str,
+        /// The name as written.
+        name: String,
+    },
+    /// A node name that a protocol key takes at the same place.
+    ReservedName {
+        /// The name as written.
+        name: String,
+        /// The names taken.
+        reserved: &'static [&'static str],
+    },
     /// An axis that names itself as its leader.
     SelfLeader,
     /// A leader named `node/leader` that is hosted by another node.
@@ -359,6 +385,14 @@ impl fmt::Display for Problem {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Problem::Unreadable(e) => write!(f, "cannot read: {e}"),
+            Problem::TooLarge { max } => write!(
+                f,
+                "larger than {max} bytes, more than any such file needs: not read"
+            ),
+            Problem::NotUtf8 { column, byte } => write!(
+                f,
+                "not UTF-8 text: byte 0x{byte:02X} at column {column} is not valid UTF-8"
+            ),
             Problem::Missing(k) => write!(f, "`{k}` is required here"),
             Problem::Endpoint { endpoint, why } => write!(f, "endpoint `{endpoint}`: {why}"),
             Problem::PlainNotDeclared(e) => write!(
@@ -447,11 +481,25 @@ impl fmt::Display for Problem {
             }
             Problem::UnknownNode(n) => write!(f, "unknown node `{n}` (define it in [[nodes]])"),
             Problem::BadHostName(h) => {
-                write!(f, "host `{h}` is defined twice, empty or contains `/`")
+                write!(
+                    f,
+                    "host `{h}` is defined twice or is not 1 to 64 letters, digits, `_` or `-`"
+                )
             }
             Problem::BadNodeName(n) => write!(
                 f,
-                "`{n}`: a node name is a plain name (letters, digits, `_`, `-`; it names services and keys)"
+                "`{n}`: a node name is 1 to 64 letters, digits, `_` or `-` (it names services, \
+                 keys and files)"
+            ),
+            Problem::BadName { what, name } => write!(
+                f,
+                "`{name}`: a {what} name is 1 to 64 letters, digits, `_` or `-` (it names \
+                 services, keys and files)"
+            ),
+            Problem::ReservedName { name, reserved } => write!(
+                f,
+                "`{name}`: the protocol's keys take the node names {} (tandem/<cell>/<name>/...)",
+                reserved.join(", ")
             ),
             Problem::HostRequired(n) => write!(
                 f,

@@ -49,6 +49,7 @@ mod cell;
 pub mod command;
 mod error;
 mod parse;
+pub mod read;
 mod schema;
 pub mod script;
 pub mod security;

@@ -91,6 +91,13 @@ pub fn parse(file: &str, src: &str, axes: &[&str], cams: &[&str]) -> Result<Scri
     parse_with(file, src, axes, cams, &ObjectNames::default())
 }
 
+/// Reads (at most [`crate::read::SCRIPT_FILE_MAX`] bytes of UTF-8) and parses the script
+/// file `path` for `cell` ([`parse_cell`]).
+pub fn load(path: &std::path::Path, cell: &crate::Cell) -> Result<Script, ConfigError> {
+    let src = crate::read::read_text(path, crate::read::SCRIPT_FILE_MAX)?;
+    parse_cell(&path.display().to_string(), &src, cell)
+}
+
 /// Parses a script for `cell`: its axes, encoders, cams, output cams, cam tracks and measuring
 /// inputs can be addressed.
 pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, ConfigError> {
@@ -495,6 +502,11 @@ fn document<'s>(file: &str, src: &'s str) -> Result<toml_edit::ImDocument<&'s st
     Ok(doc)
 }
 
+/// The longest script (s): an hour of virtual time, as long as the longest time key of a
+/// cell; a script is a test, a demonstration or a soak run, and a day of a 1 ms cell would keep
+/// `tandem sim` busy for hours.
+pub const MAX_DURATION_S: f64 = 3600.0;
+
 /// `[sim] duration`: the virtual time to run (ns).
 fn duration(file: &str, src: &str, doc: &toml_edit::ImDocument<&str>) -> Result<i64, ConfigError> {
     let e = |line, problem| ConfigError {
@@ -512,12 +524,15 @@ fn duration(file: &str, src: &str, doc: &toml_edit::ImDocument<&str>) -> Result<
                 Problem::Invalid("is required (virtual seconds to run)"),
             )
         })?;
-    num(duration).and_then(seconds_to_ns).ok_or_else(|| {
-        e(
-            crate::locate(src, &["sim", "duration"]),
-            Problem::Invalid("must be a number of seconds >= 0"),
-        )
-    })
+    num(duration)
+        .filter(|s| *s <= MAX_DURATION_S)
+        .and_then(seconds_to_ns)
+        .ok_or_else(|| {
+            e(
+                crate::locate(src, &["sim", "duration"]),
+                Problem::Invalid("must be a number of seconds from 0 to 3600 (one hour)"),
+            )
+        })
 }
 
 fn parse_with(

@@ -79,12 +79,15 @@ fn points(c: &CamSection, dir: Option<&Path>) -> Result<Vec<(f64, f64)>, FieldEr
         let path = dir
             .map(|d| d.join(csv))
             .unwrap_or_else(|| Path::new(csv).to_path_buf());
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let text = crate::read::read_text(&path, crate::read::CAM_FILE_MAX).map_err(|e| {
             (
                 "points_csv",
                 Problem::CamFile {
-                    path: path.display().to_string(),
-                    error: e.to_string(),
+                    path: match e.line {
+                        Some(l) => format!("{}:{l}", e.file),
+                        None => e.file,
+                    },
+                    error: e.problem.to_string(),
                 },
             )
         })?;

@@ -6,6 +6,7 @@ mod axis;
 mod cam;
 mod device;
 mod encoder;
+mod names;
 mod objects;
 mod security;
 mod signal;
@@ -134,14 +135,8 @@ pub fn locate(src: &str, path: &[&str]) -> Option<usize> {
 
 /// Loads and validates a cell file (cam CSV files are read relative to it).
 pub fn load(path: &Path) -> Result<Cell, ConfigError> {
-    let file = path.display().to_string();
-    let src = std::fs::read_to_string(path).map_err(|e| ConfigError {
-        file: file.clone(),
-        line: None,
-        key: String::new(),
-        problem: Box::new(Problem::Unreadable(e.to_string())),
-    })?;
-    parse_in(&file, &src, path.parent())
+    let src = crate::read::read_text(path, crate::read::CELL_FILE_MAX)?;
+    parse_in(&path.display().to_string(), &src, path.parent())
 }
 
 /// Parses and validates cell source text; `file` is used in error messages. Cam CSV files are
@@ -160,6 +155,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     })?;
     let cx = Ctx { file, src };
     check_cell_section(cx, &raw)?;
+    names::check(cx, &raw)?;
     let hosts = hosts(cx, &raw)?;
     let nodes = nodes(cx, &raw, &hosts)?;
     let devices = device::devices(cx, &raw, &nodes)?;
