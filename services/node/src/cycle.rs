@@ -49,6 +49,8 @@ pub(crate) struct Links {
     pub(crate) diag: SyncSender<Record>,
     /// Trace rows, when a trace is written.
     pub(crate) rows: Option<RowPool>,
+    /// What the recorder could not write to the disk (copied into the health).
+    pub(crate) lost: std::sync::Arc<crate::recorder::Lost>,
 }
 
 /// Where the node's cycles lie on the cell clock.
@@ -446,6 +448,7 @@ impl<'c> NodeCycle<'c> {
         h.cycles += 1;
         h.extrapolated = self.exec.extrapolated;
         h.log_dropped = self.log.dropped + self.exec.notes_dropped;
+        self.links.lost.copy_into(h);
         if (h.cycles - 1) % h.telemetry_every == 0 {
             self.telemetry();
         }

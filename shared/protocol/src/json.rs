@@ -235,6 +235,12 @@ pub struct Health {
     /// Leaders followed again after a confirmed jump.
     #[serde(default)]
     pub lv_reanchored: u64,
+    /// Trace rows the node's recorder could not write to the disk (a full disk).
+    #[serde(default)]
+    pub trace_rows_lost: u64,
+    /// Log lines the node's recorder could not write to the disk (a full disk).
+    #[serde(default)]
+    pub log_lines_lost: u64,
 }
 
 impl Health {
@@ -266,6 +272,8 @@ impl Health {
             lv_sequence: h.lv_sequence,
             lv_jump: h.lv_jump,
             lv_reanchored: h.lv_reanchored,
+            trace_rows_lost: h.trace_rows_lost,
+            log_lines_lost: h.log_lines_lost,
         }
     }
 }

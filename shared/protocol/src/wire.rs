@@ -249,7 +249,7 @@ pub fn state_code(s: AxisState) -> u32 {
 
 /// A node's health, the header of each telemetry snapshot.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.NodeHealth.v3")]
+#[type_name("tandem.NodeHealth.v4")]
 #[repr(C)]
 pub struct NodeHealth {
     /// The cycle's engine time (ns); it runs on the cell clock at `epoch_ns + t_ns`.
@@ -308,6 +308,12 @@ pub struct NodeHealth {
     pub lv_jump: u64,
     /// Leaders followed again after a confirmed jump (three consistent samples).
     pub lv_reanchored: u64,
+    /// Trace rows the recorder could not write to the disk (`--trace`; a full disk or another
+    /// write error): never partly written, counted exactly (v4). Not `trace_dropped`.
+    pub trace_rows_lost: u64,
+    /// Log lines the recorder could not write to the disk (`--log`), as `trace_rows_lost` (v4).
+    /// Not `log_dropped` (lines the cycle's ring had no room for).
+    pub log_lines_lost: u64,
 }
 
 /// One axis in a telemetry snapshot.
