@@ -242,10 +242,10 @@ impl<S: Store> Sink<S> {
             None => {
                 self.losing = Some(lost);
                 let e = error.unwrap_or_else(|| io::ErrorKind::Other.into());
-                let why = if e.kind() == io::ErrorKind::StorageFull {
-                    "disk full"
-                } else {
-                    "write error"
+                let why = match e.kind() {
+                    io::ErrorKind::StorageFull => "disk full",
+                    io::ErrorKind::QuotaExceeded => "disk quota exceeded",
+                    _ => "write error",
                 };
                 warn!(
                     file = %self.path.display(),
