@@ -217,9 +217,22 @@ pub(crate) fn render(
                 h.max_lateness_ns / 1000,
                 h.overruns
             ));
+            s.push_str(&recording_lost(h));
         }
     }
     s
+}
+
+/// The health line's note of what the node's recorder lost to the disk, if anything:
+/// `  recording lost 1234 trace rows, 0 log lines (disk full or write errors)`.
+fn recording_lost(h: &NodeHealth) -> String {
+    if h.trace_rows_lost == 0 && h.log_lines_lost == 0 {
+        return String::new();
+    }
+    format!(
+        "{:<12} recording lost {} trace rows, {} log lines (disk full or write errors)\n",
+        "", h.trace_rows_lost, h.log_lines_lost
+    )
 }
 
 /// `tandem status`: one snapshot of the host's nodes. Exit 0 when every node runs, 3 if not.

@@ -49,6 +49,8 @@ pub(crate) struct Links {
     pub(crate) diag: SyncSender<Record>,
     /// Trace rows, when a trace is written.
     pub(crate) rows: Option<RowPool>,
+    /// What the recorder could not write to the disk (copied into the health).
+    pub(crate) lost: std::sync::Arc<crate::recorder::Lost>,
 }
 
 /// Where the node's cycles lie on the cell clock.
@@ -448,6 +450,7 @@ impl<'c> NodeCycle<'c> {
         h.extrapolated = self.exec.extrapolated;
         h.lv_lost = self.exec.leading_lost();
         h.log_dropped = self.log.dropped + self.exec.notes_dropped;
+        self.links.lost.copy_into(h);
         if (h.cycles - 1) % h.telemetry_every == 0 {
             self.telemetry();
         }

@@ -45,7 +45,7 @@ use commands::{command_thread, CommandLinks, Done, Queued};
 use cycle::{Clock, CycleParts, Links, NodeCycle, Row, RowPool};
 use logring::{Record, DIAG_RECORDS};
 use ports::{PortPlan, Ports};
-use recorder::{recorder_thread, RecorderPlan};
+use recorder::{recorder_thread, Lost, RecorderPlan};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::sync_channel;
@@ -101,6 +101,7 @@ pub fn run(o: &Options) -> Result<Report, NodeError> {
     let stop = Arc::new(AtomicBool::new(false));
     let retained = retain::open(&cell, n);
     let (threads, links) = start_threads(&cell, o, &owned, &stop, retained.clone())?;
+    let lost = Arc::clone(&links.lost);
     let start = Start {
         script: script.as_ref(),
         retained: retained.as_deref(),
@@ -114,7 +115,24 @@ pub fn run(o: &Options) -> Result<Report, NodeError> {
     }
     let mut report = result?;
     report.resident_bytes = rt::resident_bytes().unwrap_or(0);
+    recording_lost(&lost, &mut report);
     Ok(report)
+}
+
+/// After the recorder ended: what it could not write to the disk, into the report, and a
+/// warning when anything was lost (the end report's `recording ...` line).
+fn recording_lost(lost: &Lost, report: &mut Report) {
+    report.trace_rows_lost = lost.rows.load(Ordering::Relaxed);
+    report.log_lines_lost = lost.lines.load(Ordering::Relaxed);
+    if report.trace_rows_lost + report.log_lines_lost > 0 {
+        warn!(
+            trace_rows_lost = report.trace_rows_lost,
+            log_lines_lost = report.log_lines_lost,
+            "recording lost {} trace rows and {} log lines to the disk in this run",
+            report.trace_rows_lost,
+            report.log_lines_lost
+        );
+    }
 }
 
 /// The script of `o`, parsed against the cell.
@@ -182,6 +200,7 @@ fn start_threads(
         }
     }
     let mut threads = Vec::new();
+    let lost = Arc::new(Lost::default());
     let (c, s, node) = (Arc::clone(cell), Arc::clone(stop), o.node.clone());
     let links = CommandLinks {
         queue: cmd_tx,
@@ -197,10 +216,12 @@ fn start_threads(
         rows: (row_rx, free_tx),
         diag: diag_rx,
         retained,
+        lost: Arc::clone(&lost),
     };
     let (c, s) = (Arc::clone(cell), Arc::clone(stop));
     threads.push(spawn("recorder", move || recorder_thread(&c, &plan, &s))?);
     let links = Links {
+        lost,
         commands: cmd_rx,
         done: done_tx,
         diag: diag_tx,

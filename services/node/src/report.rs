@@ -87,6 +87,10 @@ pub struct Report {
     pub cyclic_cpu_ns: i64,
     /// Wall time of each stage of the cycle, summed over the run.
     pub stages: Stages,
+    /// Trace rows the recorder could not write to the disk (`NodeHealth::trace_rows_lost`).
+    pub trace_rows_lost: u64,
+    /// Log lines the recorder could not write to the disk (`NodeHealth::log_lines_lost`).
+    pub log_lines_lost: u64,
 }
 
 /// Wall time of each stage of the cycle, summed over a run (ns).

@@ -238,6 +238,12 @@ pub struct Health {
     /// Leading-value samples of remote leaders that never arrived (sequence gaps).
     #[serde(default)]
     pub lv_lost: u64,
+    /// Trace rows the node's recorder could not write to the disk (a full disk).
+    #[serde(default)]
+    pub trace_rows_lost: u64,
+    /// Log lines the node's recorder could not write to the disk (a full disk).
+    #[serde(default)]
+    pub log_lines_lost: u64,
 }
 
 impl Health {
@@ -270,6 +276,8 @@ impl Health {
             lv_jump: h.lv_jump,
             lv_reanchored: h.lv_reanchored,
             lv_lost: h.lv_lost,
+            trace_rows_lost: h.trace_rows_lost,
+            log_lines_lost: h.log_lines_lost,
         }
     }
 }

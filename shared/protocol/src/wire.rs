@@ -311,6 +311,12 @@ pub struct NodeHealth {
     /// Leading-value samples of remote leaders that never arrived (sequence gaps): a follower
     /// reading inside a gap gets the interpolant between the samples around it.
     pub lv_lost: u64,
+    /// Trace rows the recorder could not write to the disk (`--trace`; a full disk or another
+    /// write error): never partly written, counted exactly (v4). Not `trace_dropped`.
+    pub trace_rows_lost: u64,
+    /// Log lines the recorder could not write to the disk (`--log`), as `trace_rows_lost` (v4).
+    /// Not `log_dropped` (lines the cycle's ring had no room for).
+    pub log_lines_lost: u64,
 }
 
 /// One axis in a telemetry snapshot.
