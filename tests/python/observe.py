@@ -2,9 +2,9 @@
 """A tandem cell seen from Python, with nothing but the eclipse-zenoh package.
 
 Subscribes to everything of a cell (tandem/<cell>/**), sends commands as Zenoh queries to
-tandem/<cell>/<node>/<object>/cmd, asks which hosts are alive (liveliness), and prints one JSON
-summary on stdout: the keys seen and how often, the last state of every axis, the replies, and
-every edge of the nodes' signals (tandem/<cell>/<node>/<signal>/signal), in arrival order.
+tandem/<cell>/<node>/<object>/cmd (or .../cmd/<sender> with --sender), asks which hosts are alive (liveliness), and prints one JSON
+summary on stdout: the keys seen and how often, the last state of every axis, the replies, the
+gateways' `command` events (who commanded what), and every edge of the nodes' signals (tandem/<cell>/<node>/<signal>/signal), in arrival order.
 
   observe.py --cell line --connect tcp/10.0.0.1:7447 --seconds 4 \
       --command followers/feed "MC_Power" --command followers/feed "MC_MoveVelocity --velocity 50"
@@ -37,6 +37,8 @@ def main():
     ap.add_argument("--ca", default=os.environ.get("TANDEM_CA"), help="the cell CA's certificate (mTLS)")
     ap.add_argument("--cert", default=os.environ.get("TANDEM_CERT"), help="an operator's or observer's certificate")
     ap.add_argument("--key", default=os.environ.get("TANDEM_KEY"), help="its private key")
+    ap.add_argument("--sender", help="query tandem/<cell>/<node>/<object>/cmd/SENDER (the key an mTLS "
+                    "cell serves: SENDER must be the certificate's CN); without, the key without a sender (plain cells)")
     ap.add_argument("--subscribe", action="append", default=[], metavar="KEY",
                     help="subscribe to this key expression (repeatable) instead of the default")
     a = ap.parse_args()
@@ -60,6 +62,7 @@ def main():
     counts = {}
     last = {}
     signals = []
+    command_events = []
     lock = threading.Lock()
 
     def on_sample(sample):
@@ -71,6 +74,13 @@ def main():
                     last[key] = json.loads(sample.payload.to_string())
                 except ValueError:
                     last[key] = {"malformed": True}
+            elif key.endswith("/events"):
+                try:
+                    e = json.loads(sample.payload.to_string())
+                except ValueError:
+                    e = {}
+                if isinstance(e, dict) and e.get("outcome") == "command":
+                    command_events.append(e)
             elif key.endswith("/signal"):
                 try:
                     signals.append(json.loads(sample.payload.to_string()))
@@ -99,7 +109,7 @@ def main():
 
     replies = []
     for target, text in a.command:
-        key = f"tandem/{a.cell}/{target}/cmd"
+        key = f"tandem/{a.cell}/{target}/cmd" + (f"/{a.sender}" if a.sender else "")
         got = None
         for reply in session.get(key, payload=text, timeout=10.0):
             if reply.ok is not None:
@@ -124,6 +134,7 @@ def main():
             "alive": alive,
             "alive_events": alive_events,
             "signals": signals,
+            "command_events": command_events,
         }
     session.close()
     json.dump(summary, sys.stdout)

@@ -19,8 +19,9 @@ use tracing::{debug, info_span};
 const REPLY_WITHIN: Duration = Duration::from_secs(5);
 
 /// Who sends the commands of this process (docs/gateway.md, "Command rate"): `$TANDEM_SENDER`
-/// if set, else `<user>@<machine>`. Not authenticated: the mTLS work binds it to the
-/// certificate's subject.
+/// if set, else `<user>@<machine>`. Not authenticated; over Zenoh with a certificate
+/// (`--zenoh --cert`) the sender is the certificate's common name instead (docs/security.md,
+/// "Commands with identity").
 pub fn sender() -> String {
     if let Ok(s) = std::env::var("TANDEM_SENDER") {
         if !s.trim().is_empty() {

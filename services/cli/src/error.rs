@@ -236,7 +236,7 @@ impl CliError {
             | Self::CertGen { .. } => 4,
             Self::Client(e) => match e {
                 C::Rejected { .. } | C::JobFailed { .. } => 1,
-                C::Invalid(_) => 2,
+                C::Invalid(_) | C::Certificate { .. } | C::Sender(_) => 2,
                 C::Timeout { .. } | C::Unreachable(_) => 3,
                 C::Zenoh(_) | C::Malformed(_) => 4,
             },

@@ -56,19 +56,26 @@ impl TlsArgs {
     }
 }
 
-/// Connects to the cell's gateways, with the client certificate when the cell runs mTLS.
+/// Connects to the cell's gateways, with the client certificate when the cell runs mTLS (the
+/// sender of its commands is then the certificate's common name).
 async fn connect(
     cell: &Cell,
     endpoints: &[String],
     tls: &TlsArgs,
 ) -> Result<tandem_client::Client, CliError> {
     let t = tls.resolve(cell)?;
-    Ok(tandem_client::Client::connect_tls(
+    let client = tandem_client::Client::connect_tls(
         &cell.name,
         &with_cell_endpoints(cell, endpoints),
         t.as_ref(),
     )
-    .await?)
+    .await?;
+    // With a certificate the sender is its common name (the access control checks it);
+    // without, the same as `tandem cmd` over iceoryx2 says.
+    Ok(match t {
+        Some(_) => client,
+        None => client.with_sender(&crate::cmd::sender())?,
+    })
 }
 
 /// The given endpoints plus every host's listen endpoints from the cell file (with none given

@@ -11,7 +11,8 @@
 //! - **Host `h`** (CN `host:h`): puts the leading values of *its own* leaders only (a gateway
 //!   of another host cannot steer a follower), subscribes to leading values, serves command
 //!   and clock queryables, asks the others' clocks, declares its liveliness token.
-//! - **Operator** (CN `operator:<name>`): queries the command keys, and observes.
+//! - **Operator** (CN `operator:<name>`): queries the command keys that name it as sender
+//!   (`tandem/<c>/*/*/cmd/operator:<name>`, a subject and a rule per operator), and observes.
 //! - **Observer** (CN `observer:<name>`): subscribes to state, health, events, log, signals and
 //!   the gateways' counters, and to the hosts' liveliness; nothing else.
 
@@ -141,17 +142,72 @@ fn observer_rules(cell: &Cell, rules: &mut Vec<Value>) -> Vec<String> {
     ]
 }
 
-/// The rules of operators beyond observing: query the command keys, get the replies.
+/// The rule shared by operators beyond observing: the gateways' command queryable
+/// declarations may reach them (they reveal no command).
 fn operator_rules(cell: &Cell, rules: &mut Vec<Value>) -> Vec<String> {
-    let cmd = [keys::all_commands(&cell.name)];
-    rules.push(rule("command-query".into(), &["query"], IN, &cmd));
     rules.push(rule(
-        "command-reply".into(),
-        &["reply", "declare_queryable"],
+        "commands-declared".into(),
+        &["declare_queryable"],
         OUT,
-        &cmd,
+        &[keys::all_commands(&cell.name)],
     ));
-    vec!["command-query".into(), "command-reply".into()]
+    vec!["commands-declared".into()]
+}
+
+/// The rules of operator `name` alone (docs/security.md, "Commands with identity"): it may query
+/// only the command keys that name its own certificate's common name as sender
+/// (`tandem/<c>/*/*/cmd/operator:<name>`) and get their replies, so the sender a gateway reads
+/// from the key is the certificate's subject.
+fn own_commands_rules(cell: &Cell, name: &str, rules: &mut Vec<Value>) -> [String; 2] {
+    let ids = [format!("query-by-{name}"), format!("reply-to-{name}")];
+    let own = [keys::sender_commands(
+        &cell.name,
+        &common_name(Role::Operator, name),
+    )];
+    let [query, reply] = &ids;
+    rules.push(rule(query.clone(), &["query"], IN, &own));
+    rules.push(rule(reply.clone(), &["reply"], OUT, &own));
+    ids
+}
+
+/// One subject and one policy per operator (its own command rule), one subject and one policy
+/// for all observers.
+fn client_policies(
+    cell: &Cell,
+    (observe_ids, operate_ids): (&[String], &[String]),
+    rules: &mut Vec<Value>,
+    (subjects, policies): (&mut Vec<Value>, &mut Vec<Value>),
+) {
+    for name in cell.security.names(Role::Operator) {
+        let id = format!("operator-{name}");
+        subjects.push(json!({
+            "id": id,
+            "cert_common_names": [common_name(Role::Operator, name)],
+            "link_protocols": ["tls"],
+        }));
+        let own = own_commands_rules(cell, name, rules);
+        let r: Vec<String> = observe_ids
+            .iter()
+            .chain(operate_ids.iter())
+            .cloned()
+            .chain(own)
+            .collect();
+        policies.push(json!({ "id": id, "rules": r, "subjects": [id] }));
+    }
+    let names = cell.security.names(Role::Observer);
+    if !names.is_empty() {
+        let id = "observers";
+        let cns: Vec<String> = names
+            .iter()
+            .map(|n| common_name(Role::Observer, n))
+            .collect();
+        subjects.push(json!({
+            "id": id,
+            "cert_common_names": cns,
+            "link_protocols": ["tls"],
+        }));
+        policies.push(json!({ "id": id, "rules": observe_ids, "subjects": [id] }));
+    }
 }
 
 /// The `access_control` section of every gateway of `cell` (Zenoh 1.10 schema).
@@ -175,24 +231,12 @@ pub fn access_control(cell: &Cell) -> Value {
         }
         policies.push(json!({ "id": id, "rules": r, "subjects": [id] }));
     }
-    for (role, extra) in [
-        (Role::Operator, &operate_ids),
-        (Role::Observer, &Vec::new()),
-    ] {
-        let names = cell.security.names(role);
-        if names.is_empty() {
-            continue;
-        }
-        let id = format!("{}s", role.name());
-        let cns: Vec<String> = names.iter().map(|n| common_name(role, n)).collect();
-        subjects.push(json!({
-            "id": id,
-            "cert_common_names": cns,
-            "link_protocols": ["tls"],
-        }));
-        let r: Vec<String> = observe_ids.iter().chain(extra.iter()).cloned().collect();
-        policies.push(json!({ "id": id, "rules": r, "subjects": [id] }));
-    }
+    client_policies(
+        cell,
+        (&observe_ids, &operate_ids),
+        &mut rules,
+        (&mut subjects, &mut policies),
+    );
     json!({
         "enabled": true,
         "default_permission": "deny",
@@ -212,7 +256,7 @@ mod tests {
 name = "c"
 
 [security]
-operators = ["alice"]
+operators = ["alice", "bob"]
 observers = ["hmi", "log"]
 
 [[hosts]]
@@ -304,6 +348,7 @@ emergency_deceleration = 2000.0
                 &json!(["host:h1"]),
                 &json!(["host:h2"]),
                 &json!(["operator:alice"]),
+                &json!(["operator:bob"]),
                 &json!(["observer:hmi", "observer:log"]),
             ]
         );
@@ -347,7 +392,7 @@ emergency_deceleration = 2000.0
                 s,
                 "declare_queryable",
                 "ingress",
-                "tandem/c/*/*/cmd"
+                "tandem/c/*/*/cmd/*"
             ));
             assert!(may(&acl, s, "query", "ingress", "tandem/c/clock/*"));
             assert!(may(
@@ -358,20 +403,35 @@ emergency_deceleration = 2000.0
                 "tandem/c/alive/*"
             ));
             // A gateway does not command another host's nodes.
-            assert!(!may(&acl, s, "query", "ingress", "tandem/c/*/*/cmd"));
+            assert!(!may(&acl, s, "query", "ingress", "tandem/c/*/*/cmd/*"));
         }
-        // Operators: command queries in, replies out, and what observers may.
-        let op = "operators";
-        assert!(may(&acl, op, "query", "ingress", "tandem/c/*/*/cmd"));
-        assert!(may(&acl, op, "reply", "egress", "tandem/c/*/*/cmd"));
-        assert!(may(
-            &acl,
-            op,
-            "declare_subscriber",
-            "ingress",
-            "tandem/c/*/*/state"
-        ));
-        assert!(!may(&acl, op, "put", "ingress", lv));
+        // Operators: their own command queries in, their replies out, and what observers may.
+        for (op, own, other) in [
+            ("operator-alice", "operator:alice", "operator:bob"),
+            ("operator-bob", "operator:bob", "operator:alice"),
+        ] {
+            let own = format!("tandem/c/*/*/cmd/{own}");
+            let other = format!("tandem/c/*/*/cmd/{other}");
+            assert!(may(&acl, op, "query", "ingress", &own));
+            assert!(may(&acl, op, "reply", "egress", &own));
+            assert!(!may(&acl, op, "query", "ingress", &other));
+            assert!(!may(&acl, op, "query", "ingress", "tandem/c/*/*/cmd/*"));
+            assert!(may(
+                &acl,
+                op,
+                "declare_queryable",
+                "egress",
+                "tandem/c/*/*/cmd/*"
+            ));
+            assert!(may(
+                &acl,
+                op,
+                "declare_subscriber",
+                "ingress",
+                "tandem/c/*/*/state"
+            ));
+            assert!(!may(&acl, op, "put", "ingress", lv));
+        }
         // Observers: subscriptions to what is observable, nothing in.
         let obs = "observers";
         for k in keys::observable("c") {
@@ -401,7 +461,7 @@ emergency_deceleration = 2000.0
             }
             for k in r["key_exprs"].as_array().unwrap() {
                 assert!(!k.as_str().unwrap().contains("/lv/"), "{r}");
-                assert!(!k.as_str().unwrap().ends_with("/cmd"), "{r}");
+                assert!(!k.as_str().unwrap().contains("/cmd"), "{r}");
             }
         }
         // Every policy names existing rules and subjects; ids are unique.
@@ -421,10 +481,51 @@ emergency_deceleration = 2000.0
         }
     }
 
+    /// Every rule that lets a client query or be replied on a command key names exactly one
+    /// sender: the common name of the one operator whose policy holds it.
+    #[test]
+    fn each_operator_may_query_only_the_commands_naming_its_own_certificate() {
+        let cell = tandem_config::parse("c.toml", CELL).unwrap();
+        let acl = access_control(&cell);
+        let mut seen = 0;
+        for p in acl["policies"].as_array().unwrap() {
+            let subject = p["subjects"][0].as_str().unwrap();
+            let s = acl["subjects"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|s| s["id"] == subject)
+                .unwrap();
+            for r in allowed(&acl, subject) {
+                let messages = r["messages"].as_array().unwrap();
+                let client_side = (r["flows"] == json!(["ingress"])
+                    && messages.iter().any(|m| m == "query"))
+                    || (r["flows"] == json!(["egress"]) && messages.iter().any(|m| m == "reply"));
+                let keys: Vec<&str> = r["key_exprs"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|k| k.as_str().unwrap())
+                    .collect();
+                if !client_side || !keys.iter().any(|k| k.contains("/cmd")) {
+                    continue;
+                }
+                // Only an operator, on its own key only.
+                assert!(subject.starts_with("operator-"), "{subject}: {r}");
+                assert_eq!(s["cert_common_names"].as_array().unwrap().len(), 1);
+                let cn = s["cert_common_names"][0].as_str().unwrap();
+                assert_eq!(keys, [format!("tandem/c/*/*/cmd/{cn}")], "{subject}: {r}");
+                seen += 1;
+            }
+        }
+        // A query rule and a reply rule for each of the two operators.
+        assert_eq!(seen, 4);
+    }
+
     #[test]
     fn a_cell_without_operators_or_observers_has_only_host_subjects() {
         let src = CELL
-            .replace("operators = [\"alice\"]\n", "")
+            .replace("operators = [\"alice\", \"bob\"]\n", "")
             .replace("observers = [\"hmi\", \"log\"]\n", "");
         let cell = tandem_config::parse("c.toml", &src).unwrap();
         let acl = access_control(&cell);

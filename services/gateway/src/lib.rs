@@ -9,8 +9,11 @@
 //!   Zenoh samples are published into this host's iceoryx2 leading-value service, so the
 //!   follower's node reads a remote leader exactly as a local one. The sample keeps its own
 //!   timestamp.
-//! - **Commands**: a queryable per node (`tandem/<cell>/<node>/*/cmd`) forwards each query to
-//!   the node's command service and replies with the job id or the ErrorID (JSON).
+//! - **Commands**: a queryable per node (`tandem/<cell>/<node>/*/cmd/*`, the last chunk the
+//!   sender, bound to the certificate by the access control in an mTLS cell) forwards each
+//!   query to the node's command service with that sender, replies with the job id or the
+//!   ErrorID (JSON), and publishes a `command` event (who, what, outcome) on the object's
+//!   events key. A plain cell also serves `tandem/<cell>/<node>/*/cmd` (the sender as claimed).
 //! - **Telemetry**: per axis state as JSON at `cell.telemetry_hz`, node health, job events and
 //!   log lines as they happen, a liveliness token per host, and the gateway's own counters.
 //! - **Clock watch**: a queryable answers with this host's clock; the gateway asks the others
@@ -570,6 +573,30 @@ type CommandClient = iceoryx2::port::client::Client<
     (),
 >;
 
+/// A queryable on `expr` that hands each query to the command thread through `tx`.
+fn command_queryable(
+    session: &zenoh::Session,
+    expr: String,
+    tx: mpsc::SyncSender<zenoh::query::Query>,
+) -> Result<zenoh::query::Queryable<()>, GatewayError> {
+    session
+        .declare_queryable(expr)
+        .callback(move |q| {
+            // Never dropped unanswered: a full queue answers `busy` at once.
+            if let Err(mpsc::TrySendError::Full(q)) = tx.try_send(q) {
+                reply_json(
+                    &q,
+                    &ReplyJson::failed(
+                        "busy",
+                        "the gateway's command queue is full; try again".to_string(),
+                    ),
+                );
+            }
+        })
+        .wait()
+        .map_err(GatewayError::zenoh("queryable"))
+}
+
 /// Zenoh queries to the nodes' command services and back.
 fn commands(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
@@ -580,25 +607,15 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
     let mut clients: HashMap<String, CommandClient> = HashMap::new();
     for n in &plan.nodes {
         let name = &cell.nodes[*n].name;
-        let tx = tx.clone();
-        queryables.push(
-            session
-                .declare_queryable(keys::commands(&cell.name, name))
-                .callback(move |q| {
-                    // Never dropped unanswered: a full queue answers `busy` at once.
-                    if let Err(mpsc::TrySendError::Full(q)) = tx.try_send(q) {
-                        reply_json(
-                            &q,
-                            &ReplyJson::failed(
-                                "busy",
-                                "the gateway's command queue is full; try again".to_string(),
-                            ),
-                        );
-                    }
-                })
-                .wait()
-                .map_err(GatewayError::zenoh("queryable"))?,
-        );
+        // The sender-bound key always; the key without a sender only in a plain cell (in an
+        // mTLS cell the sender must be the one the access control checked).
+        let mut exprs = vec![keys::commands(&cell.name, name)];
+        if cell.security.mode == SecurityMode::Plain {
+            exprs.push(keys::commands_unbound(&cell.name, name));
+        }
+        for expr in exprs {
+            queryables.push(command_queryable(session, expr, tx.clone())?);
+        }
         let svc = ipc::commands(&node, &cell.name, name)?;
         clients.insert(
             name.clone(),
@@ -612,9 +629,9 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
             continue;
         };
         c.commands.fetch_add(1, Ordering::Relaxed);
-        let sender = query_sender(&q);
+        let sender = query_sender(&cell.name, &q);
         let reply = if rates.admit(&sender, tandem_rt::now_ns()) {
-            answer(&q, (cell, host), &sender, &clients, c)
+            answer(&q, (cell, host, session), &sender, &clients, c)
         } else {
             c.commands_busy.fetch_add(1, Ordering::Relaxed);
             ReplyJson::failed(
@@ -642,10 +659,31 @@ fn reply_json(q: &zenoh::query::Query, reply: &ReplyJson) {
     }
 }
 
-/// Who sends query `q`: its attachment `sender=<name>`, else the `sender` of its JSON payload,
-/// else `anonymous` (docs/gateway.md, "Command rate"; not authenticated: Zenoh 1.x tells a
-/// queryable nothing of the querier, the mTLS work binds it to the certificate subject).
-fn query_sender(q: &zenoh::query::Query) -> String {
+/// Who sends query `q`: the sender its key names (`…/cmd/<sender>`, docs/security.md
+/// "Commands with identity": in an mTLS cell the access control let the query through only if
+/// that is the common name of the querier's certificate), whatever its payload claims; for a
+/// key without a sender (plain cells only) its attachment `sender=<name>`, else the `sender` of
+/// its JSON payload, else `anonymous` (docs/gateway.md, "Command rate").
+fn query_sender(cell: &str, q: &zenoh::query::Query) -> String {
+    let claimed = claimed_sender(q);
+    match keys::parse_command(cell, q.key_expr().as_str()).and_then(|k| k.sender) {
+        Some(bound) => {
+            if let Some(c) = claimed.filter(|c| c != bound) {
+                info!(
+                    sender = bound,
+                    claimed = %c,
+                    "the command's payload claims another sender: the key's is used"
+                );
+            }
+            bound.to_string()
+        }
+        None => claimed.unwrap_or_else(|| ANONYMOUS.to_string()),
+    }
+}
+
+/// The sender query `q` claims: its attachment `sender=<name>`, else the `sender` of its JSON
+/// payload (not authenticated).
+fn claimed_sender(q: &zenoh::query::Query) -> Option<String> {
     let from_attachment = q.attachment().and_then(|a| {
         a.try_to_string()
             .ok()
@@ -658,23 +696,25 @@ fn query_sender(q: &zenoh::query::Query) -> String {
             .and_then(|t| serde_json::from_str::<json::CommandJson>(&t).ok())
             .and_then(|c| c.sender)
     };
-    from_attachment
-        .or_else(from_json)
-        .filter(|s| !s.is_empty())
-        .unwrap_or_else(|| ANONYMOUS.to_string())
+    from_attachment.or_else(from_json).filter(|s| !s.is_empty())
 }
 
 /// The reply to one command query, in a `command` span (node, object, instruction, job):
 /// the node's, or why it was not forwarded.
 fn answer(
     q: &zenoh::query::Query,
-    (cell, host): (&Cell, &str),
+    (cell, host, session): (&Cell, &str, &zenoh::Session),
     sender: &str,
     clients: &HashMap<String, CommandClient>,
     c: &Counters,
 ) -> ReplyJson {
     let key = q.key_expr().as_str();
-    let Some((node_name, object)) = keys::parse_command(&cell.name, key) else {
+    let Some(keys::CommandKey {
+        node: node_name,
+        object,
+        ..
+    }) = keys::parse_command(&cell.name, key)
+    else {
         debug!(key, "not a command key");
         return ReplyJson::failed("invalid", format!("`{key}` is not a command key"));
     };
@@ -700,7 +740,18 @@ fn answer(
             "invalid",
             format!("node `{node_name}` is not on host `{host}`"),
         ),
-        (Ok(line), Some(client)) => forward(client, &format!("{object} {line}"), sender),
+        (Ok(line), Some(client)) => {
+            let reply = forward(client, &format!("{object} {line}"), sender);
+            // Who commanded what, with what outcome, for every observer (the node's audit
+            // file has the same record).
+            let event = EventJson::command(object, sender, &line, &reply);
+            put(
+                session,
+                keys::events(&cell.name, node_name, object),
+                serde_json::to_string(&event).unwrap_or_default(),
+            );
+            reply
+        }
     };
     span.record("job", reply.job);
     debug!(

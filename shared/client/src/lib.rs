@@ -64,6 +64,15 @@ pub enum ClientError {
     },
     /// A payload that is not what the protocol says.
     Malformed(String),
+    /// The client's certificate could not be read or names no usable common name.
+    Certificate {
+        /// The certificate file.
+        path: std::path::PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The sender cannot be the last chunk of a command key ([`keys::valid_sender`]).
+    Sender(String),
 }
 
 impl core::fmt::Display for ClientError {
@@ -91,6 +100,13 @@ impl core::fmt::Display for ClientError {
                 }
             }
             Self::Malformed(m) => write!(f, "malformed answer: {m}"),
+            Self::Certificate { path, reason } => {
+                write!(f, "certificate {}: {reason}", path.display())
+            }
+            Self::Sender(s) => write!(
+                f,
+                "sender {s:?} cannot name a command key (empty, `/`, `*`, `$`, `?`, `#`, a leading `@`, or a control character)"
+            ),
         }
     }
 }
@@ -128,6 +144,33 @@ pub struct Tls {
 }
 
 impl Tls {
+    /// The common name of the client's certificate (`operator:alice`): its identity in the
+    /// cell's access control, and so the sender of its commands.
+    pub fn common_name(&self) -> Result<String, ClientError> {
+        let path = &self.certificate;
+        let err = |reason: String| ClientError::Certificate {
+            path: path.clone(),
+            reason,
+        };
+        let text = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+        let (_, pem) = x509_parser::pem::parse_x509_pem(&text).map_err(|e| err(e.to_string()))?;
+        let cert = pem.parse_x509().map_err(|e| err(e.to_string()))?;
+        let cn = cert
+            .subject()
+            .iter_common_name()
+            .next()
+            .ok_or_else(|| err("it has no common name (CN)".into()))?
+            .as_str()
+            .map_err(|e| err(format!("its common name is not text: {e}")))?
+            .to_string();
+        if !keys::valid_sender(&cn) {
+            return Err(err(format!(
+                "its common name {cn:?} cannot name a command key"
+            )));
+        }
+        Ok(cn)
+    }
+
     /// Sets the Zenoh keys of a mutually authenticated TLS client.
     fn configure(&self, c: &mut zenoh::Config) -> Result<(), ClientError> {
         let file = |p: &std::path::Path| serde_json::to_string(&p.to_string_lossy()).map_err(z);
@@ -158,7 +201,11 @@ impl Tls {
 pub struct Client {
     session: zenoh::Session,
     cell: String,
+    sender: String,
 }
+
+/// The sender of a client without a certificate: `$TANDEM_SENDER` if set, else this.
+pub const DEFAULT_SENDER: &str = "anonymous";
 
 fn z(e: impl core::fmt::Display) -> ClientError {
     ClientError::Zenoh(e.to_string())
@@ -175,6 +222,12 @@ impl Client {
     /// Connects as [`Client::connect`] does; with `tls`, over TLS links only, presenting the
     /// operator's or observer's certificate (mTLS, docs/security.md). The session never listens:
     /// it only dials the gateways.
+    ///
+    /// The sender of its commands (the last chunk of their keys): with `tls`, the common name
+    /// of the certificate (the cell's access control lets an operator query only the keys that
+    /// name its own); without, `$TANDEM_SENDER`, else [`DEFAULT_SENDER`], or what
+    /// [`Client::with_sender`] sets (not authenticated: docs/security.md, "Commands with
+    /// identity").
     pub async fn connect_tls(
         cell: &str,
         endpoints: &[String],
@@ -190,14 +243,42 @@ impl Client {
                 .insert_json5("scouting/multicast/enabled", "false")
                 .map_err(z)?;
         }
-        if let Some(t) = tls {
-            t.configure(&mut config)?;
+        let sender = match tls {
+            Some(t) => {
+                t.configure(&mut config)?;
+                t.common_name()?
+            }
+            None => std::env::var("TANDEM_SENDER")
+                .ok()
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .unwrap_or_else(|| DEFAULT_SENDER.to_string()),
+        };
+        if !keys::valid_sender(&sender) {
+            return Err(ClientError::Sender(sender));
         }
         let session = zenoh::open(config).await.map_err(z)?;
         Ok(Client {
             session,
             cell: cell.into(),
+            sender,
         })
+    }
+
+    /// Names the sender of this client's commands (a client without a certificate; with one,
+    /// any other name than its common name is refused by the cell's access control: the
+    /// commands get no reply).
+    pub fn with_sender(mut self, sender: &str) -> Result<Client, ClientError> {
+        if !keys::valid_sender(sender) {
+            return Err(ClientError::Sender(sender.into()));
+        }
+        self.sender = sender.into();
+        Ok(self)
+    }
+
+    /// The sender of this client's commands.
+    pub fn sender(&self) -> &str {
+        &self.sender
     }
 
     /// Sends `line` (`MC_MoveAbsolute --position 10`, the names and parameters of scripts) to
@@ -209,7 +290,7 @@ impl Client {
         line: &str,
         timeout: Duration,
     ) -> Result<Accepted, ClientError> {
-        let key = keys::command(&self.cell, node, object);
+        let key = keys::command(&self.cell, node, object, &self.sender);
         let replies = self
             .session
             .get(&key)
@@ -299,7 +380,8 @@ impl Client {
             let Ok(e) = serde_json::from_str::<EventJson>(&text) else {
                 continue;
             };
-            if e.job != accepted.job {
+            // The gateway's `command` record of this very command is not a job event.
+            if e.job != accepted.job || e.outcome == "command" {
                 continue;
             }
             let outcome = e.outcome.clone();

@@ -299,15 +299,38 @@ pub struct EventJson {
     pub object: String,
     /// The job, 0 for a log line.
     pub job: u32,
-    /// `done`, `aborted`, `error`, `reached`, `progress`, or `log`.
+    /// `done`, `aborted`, `error`, `reached`, `progress`, `log`, or `command` (a command answered,
+    /// with its [`EventJson::sender`]).
     pub outcome: String,
     /// The ErrorID of an `error`, `16#8001 TechnologyAlarm`; empty otherwise.
     pub error_id: String,
     /// The event or line, as the log shows it.
     pub message: String,
+    /// Who sent the command of a `command` event (the certificate's subject in an mTLS cell);
+    /// absent for the node's own events.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sender: Option<String>,
 }
 
 impl EventJson {
+    /// A `command` event: who sent command `line` to `object` and how it was answered
+    /// (docs/gateway.md, "Audit trail"), as the gateway publishes it on the object's events key.
+    pub fn command(object: &str, sender: &str, line: &str, reply: &ReplyJson) -> Self {
+        let mut message = format!("{line}: {}", reply.outcome);
+        if !reply.message.is_empty() {
+            message.push_str(&format!(" ({})", reply.message));
+        }
+        Self {
+            t_ns: reply.t_ns,
+            object: object.into(),
+            job: reply.job,
+            outcome: "command".into(),
+            error_id: reply.error_id.clone(),
+            message,
+            sender: Some(sender.into()),
+        }
+    }
+
     /// The JSON form of a node event (`object` named by the caller).
     pub fn new(e: &Event, object: &str) -> Self {
         let outcome = match (e.kind, e.code) {
@@ -329,6 +352,7 @@ impl EventJson {
                 String::new()
             },
             message: e.message.as_str().into(),
+            sender: None,
         }
     }
 }

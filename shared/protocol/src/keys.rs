@@ -38,25 +38,70 @@ pub fn events(cell: &str, node: &str, object: &str) -> String {
     format!("tandem/{cell}/{node}/{object}/events")
 }
 
-/// The queryable of a technology object: a command in, the job id or ErrorID out.
-pub fn command(cell: &str, node: &str, object: &str) -> String {
+/// The command key of a technology object for commands of `sender`: a command in, the job id
+/// or ErrorID out. The sender is part of the key so that, in an mTLS cell, the access control
+/// binds it to the querier's certificate: the operator whose certificate's common name is `X`
+/// may query only keys ending in `/cmd/X` ([`sender_commands`]; docs/security.md, "Commands
+/// with identity").
+pub fn command(cell: &str, node: &str, object: &str, sender: &str) -> String {
+    format!("tandem/{cell}/{node}/{object}/cmd/{sender}")
+}
+
+/// The command key without a sender (plain cells only; the sender then comes from the query's
+/// attachment or JSON payload, docs/gateway.md "Command rate").
+pub fn command_unbound(cell: &str, node: &str, object: &str) -> String {
     format!("tandem/{cell}/{node}/{object}/cmd")
 }
 
-/// All command keys of `node` (one queryable per node).
+/// All command keys of `node`, of any sender (one queryable per node).
 pub fn commands(cell: &str, node: &str) -> String {
-    format!("tandem/{cell}/{node}/*/cmd")
+    command(cell, node, "*", "*")
 }
 
-/// The node and object of a command key.
-pub fn parse_command<'a>(cell: &str, key: &'a str) -> Option<(&'a str, &'a str)> {
+/// All command keys of `node` without a sender (plain cells only).
+pub fn commands_unbound(cell: &str, node: &str) -> String {
+    command_unbound(cell, node, "*")
+}
+
+/// Whether `sender` can be the last chunk of a command key: not empty, no `/`, none of Zenoh's
+/// wildcard or reserved characters (`*`, `$`, `?`, `#`), not starting with `@` (a verbatim
+/// chunk), no control characters.
+pub fn valid_sender(sender: &str) -> bool {
+    !sender.is_empty()
+        && !sender.starts_with('@')
+        && !sender
+            .chars()
+            .any(|c| matches!(c, '/' | '*' | '$' | '?' | '#') || c.is_control())
+}
+
+/// A parsed command key: the node, the object, and the sender (`None` for a key without one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CommandKey<'a> {
+    /// The node serving the object.
+    pub node: &'a str,
+    /// The technology object.
+    pub object: &'a str,
+    /// The sender named by the key (bound to the certificate in an mTLS cell).
+    pub sender: Option<&'a str>,
+}
+
+/// The node, object and sender of a command key (`None` if it is not one of `cell`).
+pub fn parse_command<'a>(cell: &str, key: &'a str) -> Option<CommandKey<'a>> {
     let rest = key
         .strip_prefix("tandem/")?
         .strip_prefix(cell)?
         .strip_prefix('/')?;
-    let rest = rest.strip_suffix("/cmd")?;
-    let (node, object) = rest.split_once('/')?;
-    (!object.contains('/')).then_some((node, object))
+    let (node, rest) = rest.split_once('/')?;
+    let (object, rest) = rest.split_once('/')?;
+    let sender = match rest {
+        "cmd" => None,
+        _ => Some(rest.strip_prefix("cmd/").filter(|s| valid_sender(s))?),
+    };
+    Some(CommandKey {
+        node,
+        object,
+        sender,
+    })
 }
 
 /// Each edge of signal `signal` (an input or output of `node`'s process image), as JSON, as it
@@ -100,9 +145,15 @@ pub fn alive_all(cell: &str) -> String {
     format!("tandem/{cell}/alive/*")
 }
 
-/// Every command key of the cell (what an operator may query).
+/// Every command key of the cell, of every sender (what the gateways serve).
 pub fn all_commands(cell: &str) -> String {
-    command(cell, "*", "*")
+    command(cell, "*", "*", "*")
+}
+
+/// Every command key of `sender` (what the operator whose certificate's common name is
+/// `sender` may query in an mTLS cell).
+pub fn sender_commands(cell: &str, sender: &str) -> String {
+    command(cell, "*", "*", sender)
 }
 
 /// Every clock queryable of the cell (what the gateways ask each other).
@@ -138,10 +189,36 @@ mod tests {
         assert_eq!(parse_leading_value("line", &k), Some(("master", true)));
         assert_eq!(parse_leading_value("other", &k), None);
         assert_eq!(parse_leading_value("line", "tandem/line/lv/a/b"), None);
-        let c = command("line", "followers", "feed");
-        assert_eq!(parse_command("line", &c), Some(("followers", "feed")));
+        let c = command("line", "followers", "feed", "operator:alice");
+        assert_eq!(c, "tandem/line/followers/feed/cmd/operator:alice");
+        let parsed = parse_command("line", &c).unwrap();
+        assert_eq!(
+            (parsed.node, parsed.object, parsed.sender),
+            ("followers", "feed", Some("operator:alice"))
+        );
+        let unbound = command_unbound("line", "followers", "feed");
+        let parsed = parse_command("line", &unbound).unwrap();
+        assert_eq!(
+            (parsed.node, parsed.object, parsed.sender),
+            ("followers", "feed", None)
+        );
         assert_eq!(parse_command("line", "tandem/line/followers/cmd"), None);
-        assert_eq!(all_commands("line"), "tandem/line/*/*/cmd");
+        assert_eq!(parse_command("line", "tandem/line/a/b/cmd/"), None);
+        assert_eq!(parse_command("line", "tandem/line/a/b/cmd/x/y"), None);
+        assert_eq!(parse_command("line", "tandem/line/a/b/state"), None);
+        assert_eq!(parse_command("other", &c), None);
+        assert_eq!(all_commands("line"), "tandem/line/*/*/cmd/*");
+        assert_eq!(commands("line", "n"), "tandem/line/n/*/cmd/*");
+        assert_eq!(
+            sender_commands("line", "operator:bob"),
+            "tandem/line/*/*/cmd/operator:bob"
+        );
+        for ok in ["operator:alice", "root@ctl1", "anonymous"] {
+            assert!(valid_sender(ok), "{ok}");
+        }
+        for bad in ["", "a/b", "*", "a*", "$x", "a?", "#", "@x", "a\nb"] {
+            assert!(!valid_sender(bad), "{bad:?}");
+        }
         assert_eq!(
             observable("line"),
             [

@@ -406,6 +406,7 @@ fn attack(hosts: &Hosts, name: &str, cell: &Path, pki: &Path) {
         name,
         &[
             &observer[..],
+            &["--sender".into(), "observer:hmi".into()],
             &cmd("nb/spare", "MC_Power"),
             &cmd("nb/fb", "MC_Halt"),
             &["--garbage".into(), lv.clone()],
@@ -459,6 +460,7 @@ fn attack(hosts: &Hosts, name: &str, cell: &Path, pki: &Path) {
                 "--key".into(),
                 p("operator-alice.key"),
             ],
+            &["--sender".into(), "operator:alice".into()],
             &cmd("nb/spare", "MC_Power"),
         ]
         .concat(),
