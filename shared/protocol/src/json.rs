@@ -235,6 +235,9 @@ pub struct Health {
     /// Leaders followed again after a confirmed jump.
     #[serde(default)]
     pub lv_reanchored: u64,
+    /// Cycles skipped to rejoin the time grid after a stall.
+    #[serde(default)]
+    pub skipped_cycles: u64,
 }
 
 impl Health {
@@ -266,6 +269,7 @@ impl Health {
             lv_sequence: h.lv_sequence,
             lv_jump: h.lv_jump,
             lv_reanchored: h.lv_reanchored,
+            skipped_cycles: h.skipped_cycles,
         }
     }
 }

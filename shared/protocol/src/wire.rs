@@ -308,6 +308,9 @@ pub struct NodeHealth {
     pub lv_jump: u64,
     /// Leaders followed again after a confirmed jump (three consistent samples).
     pub lv_reanchored: u64,
+    /// Cycles skipped to rejoin the time grid after a stall (a cycle overflow) instead of
+    /// being run back to back (docs/processes.md, "Stalls").
+    pub skipped_cycles: u64,
 }
 
 /// One axis in a telemetry snapshot.
