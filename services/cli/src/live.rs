@@ -130,6 +130,11 @@ impl Observer {
         out
     }
 
+    /// The newest health node `n` published, if any.
+    pub(crate) fn health(&self, n: usize) -> Option<&NodeHealth> {
+        self.last.get(n)?.as_ref().map(|(h, _, _)| h)
+    }
+
     /// Whether node `n` published within the last second.
     fn alive(&self, n: usize) -> bool {
         self.last[n]

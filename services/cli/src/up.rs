@@ -63,6 +63,10 @@ struct Slot {
     start_at: Option<Instant>,
     started: Instant,
     finished: bool,
+    /// The watchdog reported this process stalled (once per stall).
+    stall_reported: bool,
+    /// The watchdog killed it (kill -9) to restart it.
+    watchdog_killed: bool,
 }
 
 impl Slot {
@@ -76,6 +80,8 @@ impl Slot {
             start_at: Some(Instant::now()),
             started: Instant::now(),
             finished: false,
+            stall_reported: false,
+            watchdog_killed: false,
         }
     }
 }
@@ -154,6 +160,10 @@ fn start(
     c.stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
+    // When `up` dies (even by kill -9) its processes get SIGTERM and stop: no unsupervised set
+    // is left to run beside the next `up`'s. `up` spawns from its main thread, which lives as
+    // long as the supervision.
+    rt::die_with_parent(&mut c);
     let mut child = c.spawn()?;
     if let Some(stderr) = child.stderr.take() {
         let (tx, n) = (lines.clone(), name.to_string());
@@ -202,7 +212,10 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), C
     let (cell, host, nodes) = prepare(cell_path, o)?;
     let span = info_span!("up", cell = %cell.name, host = %host);
     let _entered = span.enter();
+    // One supervisor per cell and host, for as long as this `up` runs.
+    let _lock = lock(&cell, &host)?;
     rt::install_termination_handler();
+    warn_if_shm_small(out);
     let removed = ipc::cleanup_dead_nodes(&host);
     let iox = cli_node(&cell, "up", &host)?;
     let obs = Observer::new(&iox, &cell, &nodes, true)?;
@@ -241,6 +254,64 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), C
     s.stop(out);
     outln!(out, "tandem up: all nodes stopped");
     result
+}
+
+/// The lock file of the supervisor of `cell` on `host`: `<retain_dir>/<cell>/<host>.up.lock`.
+pub fn lock_path(cell: &Cell, host: &str) -> PathBuf {
+    cell.retain_dir
+        .join(&cell.name)
+        .join(format!("{host}.up.lock"))
+}
+
+/// Takes the supervisor's lock of `cell` on `host` (held until it is dropped or `up` ends, also
+/// by kill -9), or the error naming the `up` that holds it.
+fn lock(cell: &Cell, host: &str) -> Result<rt::RunLock, CliError> {
+    let path = lock_path(cell, host);
+    rt::RunLock::acquire(&path).map_err(|e| match e {
+        rt::LockError::Held { pid } => CliError::AlreadySupervised {
+            cell: cell.name.clone(),
+            host: host.to_string(),
+            path: path.clone(),
+            pid,
+        },
+        rt::LockError::Io { .. } => CliError::Lock {
+            path: path.clone(),
+            source: e,
+        },
+    })
+}
+
+/// Where iceoryx2 keeps its shared memory.
+const SHM: &str = "/dev/shm";
+
+/// The free space of /dev/shm below which `up` warns at start: 64 MiB. Inferred: a node of a
+/// few axes with the default iceoryx2 settings maps a few MiB (its telemetry, events and
+/// command services, each with its subscribers' buffers); a cell of several nodes and its
+/// observers needs tens of MiB.
+const SHM_WARN_BYTES: u64 = 64 << 20;
+
+/// The free space of /dev/shm in MB, for messages ("?" when it cannot be read).
+fn shm_free_mb() -> String {
+    rt::free_bytes(Path::new(SHM)).map_or("?".into(), |b| format!("{:.1}", b as f64 / 1e6))
+}
+
+/// Warns when /dev/shm has less free space than [`SHM_WARN_BYTES`]: iceoryx2's shared memory
+/// then fails to be created, or a process dies of SIGBUS when it first touches a page.
+fn warn_if_shm_small(out: &mut impl Write) {
+    let Some(free) = rt::free_bytes(Path::new(SHM)) else {
+        return;
+    };
+    if free < SHM_WARN_BYTES {
+        let line = format!(
+            "WARNING: {SHM} has only {:.1} MB free (at least {} MB recommended): iceoryx2's \
+             shared memory may not fit, and a node then dies of SIGBUS (docs/processes.md, \
+             \"Shared memory\")",
+            free as f64 / 1e6,
+            SHM_WARN_BYTES >> 20
+        );
+        warn!("{line}");
+        outln!(out, "{line}");
+    }
 }
 
 /// Warns (on stdout and as a `tracing` warning) when the cell's Zenoh is plain,
@@ -285,6 +356,7 @@ struct Supervisor<'a> {
     rx: mpsc::Receiver<(String, String)>,
     /// The live view's recent messages.
     messages: VecDeque<String>,
+
     last_draw: Instant,
 }
 
@@ -316,11 +388,11 @@ impl<'a> Supervisor<'a> {
     /// its configuration or could not be started (the error).
     fn supervise(&mut self, out: &mut impl Write) -> Result<(), CliError> {
         while !rt::termination_requested() {
+            self.obs.poll();
             for i in 0..self.slots.len() {
                 self.tend(i)?;
             }
             self.relay(out);
-            self.obs.poll();
             if self.launch.o.view && self.last_draw.elapsed() > Duration::from_millis(250) {
                 self.last_draw = Instant::now();
                 self.draw(out);
@@ -333,9 +405,96 @@ impl<'a> Supervisor<'a> {
             {
                 break;
             }
-            std::thread::sleep(Duration::from_millis(20));
+            std::thread::sleep(self.next_look());
         }
         Ok(())
+    }
+
+    /// How long to sleep before looking again: 20 ms, or less when a watchdog deadline comes
+    /// sooner (so that a stall is reported within a few ms of the watchdog time).
+    fn next_look(&self) -> Duration {
+        let cell = self.launch.cell;
+        let now = rt::now_ns();
+        let soonest = (0..self.slots.len())
+            .filter_map(|i| {
+                let slot = self.slots.get(i)?;
+                let last = self.last_cycle(i)?;
+                let after = if !slot.stall_reported {
+                    cell.watchdog_ns
+                } else if !slot.watchdog_killed {
+                    cell.watchdog_restart_ns
+                } else {
+                    return None;
+                };
+                Some(last.saturating_add(after).saturating_sub(now))
+            })
+            .min()
+            .unwrap_or(i64::MAX);
+        Duration::from_nanos(soonest.clamp(1_000_000, 20_000_000) as u64)
+    }
+
+    /// The cell clock time of the last cycle process `i` (a node, running) published, if it
+    /// published since it was started.
+    fn last_cycle(&self, i: usize) -> Option<i64> {
+        let slot = self.slots.get(i)?;
+        let pid = slot.child.as_ref()?.id();
+        let h = self.obs.health(slot.node?).filter(|h| h.pid == pid)?;
+        Some(h.epoch_ns.saturating_add(h.t_ns))
+    }
+
+    /// The watchdog of process `i`: reports it stalled once its last cycle is
+    /// `[cell] watchdog_ms` old, kills it (kill -9, to be restarted as a crashed one) once it is
+    /// `watchdog_restart_ms` old, and reports it cycling again when it resumed before.
+    fn watch(&mut self, i: usize) {
+        let Some(last) = self.last_cycle(i) else {
+            return;
+        };
+        let cell = self.launch.cell;
+        let silent = rt::now_ns().saturating_sub(last);
+        let t = last.saturating_sub(self.launch.epoch);
+        let slot = &mut self.slots[i];
+        let name = slot.name.clone();
+        let ms = |ns: i64| ns as f64 / 1e6;
+        let mut lines = Vec::new();
+        if silent > cell.watchdog_ns && !slot.stall_reported {
+            slot.stall_reported = true;
+            let line = format!(
+                "[{name}] stalled: no cycle since t={} ({:.1} ms ago; watchdog {:.0} ms)",
+                tandem_runtime::exec::Secs(t),
+                ms(silent),
+                ms(cell.watchdog_ns)
+            );
+            warn!(silent_ms = ms(silent), "{line}");
+            lines.push(line);
+        }
+        if silent > cell.watchdog_restart_ns && !slot.watchdog_killed {
+            slot.watchdog_killed = true;
+            let line = format!(
+                "[{name}] silent for {:.1} ms (watchdog_restart_ms {:.0}): killing it (kill -9) to restart it",
+                ms(silent),
+                ms(cell.watchdog_restart_ns)
+            );
+            warn!("{line}");
+            if let Some(c) = slot.child.as_mut() {
+                if let Err(e) = c.kill() {
+                    // It ended meanwhile: `tend` collects it and restarts it.
+                    tracing::debug!(node = %name, error = %e, "SIGKILL");
+                }
+            }
+            lines.push(line);
+        }
+        if silent <= cell.watchdog_ns && slot.stall_reported && !slot.watchdog_killed {
+            slot.stall_reported = false;
+            let line = format!(
+                "[{name}] cycling again at t={}",
+                tandem_runtime::exec::Secs(t)
+            );
+            info!("{line}");
+            lines.push(line);
+        }
+        for line in lines {
+            self.note(line);
+        }
     }
 
     /// Lists `line` in the live view (a supervision event, already given to `tracing`).
@@ -367,6 +526,7 @@ impl<'a> Supervisor<'a> {
                 slot.child = None;
                 return self.ended(i, status);
             }
+            self.watch(i);
         } else if slot.start_at.is_some_and(|at| Instant::now() >= at) {
             slot.start_at = None;
             return self.spawn(i);
@@ -392,7 +552,16 @@ impl<'a> Supervisor<'a> {
         if slot.started.elapsed() > MAX_BACKOFF {
             slot.backoff = FIRST_BACKOFF;
         }
-        let reason = describe_exit(status);
+        let reason = if slot.watchdog_killed {
+            "killed by the watchdog after a stall".to_string()
+        } else if std::os::unix::process::ExitStatusExt::signal(&status) == Some(libc::SIGBUS) {
+            format!(
+                "SIGBUS: {SHM} is probably too small (free {} MB)",
+                shm_free_mb()
+            )
+        } else {
+            describe_exit(status)
+        };
         let line = format!(
             "[{name}] crashed ({reason}); restarting in {:.1} s",
             slot.backoff.as_secs_f64()
@@ -431,6 +600,8 @@ impl<'a> Supervisor<'a> {
         let slot = &mut self.slots[i];
         slot.child = Some(child);
         slot.started = Instant::now();
+        slot.stall_reported = false;
+        slot.watchdog_killed = false;
         self.note(line);
         Ok(())
     }
