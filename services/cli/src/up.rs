@@ -284,11 +284,11 @@ fn lock(cell: &Cell, host: &str) -> Result<rt::RunLock, CliError> {
 /// Where iceoryx2 keeps its shared memory.
 const SHM: &str = "/dev/shm";
 
-/// The free space of /dev/shm below which `up` warns at start: 64 MiB. Inferred: a node of a
-/// few axes with the default iceoryx2 settings maps a few MiB (its telemetry, events and
-/// command services, each with its subscribers' buffers); a cell of several nodes and its
-/// observers needs tens of MiB.
-const SHM_WARN_BYTES: u64 = 64 << 20;
+/// The free space of /dev/shm below which `up` warns at start: 16 MiB. Measured: the three
+/// nodes of the bundled line cell and `up` map 11.5 MB of iceoryx2 segments there (sparse
+/// files; 0.8 MB of pages touched after a few seconds), and a node dies of SIGBUS when it
+/// touches a page the file system cannot give (docs/processes.md, "Shared memory").
+const SHM_WARN_BYTES: u64 = 16 << 20;
 
 /// The free space of /dev/shm in MB, for messages ("?" when it cannot be read).
 fn shm_free_mb() -> String {

@@ -316,3 +316,32 @@ fn one_supervisor_per_host_and_none_left_behind_by_a_killed_one() {
     assert!(processes(&cell).is_empty(), "{:?}", processes(&cell));
     remove_dir(&dir);
 }
+
+/// /dev/shm too small (a 200 kB tmpfs in a mount namespace of its own): `up` warns at start
+/// naming /dev/shm and its free space, and reports each node that dies of SIGBUS as such
+/// instead of a bare crash. Needs root (unshare -m); the suite's network tests need it too.
+#[test]
+fn a_too_small_dev_shm_is_named() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = fresh_dir(&format!("tandem-watchdog-shm-{}", std::process::id()));
+    let cell = cell(&dir, &format!("wdm{}", std::process::id()), 2000);
+    let tandem = tandem_testkit::workspace::bin("tandem");
+    let mut c = std::process::Command::new("unshare");
+    c.arg("-m").arg("sh").arg("-c").arg(format!(
+        "mount -t tmpfs -o size=200k tmpfs /dev/shm && exec timeout -s TERM 6 {} up {} \
+         --no-view --no-gateway",
+        tandem.display(),
+        cell.display()
+    ));
+    let o = run(c, Duration::from_secs(30));
+    let said = text(&o);
+    assert!(
+        said.contains("WARNING: /dev/shm has only 0.2 MB free"),
+        "{said}"
+    );
+    assert!(
+        said.contains("crashed (SIGBUS: /dev/shm is probably too small (free"),
+        "{said}"
+    );
+    remove_dir(&dir);
+}
