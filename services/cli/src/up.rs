@@ -67,6 +67,8 @@ struct Slot {
     stall_reported: bool,
     /// The watchdog killed it (kill -9) to restart it.
     watchdog_killed: bool,
+    /// The gateway: the cell clock time it was last seen not stopped.
+    gateway_alive_ns: i64,
 }
 
 impl Slot {
@@ -82,6 +84,7 @@ impl Slot {
             finished: false,
             stall_reported: false,
             watchdog_killed: false,
+            gateway_alive_ns: rt::now_ns(),
         }
     }
 }
@@ -433,12 +436,16 @@ impl<'a> Supervisor<'a> {
         Duration::from_nanos(soonest.clamp(1_000_000, 20_000_000) as u64)
     }
 
-    /// The cell clock time of the last cycle process `i` (a node, running) published, if it
-    /// published since it was started.
+    /// The cell clock time process `i` was last seen alive: for a node, its last cycle
+    /// published (if it published since it was started); for the gateway, which publishes no
+    /// cycle on iceoryx2, the last time its process was not stopped (`/proc/<pid>/stat`).
     fn last_cycle(&self, i: usize) -> Option<i64> {
         let slot = self.slots.get(i)?;
         let pid = slot.child.as_ref()?.id();
-        let h = self.obs.health(slot.node?).filter(|h| h.pid == pid)?;
+        let Some(node) = slot.node else {
+            return Some(slot.gateway_alive_ns);
+        };
+        let h = self.obs.health(node).filter(|h| h.pid == pid)?;
         Some(h.epoch_ns.saturating_add(h.t_ns))
     }
 
@@ -446,6 +453,12 @@ impl<'a> Supervisor<'a> {
     /// `[cell] watchdog_ms` old, kills it (kill -9, to be restarted as a crashed one) once it is
     /// `watchdog_restart_ms` old, and reports it cycling again when it resumed before.
     fn watch(&mut self, i: usize) {
+        if let Some(slot) = self.slots.get_mut(i).filter(|s| s.node.is_none()) {
+            let pid = slot.child.as_ref().map(Child::id);
+            if pid.is_some_and(|p| !stopped(p)) {
+                slot.gateway_alive_ns = rt::now_ns();
+            }
+        }
         let Some(last) = self.last_cycle(i) else {
             return;
         };
@@ -458,8 +471,13 @@ impl<'a> Supervisor<'a> {
         let mut lines = Vec::new();
         if silent > cell.watchdog_ns && !slot.stall_reported {
             slot.stall_reported = true;
+            let what = if slot.node.is_some() {
+                "no cycle"
+            } else {
+                "stopped"
+            };
             let line = format!(
-                "[{name}] stalled: no cycle since t={} ({:.1} ms ago; watchdog {:.0} ms)",
+                "[{name}] stalled: {what} since t={} ({:.1} ms ago; watchdog {:.0} ms)",
                 tandem_runtime::exec::Secs(t),
                 ms(silent),
                 ms(cell.watchdog_ns)
@@ -486,7 +504,12 @@ impl<'a> Supervisor<'a> {
         if silent <= cell.watchdog_ns && slot.stall_reported && !slot.watchdog_killed {
             slot.stall_reported = false;
             let line = format!(
-                "[{name}] cycling again at t={}",
+                "[{name}] {} again at t={}",
+                if slot.node.is_some() {
+                    "cycling"
+                } else {
+                    "running"
+                },
                 tandem_runtime::exec::Secs(t)
             );
             info!("{line}");
@@ -602,6 +625,7 @@ impl<'a> Supervisor<'a> {
         slot.started = Instant::now();
         slot.stall_reported = false;
         slot.watchdog_killed = false;
+        slot.gateway_alive_ns = rt::now_ns();
         self.note(line);
         Ok(())
     }
@@ -659,6 +683,19 @@ impl<'a> Supervisor<'a> {
             outln!(out, "[{n}] {line}");
         }
     }
+}
+
+/// Whether process `pid` is stopped (SIGSTOP, a debugger: state `T` or `t` in
+/// `/proc/<pid>/stat`); `false` when that cannot be read.
+fn stopped(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|s| {
+            // The state follows the command name, which ends with the last ')'.
+            let rest = s.get(s.rfind(')')? + 1..)?;
+            rest.split_whitespace().next().map(|x| x == "T" || x == "t")
+        })
+        .unwrap_or(false)
 }
 
 /// Waits for `c` until `deadline`, then kills it.

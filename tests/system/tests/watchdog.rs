@@ -264,6 +264,28 @@ fn one_supervisor_per_host_and_none_left_behind_by_a_killed_one() {
     let cell = cell(&dir, &format!("wdo{}", std::process::id()), 2000);
     let mut first = Up::start(&cell, true);
     status(&cell);
+    // The gateway has no cycle: a stopped gateway process is noticed all the same, and
+    // restarted after watchdog_restart_ms (2 s).
+    let gateway = processes(&cell)
+        .into_iter()
+        .find(|(p, _, _)| p == "tandem-gateway")
+        .map(|(_, _, pid)| pid)
+        .unwrap();
+    signal(gateway, libc::SIGSTOP);
+    first.wait_for(
+        "[gateway ipc1] stalled: stopped since t=",
+        Duration::from_secs(10),
+    );
+    first.wait_for(
+        "[gateway ipc1] crashed (killed by the watchdog after a stall)",
+        Duration::from_secs(10),
+    );
+    first.wait_for("[gateway ipc1] started, pid", Duration::from_secs(10));
+    until(Duration::from_secs(10), "a new gateway", || {
+        processes(&cell)
+            .iter()
+            .any(|(p, _, pid)| p == "tandem-gateway" && *pid != gateway)
+    });
     let set = processes(&cell);
     assert_eq!(set.len(), 4, "{set:?}");
 
