@@ -16,7 +16,8 @@ pub type Source = Box<dyn std::error::Error + Send + Sync>;
 /// or the job ended in error or was aborted; `sim --strict`: a command was rejected or an alarm
 /// is pending); 2 the input is wrong (usage, config, script or command error); 3 the cell is not
 /// reachable (a node not running, a timeout) or an IO error of `sim`; 4 an iceoryx2 error (or
-/// Zenoh, or a program that cannot be started).
+/// Zenoh, or a program that cannot be started); 5 `up`: another `tandem up` supervises the cell
+/// on this host.
 #[derive(Debug)]
 pub enum CliError {
     /// A required argument is missing (clap checks them first, so this is a safeguard).
@@ -71,6 +72,24 @@ pub enum CliError {
     },
     /// `up` on a host without nodes.
     NoNodesHere,
+    /// Another `tandem up` supervises this cell on this host (it holds the lock file).
+    AlreadySupervised {
+        /// The cell's name.
+        cell: String,
+        /// The host.
+        host: String,
+        /// The lock file.
+        path: PathBuf,
+        /// The running `up`'s process id, as it wrote it into the lock file.
+        pid: Option<u32>,
+    },
+    /// The supervisor's lock file could not be created or locked.
+    Lock {
+        /// The lock file.
+        path: PathBuf,
+        /// Why.
+        source: tandem_rt::LockError,
+    },
     /// An iceoryx2 node or service could not be opened.
     Ipc(IpcError),
     /// An iceoryx2 port could not be created or used.
@@ -195,7 +214,8 @@ pub enum CliError {
 
 impl CliError {
     /// The process exit code: 1 the command failed, 2 the input is wrong, 3 the cell is not
-    /// reachable (or `sim` could not write), 4 an iceoryx2, Zenoh or process error.
+    /// reachable (or `sim` could not write), 4 an iceoryx2, Zenoh or process error, 5 another
+    /// `tandem up` supervises the cell on this host.
     pub fn exit_code(&self) -> u8 {
         use tandem_client::ClientError as C;
         match self {
@@ -233,7 +253,9 @@ impl CliError {
             | Self::UnknownOutcome(_)
             | Self::CannotStart { .. }
             | Self::Runtime(_)
-            | Self::CertGen { .. } => 4,
+            | Self::CertGen { .. }
+            | Self::Lock { .. } => 4,
+            Self::AlreadySupervised { .. } => 5,
             Self::Client(e) => match e {
                 C::Rejected { .. } | C::JobFailed { .. } => 1,
                 C::Invalid(_) | C::Certificate { .. } | C::Sender(_) => 2,
@@ -326,6 +348,21 @@ impl CliError {
                 hosts.join(", ")
             ),
             Self::NoNodesHere => f.write_str("this host has no nodes"),
+            Self::AlreadySupervised {
+                cell,
+                host,
+                path,
+                pid,
+            } => write!(
+                f,
+                "cell `{cell}` on host `{host}` is already supervised by tandem up{} (lock {}); \
+                 stop that one first (a second set of processes would serve the same services)",
+                pid.map_or(String::new(), |p| format!(", pid {p}")),
+                path.display()
+            ),
+            Self::Lock { path, source } => {
+                write!(f, "cannot lock {}: {source}", path.display())
+            }
             Self::Ipc(e) => write!(f, "{e}"),
             Self::IpcPort { what, source } => write!(f, "{what}: {source}"),
             Self::NotRunning { nodes, cell } => write!(
@@ -407,6 +444,7 @@ impl std::error::Error for CliError {
             Self::Config(e) => Some(e),
             Self::Ipc(e) => Some(e),
             Self::Client(e) => Some(e),
+            Self::Lock { source, .. } => Some(source),
             Self::RecordDir { source, .. }
             | Self::CreateTrace { source, .. }
             | Self::CannotStart { source, .. }
@@ -464,6 +502,14 @@ mod tests {
             3
         );
         assert_eq!(CliError::UnknownOutcome(9).exit_code(), 4);
+        let dup = CliError::AlreadySupervised {
+            cell: "line".into(),
+            host: "local".into(),
+            path: "retain/line/local.up.lock".into(),
+            pid: Some(4242),
+        };
+        assert_eq!(dup.exit_code(), 5);
+        assert!(dup.to_string().contains("pid 4242"), "{dup}");
         assert_eq!(
             CliError::Client(tandem_client::ClientError::Invalid("x".into())).exit_code(),
             2

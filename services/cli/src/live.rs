@@ -130,6 +130,11 @@ impl Observer {
         out
     }
 
+    /// The newest health node `n` published, if any.
+    pub(crate) fn health(&self, n: usize) -> Option<&NodeHealth> {
+        self.last.get(n)?.as_ref().map(|(h, _, _)| h)
+    }
+
     /// Whether node `n` published within the last second.
     fn alive(&self, n: usize) -> bool {
         self.last[n]
@@ -206,7 +211,7 @@ pub(crate) fn render(
     for n in nodes {
         if let (Some((h, _, _)), true) = (&obs.last[*n], obs.alive(*n)) {
             s.push_str(&format!(
-                "{:<12} pid {:<7} t={:<14} cycle {} µs, compute {} µs (max {}), lateness {} µs (max {}), overruns {}\n",
+                "{:<12} pid {:<7} t={:<14} cycle {} µs, compute {} µs (max {}), lateness {} µs (max {}), overruns {}, skipped cycles {}\n",
                 cell.nodes[*n].name,
                 h.pid,
                 tandem_runtime::exec::Secs(h.t_ns),
@@ -215,7 +220,8 @@ pub(crate) fn render(
                 h.max_compute_ns / 1000,
                 h.lateness_ns / 1000,
                 h.max_lateness_ns / 1000,
-                h.overruns
+                h.overruns,
+                h.skipped_cycles
             ));
             s.push_str(&recording_lost(h));
         }

@@ -63,6 +63,12 @@ struct Slot {
     start_at: Option<Instant>,
     started: Instant,
     finished: bool,
+    /// The watchdog reported this process stalled (once per stall).
+    stall_reported: bool,
+    /// The watchdog killed it (kill -9) to restart it.
+    watchdog_killed: bool,
+    /// The gateway: the cell clock time it was last seen not stopped.
+    gateway_alive_ns: i64,
 }
 
 impl Slot {
@@ -76,6 +82,9 @@ impl Slot {
             start_at: Some(Instant::now()),
             started: Instant::now(),
             finished: false,
+            stall_reported: false,
+            watchdog_killed: false,
+            gateway_alive_ns: rt::now_ns(),
         }
     }
 }
@@ -154,6 +163,10 @@ fn start(
     c.stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
+    // When `up` dies (even by kill -9) its processes get SIGTERM and stop: no unsupervised set
+    // is left to run beside the next `up`'s. `up` spawns from its main thread, which lives as
+    // long as the supervision.
+    rt::die_with_parent(&mut c);
     let mut child = c.spawn()?;
     if let Some(stderr) = child.stderr.take() {
         let (tx, n) = (lines.clone(), name.to_string());
@@ -198,7 +211,10 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), C
     let (cell, host, nodes) = prepare(cell_path, o)?;
     let span = info_span!("up", cell = %cell.name, host = %host);
     let _entered = span.enter();
+    // One supervisor per cell and host, for as long as this `up` runs.
+    let _lock = lock(&cell, &host)?;
     rt::install_termination_handler();
+    warn_if_shm_small(out);
     let removed = ipc::cleanup_dead_nodes(&host);
     let iox = cli_node(&cell, "up", &host)?;
     let obs = Observer::new(&iox, &cell, &nodes, true)?;
@@ -237,6 +253,64 @@ pub fn up(cell_path: &Path, o: &UpOptions, out: &mut impl Write) -> Result<(), C
     s.stop(out);
     outln!(out, "tandem up: all nodes stopped");
     result
+}
+
+/// The lock file of the supervisor of `cell` on `host`: `<retain_dir>/<cell>/<host>.up.lock`.
+pub fn lock_path(cell: &Cell, host: &str) -> PathBuf {
+    cell.retain_dir
+        .join(&cell.name)
+        .join(format!("{host}.up.lock"))
+}
+
+/// Takes the supervisor's lock of `cell` on `host` (held until it is dropped or `up` ends, also
+/// by kill -9), or the error naming the `up` that holds it.
+fn lock(cell: &Cell, host: &str) -> Result<rt::RunLock, CliError> {
+    let path = lock_path(cell, host);
+    rt::RunLock::acquire(&path).map_err(|e| match e {
+        rt::LockError::Held { pid } => CliError::AlreadySupervised {
+            cell: cell.name.clone(),
+            host: host.to_string(),
+            path: path.clone(),
+            pid,
+        },
+        rt::LockError::Io { .. } => CliError::Lock {
+            path: path.clone(),
+            source: e,
+        },
+    })
+}
+
+/// Where iceoryx2 keeps its shared memory.
+const SHM: &str = "/dev/shm";
+
+/// The free space of /dev/shm below which `up` warns at start: 16 MiB. Measured: the three
+/// nodes of the bundled line cell and `up` map 11.5 MB of iceoryx2 segments there (sparse
+/// files; 0.8 MB of pages touched after a few seconds), and a node dies of SIGBUS when it
+/// touches a page the file system cannot give (docs/processes.md, "Shared memory").
+const SHM_WARN_BYTES: u64 = 16 << 20;
+
+/// The free space of /dev/shm in MB, for messages ("?" when it cannot be read).
+fn shm_free_mb() -> String {
+    rt::free_bytes(Path::new(SHM)).map_or("?".into(), |b| format!("{:.1}", b as f64 / 1e6))
+}
+
+/// Warns when /dev/shm has less free space than [`SHM_WARN_BYTES`]: iceoryx2's shared memory
+/// then fails to be created, or a process dies of SIGBUS when it first touches a page.
+fn warn_if_shm_small(out: &mut impl Write) {
+    let Some(free) = rt::free_bytes(Path::new(SHM)) else {
+        return;
+    };
+    if free < SHM_WARN_BYTES {
+        let line = format!(
+            "WARNING: {SHM} has only {:.1} MB free (at least {} MB recommended): iceoryx2's \
+             shared memory may not fit, and a node then dies of SIGBUS (docs/processes.md, \
+             \"Shared memory\")",
+            free as f64 / 1e6,
+            SHM_WARN_BYTES >> 20
+        );
+        warn!("{line}");
+        outln!(out, "{line}");
+    }
 }
 
 /// Warns (on stdout and as a `tracing` warning) when the cell's Zenoh is plain,
@@ -281,6 +355,7 @@ struct Supervisor<'a> {
     rx: mpsc::Receiver<(String, String)>,
     /// The live view's recent messages.
     messages: VecDeque<String>,
+
     last_draw: Instant,
 }
 
@@ -312,11 +387,11 @@ impl<'a> Supervisor<'a> {
     /// its configuration or could not be started (the error).
     fn supervise(&mut self, out: &mut impl Write) -> Result<(), CliError> {
         while !rt::termination_requested() {
+            self.obs.poll();
             for i in 0..self.slots.len() {
                 self.tend(i)?;
             }
             self.relay(out);
-            self.obs.poll();
             if self.launch.o.view && self.last_draw.elapsed() > Duration::from_millis(250) {
                 self.last_draw = Instant::now();
                 self.draw(out);
@@ -329,9 +404,116 @@ impl<'a> Supervisor<'a> {
             {
                 break;
             }
-            std::thread::sleep(Duration::from_millis(20));
+            std::thread::sleep(self.next_look());
         }
         Ok(())
+    }
+
+    /// How long to sleep before looking again: 20 ms, or less when a watchdog deadline comes
+    /// sooner (so that a stall is reported within a few ms of the watchdog time).
+    fn next_look(&self) -> Duration {
+        let cell = self.launch.cell;
+        let now = rt::now_ns();
+        let soonest = (0..self.slots.len())
+            .filter_map(|i| {
+                let slot = self.slots.get(i)?;
+                let last = self.last_cycle(i)?;
+                let after = if !slot.stall_reported {
+                    cell.watchdog_ns
+                } else if !slot.watchdog_killed {
+                    cell.watchdog_restart_ns
+                } else {
+                    return None;
+                };
+                Some(last.saturating_add(after).saturating_sub(now))
+            })
+            .min()
+            .unwrap_or(i64::MAX);
+        Duration::from_nanos(soonest.clamp(1_000_000, 20_000_000) as u64)
+    }
+
+    /// The cell clock time process `i` was last seen alive: for a node, its last cycle
+    /// published (if it published since it was started); for the gateway, which publishes no
+    /// cycle on iceoryx2, the last time its process was not stopped (`/proc/<pid>/stat`).
+    fn last_cycle(&self, i: usize) -> Option<i64> {
+        let slot = self.slots.get(i)?;
+        let pid = slot.child.as_ref()?.id();
+        let Some(node) = slot.node else {
+            return Some(slot.gateway_alive_ns);
+        };
+        let h = self.obs.health(node).filter(|h| h.pid == pid)?;
+        Some(h.epoch_ns.saturating_add(h.t_ns))
+    }
+
+    /// The watchdog of process `i`: reports it stalled once its last cycle is
+    /// `[cell] watchdog_ms` old, kills it (kill -9, to be restarted as a crashed one) once it is
+    /// `watchdog_restart_ms` old, and reports it cycling again when it resumed before.
+    fn watch(&mut self, i: usize) {
+        if let Some(slot) = self.slots.get_mut(i).filter(|s| s.node.is_none()) {
+            let pid = slot.child.as_ref().map(Child::id);
+            if pid.is_some_and(|p| !stopped(p)) {
+                slot.gateway_alive_ns = rt::now_ns();
+            }
+        }
+        let Some(last) = self.last_cycle(i) else {
+            return;
+        };
+        let cell = self.launch.cell;
+        let silent = rt::now_ns().saturating_sub(last);
+        let t = last.saturating_sub(self.launch.epoch);
+        let slot = &mut self.slots[i];
+        let name = slot.name.clone();
+        let ms = |ns: i64| ns as f64 / 1e6;
+        let mut lines = Vec::new();
+        if silent > cell.watchdog_ns && !slot.stall_reported {
+            slot.stall_reported = true;
+            let what = if slot.node.is_some() {
+                "no cycle"
+            } else {
+                "stopped"
+            };
+            let line = format!(
+                "[{name}] stalled: {what} since t={} ({:.1} ms ago; watchdog {:.0} ms)",
+                tandem_runtime::exec::Secs(t),
+                ms(silent),
+                ms(cell.watchdog_ns)
+            );
+            warn!(silent_ms = ms(silent), "{line}");
+            lines.push(line);
+        }
+        if silent > cell.watchdog_restart_ns && !slot.watchdog_killed {
+            slot.watchdog_killed = true;
+            let line = format!(
+                "[{name}] silent for {:.1} ms (watchdog_restart_ms {:.0}): killing it (kill -9) to restart it",
+                ms(silent),
+                ms(cell.watchdog_restart_ns)
+            );
+            warn!("{line}");
+            if let Some(c) = slot.child.as_mut() {
+                if let Err(e) = c.kill() {
+                    // It ended meanwhile: `tend` collects it and restarts it.
+                    tracing::debug!(node = %name, error = %e, "SIGKILL");
+                }
+            }
+            lines.push(line);
+        }
+        if silent <= cell.watchdog_ns && slot.stall_reported && !slot.watchdog_killed {
+            slot.stall_reported = false;
+            let line = format!(
+                "[{name}] {} again at t={}",
+                if slot.node.is_some() {
+                    "cycling"
+                } else {
+                    "running"
+                },
+                tandem_runtime::exec::Secs(t)
+            );
+            info!("{line}");
+            lines.push(line);
+        }
+        for line in lines {
+            self.note(line);
+        }
     }
 
     /// Lists `line` in the live view (a supervision event, already given to `tracing`).
@@ -363,6 +545,7 @@ impl<'a> Supervisor<'a> {
                 slot.child = None;
                 return self.ended(i, status);
             }
+            self.watch(i);
         } else if slot.start_at.is_some_and(|at| Instant::now() >= at) {
             slot.start_at = None;
             return self.spawn(i);
@@ -388,7 +571,16 @@ impl<'a> Supervisor<'a> {
         if slot.started.elapsed() > MAX_BACKOFF {
             slot.backoff = FIRST_BACKOFF;
         }
-        let reason = describe_exit(status);
+        let reason = if slot.watchdog_killed {
+            "killed by the watchdog after a stall".to_string()
+        } else if std::os::unix::process::ExitStatusExt::signal(&status) == Some(libc::SIGBUS) {
+            format!(
+                "SIGBUS: {SHM} is probably too small (free {} MB)",
+                shm_free_mb()
+            )
+        } else {
+            describe_exit(status)
+        };
         let line = format!(
             "[{name}] crashed ({reason}); restarting in {:.1} s",
             slot.backoff.as_secs_f64()
@@ -427,6 +619,9 @@ impl<'a> Supervisor<'a> {
         let slot = &mut self.slots[i];
         slot.child = Some(child);
         slot.started = Instant::now();
+        slot.stall_reported = false;
+        slot.watchdog_killed = false;
+        slot.gateway_alive_ns = rt::now_ns();
         self.note(line);
         Ok(())
     }
@@ -484,6 +679,19 @@ impl<'a> Supervisor<'a> {
             outln!(out, "[{n}] {line}");
         }
     }
+}
+
+/// Whether process `pid` is stopped (SIGSTOP, a debugger: state `T` or `t` in
+/// `/proc/<pid>/stat`); `false` when that cannot be read.
+fn stopped(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|s| {
+            // The state follows the command name, which ends with the last ')'.
+            let rest = s.get(s.rfind(')')? + 1..)?;
+            rest.split_whitespace().next().map(|x| x == "T" || x == "t")
+        })
+        .unwrap_or(false)
 }
 
 /// Waits for `c` until `deadline`, then kills it.

@@ -11,6 +11,7 @@ use crate::logring::{DiagRecord, LogRing, Record, TextWriter};
 use crate::owns;
 use crate::ports::Ports;
 use crate::report::{cpu_time_ns, Report};
+use std::io::Write as _;
 use std::sync::mpsc::{Receiver, SyncSender};
 use tandem_config::script::ScriptEntry;
 use tandem_config::{AxisIndex, Cell};
@@ -196,6 +197,12 @@ impl<'c> NodeCycle<'c> {
             let wake = rt::now_ns();
             if wake < start {
                 // A signal woke us early: look at the flag, then sleep again.
+                continue;
+            }
+            if let Some(to) = rejoin(clock, k, wake) {
+                // Stalled: the loop's next pass runs grid cycle `to` at once (its start is past).
+                self.skip_cycles(to - k, wake - start, to * clock.cycle);
+                k = to;
                 continue;
             }
             if cpu0.is_none() {
@@ -472,6 +479,24 @@ impl<'c> NodeCycle<'c> {
         }
     }
 
+    /// The node woke `late` ns after its cycle's start and skips `n` cycles to rejoin the time
+    /// grid at engine time `t`: counted in the health, and said once per stall in the log (an
+    /// S7-1500 calls this a cycle overflow). No allocation: the line is formatted into the log
+    /// ring's buffer.
+    fn skip_cycles(&mut self, n: i64, late: i64, t: i64) {
+        let n = u64::try_from(n).unwrap_or(0);
+        self.health.skipped_cycles += n;
+        // The log ring never fails: a line beyond its capacity is counted as dropped.
+        let _ = writeln!(
+            self.log,
+            "t={} cycle overflow: woke {} late, skipped {n} cycles to rejoin the time grid \
+             ({} skipped so far)",
+            tandem_runtime::exec::Secs(t),
+            tandem_runtime::exec::Secs(late),
+            self.health.skipped_cycles
+        );
+    }
+
     /// Publishes a telemetry snapshot: every owned axis, the health as header.
     fn telemetry(&mut self) {
         let status = self.exec.status();
@@ -491,6 +516,27 @@ impl<'c> NodeCycle<'c> {
             self.health.sends_failed += 1;
         }
     }
+}
+
+/// How late a cycle may wake before the node skips to the current grid cycle instead of
+/// running every missed cycle back to back: 100 ms, or 2 cycles of a slower node. Below it the
+/// missed cycles are replayed (the motion stays exactly as on an idle machine; the leading
+/// values' tolerance decides whether remote followers bridged the gap); above it replaying
+/// would only prolong the lateness (docs/processes.md, "Stalls").
+pub(crate) const REJOIN_AFTER_NS: i64 = 100_000_000;
+
+/// The grid cycle to continue with when cycle `k` of `clock` woke at `wake` (cell clock, ns)
+/// more than [`REJOIN_AFTER_NS`] (at least 2 cycles) after its start: the last cycle whose
+/// start is not after `wake`. `None`: run cycle `k`.
+pub(crate) fn rejoin(clock: &Clock, k: i64, wake: i64) -> Option<i64> {
+    let cycle = clock.cycle.max(1);
+    let start = clock.epoch.saturating_add(k.saturating_mul(cycle));
+    let late = wake.saturating_sub(start);
+    if late <= REJOIN_AFTER_NS.max(cycle.saturating_mul(2)) {
+        return None;
+    }
+    let to = wake.saturating_sub(clock.epoch).div_euclid(cycle);
+    (to > k).then_some(to)
 }
 
 /// Fills a trace row from the pool and hands it to the recorder; `false` when the recorder
@@ -549,4 +595,55 @@ fn job_event(j: &JobNote, names: &[&str]) -> Event {
         ),
     );
     ev
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{rejoin, Clock, REJOIN_AFTER_NS};
+
+    const MS: i64 = 1_000_000;
+
+    fn clock(cycle: i64) -> Clock {
+        Clock {
+            epoch: 5_000 * MS,
+            cycle,
+            first: 0,
+            end_ns: None,
+        }
+    }
+
+    /// A cycle on time, or late by one or a few cycles, runs as today: every cycle, no skip.
+    #[test]
+    fn jitter_and_plain_overruns_run_every_cycle() {
+        let c = clock(MS);
+        let start = c.epoch + 7 * MS;
+        for late in [0, MS / 2, MS, 2 * MS + 1, 37 * MS, REJOIN_AFTER_NS] {
+            assert_eq!(rejoin(&c, 7, start + late), None, "late {late} ns");
+        }
+    }
+
+    /// A stall of 2 s on a 1 ms cycle continues with the grid cycle of the wake-up: 2,000
+    /// cycles skipped, the cycle run is late by less than one cycle.
+    #[test]
+    fn a_stall_rejoins_the_grid_cycle_of_the_wake_up() {
+        let c = clock(MS);
+        let start = c.epoch + 7 * MS;
+        let wake = start + 2_000 * MS + 300_000;
+        let to = rejoin(&c, 7, wake).unwrap_or(7);
+        assert_eq!(to - 7, 2_000);
+        let late = wake - (c.epoch + to * MS);
+        assert!((0..MS).contains(&late), "{late}");
+        // Just over the threshold: skips too.
+        assert_eq!(rejoin(&c, 7, start + REJOIN_AFTER_NS + 1), Some(107));
+    }
+
+    /// A slow node (100 ms cycle) replays a one-cycle overrun and skips only beyond 2 cycles.
+    #[test]
+    fn a_slow_node_skips_only_beyond_two_cycles() {
+        let c = clock(100 * MS);
+        let start = c.epoch + 3 * 100 * MS;
+        assert_eq!(rejoin(&c, 3, start + 150 * MS), None);
+        assert_eq!(rejoin(&c, 3, start + 200 * MS), None);
+        assert_eq!(rejoin(&c, 3, start + 250 * MS), Some(5));
+    }
 }

@@ -527,6 +527,10 @@ pub struct Cell {
     pub command_rate_hz: f64,
     /// Commands a sender may send at once above that rate (`[cell] command_burst`).
     pub command_burst: u32,
+    /// `tandem up` reports a process stalled after this silence (ns, `[cell] watchdog_ms`).
+    pub watchdog_ns: i64,
+    /// ... and restarts it after this one (ns, `[cell] watchdog_restart_ms`).
+    pub watchdog_restart_ns: i64,
     /// The directory of the retained data: `[cell] retain_dir` (default `retain`), relative to
     /// the cell file's directory (to the current directory for a cell parsed from text).
     /// A node's records are in [`Cell::node_retain_dir`].

@@ -609,6 +609,23 @@ pub struct CellSection {
     /// Commands a sender may send at once above the sustained rate. Default 40.
     #[serde(default = "default_command_burst")]
     pub command_burst: u32,
+    /// `tandem up`'s watchdog (docs/processes.md, "Watchdog"), in ms: a node whose cycles
+    /// stop advancing (or a gateway that stops answering) for this long is reported as
+    /// stalled. Default 500, from 10 to 3600000.
+    #[serde(default = "default_watchdog_ms")]
+    pub watchdog_ms: u64,
+    /// The silence after which `tandem up` restarts a stalled process (kill -9, then start),
+    /// in ms; at least `watchdog_ms`, at most 3600000. Default 2000.
+    #[serde(default = "default_watchdog_restart_ms")]
+    pub watchdog_restart_ms: u64,
+}
+
+fn default_watchdog_ms() -> u64 {
+    500
+}
+
+fn default_watchdog_restart_ms() -> u64 {
+    2000
 }
 
 fn default_command_rate_hz() -> f64 {

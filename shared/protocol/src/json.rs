@@ -244,6 +244,9 @@ pub struct Health {
     /// Log lines the node's recorder could not write to the disk (a full disk).
     #[serde(default)]
     pub log_lines_lost: u64,
+    /// Cycles skipped to rejoin the time grid after a stall.
+    #[serde(default)]
+    pub skipped_cycles: u64,
 }
 
 impl Health {
@@ -278,6 +281,7 @@ impl Health {
             lv_lost: h.lv_lost,
             trace_rows_lost: h.trace_rows_lost,
             log_lines_lost: h.log_lines_lost,
+            skipped_cycles: h.skipped_cycles,
         }
     }
 }

@@ -317,6 +317,9 @@ pub struct NodeHealth {
     /// Log lines the recorder could not write to the disk (`--log`), as `trace_rows_lost` (v4).
     /// Not `log_dropped` (lines the cycle's ring had no room for).
     pub log_lines_lost: u64,
+    /// Cycles skipped to rejoin the time grid after a stall (a cycle overflow) instead of
+    /// being run back to back (docs/processes.md, "Stalls").
+    pub skipped_cycles: u64,
 }
 
 /// One axis in a telemetry snapshot.

@@ -254,3 +254,124 @@ pub fn send_signal(pid: u32, signal: libc::c_int) -> Result<(), RtError> {
         })
     }
 }
+
+/// Makes the program `c` starts receive SIGTERM when the thread that starts it ends (its
+/// supervisor died, even by kill -9): `prctl(PR_SET_PDEATHSIG, SIGTERM)` in the child before
+/// `exec`. A child whose parent died between the fork and the prctl exits at once. The parent
+/// is the *thread* that spawns: spawn from a thread that lives as long as the supervision.
+pub fn die_with_parent(c: &mut std::process::Command) {
+    use std::os::unix::process::CommandExt;
+    // SAFETY: getpid has no preconditions.
+    let parent = unsafe { libc::getpid() };
+    // SAFETY: the closure runs in the forked child before exec and calls only prctl and
+    // getppid, both async-signal-safe; it allocates nothing (the error is built from a raw
+    // OS error number).
+    unsafe {
+        c.pre_exec(move || {
+            if libc::prctl(
+                libc::PR_SET_PDEATHSIG,
+                libc::SIGTERM as libc::c_ulong,
+                0,
+                0,
+                0,
+            ) != 0
+            {
+                return Err(std::io::Error::last_os_error());
+            }
+            if libc::getppid() != parent {
+                // The supervisor died before the prctl: its signal will never come.
+                return Err(std::io::Error::from_raw_os_error(libc::ESRCH));
+            }
+            Ok(())
+        });
+    }
+}
+
+/// An exclusive lock on a file, held until dropped or until the process ends (also by kill
+/// -9: the kernel releases a `flock` with the process' last file descriptor).
+#[derive(Debug)]
+pub struct RunLock {
+    /// The open lock file; closing it releases the lock.
+    _file: std::fs::File,
+}
+
+/// Why [`RunLock::acquire`] failed.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum LockError {
+    /// Another process holds the lock; the pid it wrote into the file, if readable.
+    Held {
+        /// The holder's process id.
+        pid: Option<u32>,
+    },
+    /// The lock file could not be created, locked or written.
+    Io {
+        /// The OS error.
+        errno: i32,
+    },
+}
+
+impl std::fmt::Display for LockError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Self::Held { pid: Some(pid) } => write!(f, "held by process {pid}"),
+            Self::Held { pid: None } => f.write_str("held by another process"),
+            Self::Io { errno } => write!(f, "{}", std::io::Error::from_raw_os_error(errno)),
+        }
+    }
+}
+
+impl std::error::Error for LockError {}
+
+impl RunLock {
+    /// Takes the exclusive lock on `path` (created, with its directory, if missing) without
+    /// waiting, and writes this process' id into it.
+    pub fn acquire(path: &std::path::Path) -> Result<Self, LockError> {
+        use std::io::{Read, Seek, Write};
+        use std::os::fd::AsRawFd;
+        let io = |e: std::io::Error| LockError::Io {
+            errno: e.raw_os_error().unwrap_or(0),
+        };
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir).map_err(io)?;
+        }
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)
+            .map_err(io)?;
+        // SAFETY: the descriptor is open (owned by `file`); flock has no memory preconditions.
+        if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
+            let e = errno();
+            if e != libc::EWOULDBLOCK {
+                return Err(LockError::Io { errno: e });
+            }
+            let mut s = String::new();
+            // An unreadable file only loses the pid in the message.
+            let _ = file.read_to_string(&mut s);
+            return Err(LockError::Held {
+                pid: s.trim().parse().ok(),
+            });
+        }
+        file.set_len(0).map_err(io)?;
+        file.rewind().map_err(io)?;
+        write!(file, "{}", std::process::id()).map_err(io)?;
+        file.flush().map_err(io)?;
+        Ok(Self { _file: file })
+    }
+}
+
+/// The bytes free for unprivileged users on the file system of `path` (statvfs), e.g. of
+/// `/dev/shm`, where iceoryx2 keeps its shared memory.
+pub fn free_bytes(path: &std::path::Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(path.as_os_str().as_bytes()).ok()?;
+    // SAFETY: statvfs is plain data, zeroed is a valid value; `c` is a NUL-terminated path.
+    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
+    // SAFETY: both pointers are valid for the call.
+    if unsafe { libc::statvfs(c.as_ptr(), &mut s) } != 0 {
+        return None;
+    }
+    s.f_bavail.checked_mul(s.f_frsize)
+}

@@ -204,6 +204,9 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         clock_warning_fraction: raw.cell.clock_warning_fraction,
         command_rate_hz: raw.cell.command_rate_hz,
         command_burst: raw.cell.command_burst,
+        // Range-checked in `check_cell_section` (at most one hour): no overflow.
+        watchdog_ns: raw.cell.watchdog_ms as i64 * 1_000_000,
+        watchdog_restart_ns: raw.cell.watchdog_restart_ms as i64 * 1_000_000,
         retain_dir: dir
             .unwrap_or(Path::new(""))
             .join(raw.cell.retain_dir.as_deref().unwrap_or(DEFAULT_RETAIN_DIR)),
@@ -255,6 +258,18 @@ fn check_cell_section(cx: Ctx<'_>, raw: &CellFile) -> Result<(), ConfigError> {
         return Err(cx.at(
             &["cell", "command_burst"],
             Problem::Invalid("must be a number of commands from 1 to 100000"),
+        ));
+    }
+    if !(MIN_WATCHDOG_MS..=MAX_MS).contains(&c.watchdog_ms) {
+        return Err(cx.at(
+            &["cell", "watchdog_ms"],
+            Problem::Invalid("must be from 10 to 3600000 ms (one hour)"),
+        ));
+    }
+    if !(c.watchdog_ms..=MAX_MS).contains(&c.watchdog_restart_ms) {
+        return Err(cx.at(
+            &["cell", "watchdog_restart_ms"],
+            Problem::Invalid("must be at least watchdog_ms and at most 3600000 ms (one hour)"),
         ));
     }
     if c.retain_dir.as_deref().is_some_and(|d| d.trim().is_empty()) {
@@ -498,6 +513,13 @@ fn leading_values(
 /// The longest time a `*_us` key may give: one hour. Larger values (up to 2^64 - 1 in the
 /// file) would wrap when turned into nanoseconds; no cycle, delay or budget is that long.
 const MAX_US: u64 = 3_600_000_000;
+
+/// The longest time a `*_ms` key may give: one hour.
+const MAX_MS: u64 = 3_600_000;
+
+/// The shortest watchdog: 10 ms (`tandem up` looks at its processes every few ms; the nodes
+/// publish their health at twice `telemetry_hz`).
+const MIN_WATCHDOG_MS: u64 = 10;
 
 /// A `*_us` key's value in ns, or the error naming the key at `path` when it is over
 /// [`MAX_US`].
