@@ -36,9 +36,9 @@ fn cell(dir: &Path, name: &str) -> PathBuf {
     let src = std::fs::read_to_string(root().join("config/line.toml")).unwrap();
     let src = src
         .replace("name = \"line\"", &format!("name = \"{name}\""))
-        .replace("delay_us = 3000", &format!("delay_us = {}", D_NS / 1000))
+        .replace("delay_us = 10000", &format!("delay_us = {}", D_NS / 1000))
         .replace(
-            "tolerance_us = 4000",
+            "tolerance_us = 100000",
             &format!("tolerance_us = {}", TOL_NS / 1000),
         );
     assert!(src.contains("delay_us = 100000") && src.contains("tolerance_us = 150000"));
@@ -473,7 +473,7 @@ fn a_bad_config_is_refused_naming_the_key() {
     let dir = tmp("bad");
     let src = std::fs::read_to_string(root().join("config/line.toml"))
         .unwrap()
-        .replace("delay_us = 3000", "delay_us = 1000");
+        .replace("delay_us = 10000", "delay_us = 1000");
     let p = dir.join("bad.toml");
     std::fs::write(&p, &src).unwrap();
     let line = src

@@ -37,8 +37,8 @@ fn cell(dir: &Path, name: &str, restart_ms: u32) -> PathBuf {
                 "name = \"{name}\"\nwatchdog_ms = {WATCHDOG_MS}\nwatchdog_restart_ms = {restart_ms}\n"
             ),
         )
-        .replace("delay_us = 3000", "delay_us = 100000")
-        .replace("tolerance_us = 4000", "tolerance_us = 150000");
+        .replace("delay_us = 10000", "delay_us = 100000")
+        .replace("tolerance_us = 100000", "tolerance_us = 150000");
     assert!(src.contains("watchdog_restart_ms") && src.contains("delay_us = 100000"));
     let p = dir.join("cell.toml");
     std::fs::write(&p, src).unwrap();
