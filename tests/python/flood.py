@@ -2,9 +2,10 @@
 """A command flood against a tandem cell, with nothing but the eclipse-zenoh package.
 
 One sender (`flood`) sends --flood commands spread over --seconds while another (`operator`)
-sends --operator commands over the same time, each a Zenoh query to tandem/<cell>/<key>/cmd
-with the attachment `sender=<name>`. Prints one JSON summary on stdout: per sender the replies
-by outcome and the queries that got no reply.
+sends --operator commands over the same time, each a Zenoh query to
+tandem/<cell>/<key>/cmd/<sender> (the sender in the key, as the access control of an mTLS cell
+binds it to the certificate). Prints one JSON summary on stdout: per sender the replies by
+outcome, the queries that got no reply, and the reply times (p50, p99, max in ms).
 
   flood.py --cell glue --connect tcp/127.0.0.1:7447 --key packer/conveyor --text MC_Reset
 """
@@ -39,9 +40,14 @@ def main():
     lock = threading.Lock()
     outcomes = {"flood": {}, "operator": {}, "probe": {}}
     replied = {"flood": 0, "operator": 0, "probe": 0}
+    # Reply times (s) of each sender's queries: from the get to its (first) reply.
+    latency = {"flood": [], "operator": [], "probe": []}
 
     def handler(sender):
+        sent = time.monotonic()
+
         def on_reply(reply):
+            took = time.monotonic() - sent
             if reply.ok is not None:
                 try:
                     o = json.loads(reply.ok.payload.to_string()).get("outcome", "?")
@@ -52,10 +58,11 @@ def main():
             with lock:
                 outcomes[sender][o] = outcomes[sender].get(o, 0) + 1
                 replied[sender] += 1
+                latency[sender].append(took)
         return on_reply
 
     def send(sender):
-        session.get(key, handler(sender), payload=a.text, attachment=f"sender={sender}", timeout=a.wait)
+        session.get(f"{key}/{sender}", handler(sender), payload=a.text, timeout=a.wait)
 
     # The gateway first: probe until one reply comes.
     deadline = time.monotonic() + a.wait
@@ -91,8 +98,17 @@ def main():
             if replied["flood"] >= a.flood and replied["operator"] >= a.operator:
                 break
         time.sleep(0.05)
+    def ms(xs):
+        """p50, p99 and max of reply times, in ms (None without replies)."""
+        if not xs:
+            return None
+        xs = sorted(xs)
+        at = lambda q: xs[min(len(xs) - 1, int(q * len(xs)))]
+        return {"p50": at(0.5) * 1e3, "p99": at(0.99) * 1e3, "max": xs[-1] * 1e3}
+
     with lock:
         print(json.dumps({
+            "reply_ms": {"flood": ms(latency["flood"]), "operator": ms(latency["operator"])},
             "flood": outcomes["flood"],
             "operator": outcomes["operator"],
             "missing": {"flood": a.flood - replied["flood"], "operator": a.operator - replied["operator"]},
