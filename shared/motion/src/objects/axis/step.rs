@@ -2,8 +2,8 @@
 //! completion, monitoring, drive, status. Allocation-free.
 
 use super::{
-    sign, sync_function, Axis, AxisKind, AxisState, Goal, HomePhase, HomingMark, PassiveDirection,
-    PosMon, Sense,
+    sign, sync_function, ActiveHoming, Axis, AxisKind, AxisState, Goal, HomePhase, HomingMark,
+    PassiveDirection, PosMon, Sense,
 };
 use crate::catalog::alarm::{status_bit, supplement, AlarmId, ErrorDetail, Reaction};
 use crate::kinematics::profile::{plan_position, Limits, State};
@@ -352,14 +352,52 @@ impl Axis {
         let Some(mut h) = job.homing else {
             return;
         };
-        let hc = self.cfg.homing;
-        let hd = hc.homing_direction.sign();
-        let moved = sign(phys - prev);
         let vlim = Limits {
             vel: self.cfg.limits.max_velocity,
             ..job.lim
         };
-        let mut new_goal = None;
+        let Some(mut new_goal) = self.homing_phase(&mut h, vlim, sign(phys - prev)) else {
+            // Nothing found: the alarm is raised.
+            return;
+        };
+        if h.phase == HomePhase::Travel && job.homing.map(|o| o.phase) != Some(HomePhase::Travel) {
+            // Travel to the end position at approach velocity (shortest way on modulo axes).
+            let here = self.basic.p;
+            let target = match self.cfg.modulo {
+                Some(m) => here + m.shortest(here, h.end),
+                None => h.end,
+            };
+            let lim = Limits {
+                vel: self.cfg.homing.approach_velocity,
+                ..job.lim
+            };
+            new_goal = Some(Goal::Position { target, lim });
+        }
+        if let Some(m) = self.main.as_mut() {
+            m.homing = Some(h);
+        }
+        if let Some(g) = new_goal {
+            // Homing motions ignore the override.
+            let ovr = self.override_pct;
+            self.override_pct = 100.0;
+            self.set_goal(g);
+            self.override_pct = ovr;
+        }
+    }
+
+    /// One cycle of active homing's search (S7-1500T Motion Control V4.0 function manual,
+    /// 'Active homing'): `h` advances on the reversing cam, the reference cam and the zero
+    /// mark, `moved` being the direction the axis moved in this cycle. Returns the new goal
+    /// of the homing motion, if any (`Some(None)`: keep going), or `None` when the second
+    /// reversal found nothing and alarm `HomingNotFound` was raised.
+    fn homing_phase(
+        &mut self,
+        h: &mut ActiveHoming,
+        vlim: Limits,
+        moved: f64,
+    ) -> Option<Option<Goal>> {
+        let hc = self.cfg.homing;
+        let hd = hc.homing_direction.sign();
         // The direction the homing motion is commanded in (a reversal is counted once, when
         // the switch lies ahead of it, not again while braking on the switch).
         let heading = if h.phase == HomePhase::Search {
@@ -376,7 +414,7 @@ impl Axis {
                 h.reversals += 1;
                 if h.reversals >= 2 {
                     self.raise_alarm(AlarmId::HomingNotFound, supplement::NONE);
-                    return;
+                    return None;
                 }
                 h.search_dir = -heading;
                 h.phase = HomePhase::Search;
@@ -384,18 +422,18 @@ impl Axis {
                     dec: self.cfg.limits.max_deceleration,
                     ..vlim
                 };
-                new_goal = Some(Goal::Velocity {
+                return Some(Some(Goal::Velocity {
                     v: h.search_dir * hc.approach_velocity,
                     lim,
-                });
+                }));
             }
             HomePhase::Search => {
                 if self.signals.reference_cam {
                     h.phase = HomePhase::OnCam;
-                    new_goal = Some(Goal::Velocity {
+                    return Some(Some(Goal::Velocity {
                         v: hd * hc.referencing_velocity,
                         lim: vlim,
-                    });
+                    }));
                 }
             }
             HomePhase::OnCam => {
@@ -420,29 +458,7 @@ impl Axis {
             }
             HomePhase::Travel => {}
         }
-        if h.phase == HomePhase::Travel && job.homing.map(|o| o.phase) != Some(HomePhase::Travel) {
-            // Travel to the end position at approach velocity (shortest way on modulo axes).
-            let here = self.basic.p;
-            let target = match self.cfg.modulo {
-                Some(m) => here + m.shortest(here, h.end),
-                None => h.end,
-            };
-            let lim = Limits {
-                vel: hc.approach_velocity,
-                ..job.lim
-            };
-            new_goal = Some(Goal::Position { target, lim });
-        }
-        if let Some(m) = self.main.as_mut() {
-            m.homing = Some(h);
-        }
-        if let Some(g) = new_goal {
-            // Homing motions ignore the override.
-            let ovr = self.override_pct;
-            self.override_pct = 100.0;
-            self.set_goal(g);
-            self.override_pct = ovr;
-        }
+        Some(None)
     }
 
     fn passive_homing(&mut self, prev: f64, phys: f64) {
