@@ -19,8 +19,9 @@
 //!
 //! No sample can lock the gate: the window follows the receiver's clock, and a leader that
 //! really jumped (homed with a new position, restarted at another position) is followed again
-//! once no valid sample was accepted for longer than a gap (one leader cycle plus the
-//! tolerance: its followers have stopped with 601 by then), [`Verdict::Reanchored`]. While the
+//! once no valid sample was accepted for longer than one leader cycle plus the delay D plus
+//! the tolerance on the receiver's clock (its followers have stopped with 601 by then),
+//! [`Verdict::Reanchored`]. While the
 //! real samples flow, no forged jump is ever accepted; right after an outage, the first
 //! plausible sample becomes the reference whoever sent it (only the leader's host may publish
 //! on the leader's key: the access control of the Zenoh sessions, docs/gateway.md).
@@ -57,6 +58,12 @@ pub struct GateConfig {
     /// Largest plausible change of velocity per second (the largest of `MaxAcceleration`,
     /// `MaxDeceleration` and the emergency deceleration, times the slack; infinite: unchecked).
     pub max_acceleration: f64,
+    /// How long after the last accepted valid sample, on the receiver's clock (ns), a sample
+    /// not reachable from it becomes the new reference: the leader's cycle plus its delay D
+    /// plus its tolerance, when every follower reading `t - D` has bridged the tolerance and
+    /// stopped with 601 ([`gate_config`]; [`GateConfig::new`] knows no D and takes one cycle
+    /// plus the tolerance).
+    pub reanchor_ns: i64,
     /// Check the position against the kinematics (setpoint coupling): with `|a| <= amax`
     /// between two samples, `|p_b - p_a - v_a·Δt| <= amax·Δt²/2`. Off for an actual value,
     /// whose filtered position and velocity need not agree so closely.
@@ -81,6 +88,7 @@ impl GateConfig {
             behind_ns: cycle_ns.saturating_mul(n),
             max_velocity,
             max_acceleration,
+            reanchor_ns: cycle_ns.saturating_add(tolerance_ns.max(0)),
             kinematic: true,
         }
     }
@@ -105,15 +113,18 @@ pub fn gate_config(cell: &Cell, leader: Leader, coupling: Coupling) -> GateConfi
         }),
         Leader::Encoder(_) => (f64::INFINITY, f64::INFINITY),
     };
+    let lv = cell.leading(leader);
+    let g = GateConfig::new(
+        cell.leader_cycle_ns(leader),
+        lv.tolerance_ns,
+        LEADING_BUFFER,
+        v,
+        a,
+    );
     GateConfig {
         kinematic: coupling == Coupling::Setpoint,
-        ..GateConfig::new(
-            cell.leader_cycle_ns(leader),
-            cell.leading(leader).tolerance_ns,
-            LEADING_BUFFER,
-            v,
-            a,
-        )
+        reanchor_ns: g.reanchor_ns.saturating_add(lv.delay_ns.max(0)),
+        ..g
     }
 }
 
@@ -181,7 +192,8 @@ impl std::error::Error for Refused {}
 pub enum Verdict {
     /// Plausible: into the buffer.
     Accepted,
-    /// Not reachable from the reference, but after an outage longer than a gap: into the
+    /// Not reachable from the reference, but after an outage longer than the leader's cycle,
+    /// D and the tolerance ([`GateConfig::reanchor_ns`]): into the
     /// buffer, the new reference.
     Reanchored,
 }
@@ -309,10 +321,11 @@ impl LeadingValueGate {
             return Ok(Verdict::Accepted);
         }
         // Not reachable from the reference: a forgery, or a leader that jumped (homed with a new
-        // position, restarted elsewhere). Once nothing valid was accepted for longer than a
-        // gap, the followers have bridged their tolerance and stopped with 601: the sample is
-        // the new reference.
-        if s.t_ns.saturating_sub(anchor.t_ns) > c.ahead_ns {
+        // position, restarted elsewhere). Once nothing valid was accepted for longer than the
+        // leader's cycle, D and the tolerance on the receiver's clock (not the sample's time,
+        // which a forger may stamp up to the window's end), the followers have bridged their
+        // tolerance and stopped with 601: the sample is the new reference.
+        if now_ns.saturating_sub(anchor.t_ns) > c.reanchor_ns {
             self.accept(s);
             return Ok(Verdict::Reanchored);
         }
@@ -519,6 +532,32 @@ mod tests {
         assert_eq!(g.check(1006 * MS, &moved(1006)), Ok(Verdict::Reanchored));
         assert_eq!(g.check(1007 * MS, &moved(1007)), Ok(Verdict::Accepted));
         assert_eq!((g.counts.jump, g.counts.reanchored), (5, 1));
+    }
+
+    #[test]
+    fn an_outage_reanchors_only_after_cycle_delay_and_tolerance_on_the_receivers_clock() {
+        // D = 10 ms: the followers stop with 601 at 1 + 10 + 4 = 15 ms after the last sample.
+        let mut g = LeadingValueGate::new(GateConfig {
+            reanchor_ns: 15 * MS,
+            ..GateConfig::new(MS, 4 * MS, 256, 100.0, 1000.0)
+        });
+        g.check(1000 * MS, &at(1000, 0.0)).unwrap();
+        let moved = |k: u64| {
+            let mut s = at(k, 0.0);
+            s.p = 360.0;
+            s
+        };
+        // A forger stamps the latest time the window takes (now + cycle + tolerance): 9 ms
+        // into the outage its sample lies 14 ms after the reference, and is still a jump.
+        assert_eq!(
+            g.check(1009 * MS, &moved(1014)),
+            Err(Refused::Jump { seq: 1014 })
+        );
+        assert_eq!(
+            g.check(1015 * MS, &moved(1019)),
+            Err(Refused::Jump { seq: 1019 })
+        );
+        assert_eq!(g.check(1016 * MS, &moved(1020)), Ok(Verdict::Reanchored));
     }
 
     #[test]
