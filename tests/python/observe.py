@@ -41,6 +41,12 @@ def main():
                     "cell serves: SENDER must be the certificate's CN); without, the key without a sender (plain cells)")
     ap.add_argument("--subscribe", action="append", default=[], metavar="KEY",
                     help="subscribe to this key expression (repeatable) instead of the default")
+    ap.add_argument("--forge-state", action="append", default=[], metavar="KEY",
+                    help="put a forged axis state (standing still, marked \"forged\": true) on KEY every 50 ms while watching")
+    ap.add_argument("--forge-alive", action="append", default=[], metavar="HOST",
+                    help="declare the liveliness token of a host that does not exist: tandem/<cell>/alive/HOST")
+    ap.add_argument("--forge-clock", action="append", default=[], metavar="HOST",
+                    help="answer the gateways' clock queries for HOST with a time an hour off")
     a = ap.parse_args()
 
     conf = zenoh.Config()
@@ -63,6 +69,7 @@ def main():
     last = {}
     signals = []
     command_events = []
+    forged_seen = [0]
     lock = threading.Lock()
 
     def on_sample(sample):
@@ -74,6 +81,8 @@ def main():
                     last[key] = json.loads(sample.payload.to_string())
                 except ValueError:
                     last[key] = {"malformed": True}
+                if isinstance(last[key], dict) and last[key].get("forged"):
+                    forged_seen[0] += 1
             elif key.endswith("/events"):
                 try:
                     e = json.loads(sample.payload.to_string())
@@ -102,6 +111,26 @@ def main():
             alive_events.append([round(time.monotonic() - t0, 3), kind, str(sample.key_expr)])
 
     alive_sub = session.liveliness().declare_subscriber(f"tandem/{a.cell}/alive/*", on_alive, history=True)
+
+    # Forgeries: what an attacker holding only this session would try (issue 12).
+    tokens = [session.liveliness().declare_token(f"tandem/{a.cell}/alive/{h}") for h in a.forge_alive]
+
+    def on_clock(query):
+        # The gateways' clock reply: the time in ns as text (services/gateway, "Clock watch").
+        query.reply(query.key_expr, str(time.time_ns() + 3_600_000_000_000))
+
+    clocks = [session.declare_queryable(f"tandem/{a.cell}/clock/{h}", on_clock) for h in a.forge_clock]
+    stop_forging = threading.Event()
+
+    def forge_states():
+        while not stop_forging.is_set():
+            for key in a.forge_state:
+                session.put(key, json.dumps({"state": "Standstill", "position": 0.0, "velocity": 0.0,
+                                             "forged": True}))
+            stop_forging.wait(0.05)
+
+    forger = threading.Thread(target=forge_states)
+    forger.start()
     for key in a.garbage:
         for payload in (b"", b"\x00garbage", bytes(range(64)) + b"!"):
             session.put(key, payload)
@@ -121,12 +150,19 @@ def main():
 
     time.sleep(max(0.0, a.seconds - 1.5))
     alive = sorted(str(r.ok.key_expr) for r in session.liveliness().get(f"tandem/{a.cell}/alive/*", timeout=2.0) if r.ok is not None)
+    stop_forging.set()
+    forger.join()
+    for t in tokens:
+        t.undeclare()
+    for q in clocks:
+        q.undeclare()
     for sub in subs:
         sub.undeclare()
     alive_sub.undeclare()
     with lock:
         summary = {
             "keys": counts,
+            "forged_states_seen": forged_seen[0],
             "states": {k: v for k, v in last.items() if k.endswith("/state")},
             "health": {k: v for k, v in last.items() if k.endswith("/health")},
             "gateways": {k: v for k, v in last.items() if "/gateway/" in k},

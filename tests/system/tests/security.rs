@@ -197,7 +197,7 @@ emergency_deceleration = 10000.0
 "#;
 
 /// The test's duration of engine time (s).
-const SECONDS: f64 = 16.0;
+const SECONDS: f64 = 20.0;
 
 /// Power, home and gear (after t = D: before it there is no leading value at t - D), then
 /// jerk-limited moves of the leader with reversals. `fa` follows on the leader's host, `fb` on
@@ -263,6 +263,41 @@ fn observe_over(hosts: &Hosts, cell: &str, protocol: &str, args: &[String]) -> s
     assert!(o.status.success(), "observe.py: {said}");
     let out = String::from_utf8_lossy(&o.stdout).to_string();
     serde_json::from_str(out.trim()).unwrap_or_else(|e| panic!("{e}: {said}"))
+}
+
+/// While a client in the third namespace (`who`: its certificate arguments, none for an
+/// outsider on a plain cell) forges the state of axis `fb`, the liveliness token of a host
+/// `ghost` and the clock replies of host h1, another client watches with `watcher`'s arguments:
+/// its summary.
+fn watch_forgeries(
+    hosts: &Hosts,
+    cell: &str,
+    protocol: &str,
+    who: &[String],
+    watcher: &[String],
+) -> serde_json::Value {
+    let mut c = hosts.exec(2, Path::new("python3"));
+    c.arg(root().join("tests/python/observe.py"))
+        .args(["--cell", cell, "--seconds", "6.5"])
+        .args([
+            "--connect",
+            &format!("{protocol}/{}:7447", hosts.addr(0)),
+            "--connect",
+            &format!("{protocol}/{}:7447", hosts.addr(1)),
+        ])
+        .args(who)
+        .args(["--forge-state", &format!("tandem/{cell}/nb/fb/state")])
+        .args(["--forge-alive", "ghost", "--forge-clock", "h1"])
+        .args(["--subscribe", &format!("tandem/{cell}/none")])
+        .stdin(Stdio::null());
+    let forger = Spawned::start(&mut c);
+    // The forger connects and declares its token and queryable within its first 1.5 s, and
+    // forges for 5 s more: the watcher's 2 s (and its commands) lie inside.
+    std::thread::sleep(Duration::from_millis(2500));
+    let seen = observe_over(hosts, cell, protocol, watcher);
+    let (status, out) = forger.wait(Duration::from_secs(60), "observe.py forging");
+    assert!(status.success(), "the forger: {out}");
+    seen
 }
 
 /// A status row of `axis` on host h2 (its own namespace, over iceoryx2), split in columns.
@@ -448,10 +483,15 @@ fn attack(hosts: &Hosts, name: &str, cell: &Path, pki: &Path) {
         serde_json::json!({}),
         "observer on lv: {seen}"
     );
-    // An operator commands.
-    let seen = observe(
+    // An operator commands, and watches while the observer forges an axis' state, a host's
+    // liveliness and the clock replies of h1: none of them reaches it, and the gateways'
+    // clocks see no forged reply (the plain run's control: there they warn of a host an hour
+    // off).
+    let seen = watch_forgeries(
         hosts,
         name,
+        "tls",
+        &observer,
         &[
             &ca[..],
             &[
@@ -466,6 +506,19 @@ fn attack(hosts: &Hosts, name: &str, cell: &Path, pki: &Path) {
         .concat(),
     );
     assert_eq!(seen["replies"][0]["reply"]["outcome"], "accepted", "{seen}");
+    assert_eq!(seen["forged_states_seen"], 0, "{seen}");
+    assert_eq!(
+        seen["alive"],
+        serde_json::json!([
+            format!("tandem/{name}/alive/h1"),
+            format!("tandem/{name}/alive/h2")
+        ]),
+        "{seen}"
+    );
+    for host in ["h1", "h2"] {
+        let g = &seen["gateways"][&format!("tandem/{name}/gateway/{host}")];
+        assert_eq!(g["clock_warnings"], 0, "{host}: {seen}");
+    }
     // The leading values flow between the gateways (whether the clients' puts reached one is
     // checked on the gateways' debug log after the run).
     for host in ["h1", "h2"] {
@@ -531,6 +584,26 @@ fn mtls_refuses_outsiders_and_observers_commands_and_moves_exactly_as_plain() {
         // follower's gateway, which drops them as malformed and says so.
         let lv = format!("tandem/{plain_name}/lv/master");
         observe_over(&hosts, &plain_name, "tcp", &["--garbage".into(), lv]);
+        // And an outsider's forged clock replies reach the gateways: a host an hour off, and
+        // warnings. (Its forged state and liveliness token reach the gateways too, but peers
+        // do not route between clients: another client of the gateways never sees them.)
+        let seen = watch_forgeries(&hosts, &plain_name, "tcp", &[], &[]);
+        let warnings: u64 = ["h1", "h2"]
+            .iter()
+            .map(|h| {
+                seen["gateways"][&format!("tandem/{plain_name}/gateway/{h}")]["clock_warnings"]
+                    .as_u64()
+                    .unwrap_or(0)
+            })
+            .sum();
+        assert!(
+            warnings > 0,
+            "the plain run's forged clock had no effect: {seen}"
+        );
+        eprintln!(
+            "plain run: forged states seen by another client {}, hosts alive {}",
+            seen["forged_states_seen"], seen["alive"]
+        );
     });
     assert!(
         plain_out.contains("malformed leading value: dropped"),
