@@ -573,17 +573,52 @@ type CommandClient = iceoryx2::port::client::Client<
     (),
 >;
 
-/// A queryable on `expr` that hands each query to the command thread through `tx`.
+/// What the queryables of the command keys share: the command thread's queue, the senders'
+/// rates, the cell's name and rate (for the `busy` message) and the counters.
+#[derive(Clone)]
+struct CommandGate {
+    tx: mpsc::SyncSender<(zenoh::query::Query, String)>,
+    rates: Arc<std::sync::Mutex<SenderRates>>,
+    cell: Arc<Cell>,
+    counters: Arc<Counters>,
+}
+
+/// A queryable on `expr` that answers a sender beyond its rate `busy` at once, on Zenoh's
+/// thread, and hands every other query (with its sender) to the command thread: a flood's
+/// excess never waits in the queue ahead of another sender's commands.
 fn command_queryable(
     session: &zenoh::Session,
     expr: String,
-    tx: mpsc::SyncSender<zenoh::query::Query>,
+    gate: CommandGate,
 ) -> Result<zenoh::query::Queryable<()>, GatewayError> {
     session
         .declare_queryable(expr)
         .callback(move |q| {
+            let c = &gate.counters;
+            c.commands.fetch_add(1, Ordering::Relaxed);
+            let sender = query_sender(&gate.cell.name, &q);
+            // A poisoned lock (a panic elsewhere while admitting) admits: the command thread
+            // still answers every command.
+            let admitted = gate
+                .rates
+                .lock()
+                .map_or(true, |mut r| r.admit(&sender, tandem_rt::now_ns()));
+            if !admitted {
+                c.commands_busy.fetch_add(1, Ordering::Relaxed);
+                reply_json(
+                    &q,
+                    &ReplyJson::failed(
+                        "busy",
+                        format!(
+                            "busy: more than {} commands per second from `{sender}`; try again",
+                            gate.cell.command_rate_hz
+                        ),
+                    ),
+                );
+                return;
+            }
             // Never dropped unanswered: a full queue answers `busy` at once.
-            if let Err(mpsc::TrySendError::Full(q)) = tx.try_send(q) {
+            if let Err(mpsc::TrySendError::Full((q, _))) = gate.tx.try_send((q, sender)) {
                 reply_json(
                     &q,
                     &ReplyJson::failed(
@@ -601,8 +636,16 @@ fn command_queryable(
 fn commands(x: &Ctx) -> Result<(), GatewayError> {
     let (cell, host, plan, session, c, stop) = x.parts();
     let node = iox(cell, host, "commands")?;
-    let (tx, rx) = mpsc::sync_channel::<zenoh::query::Query>(COMMAND_QUEUE);
-    let mut rates = SenderRates::new(cell.command_rate_hz, cell.command_burst);
+    let (tx, rx) = mpsc::sync_channel(COMMAND_QUEUE);
+    let gate = CommandGate {
+        tx,
+        rates: Arc::new(std::sync::Mutex::new(SenderRates::new(
+            cell.command_rate_hz,
+            cell.command_burst,
+        ))),
+        cell: x.cell.clone(),
+        counters: x.counters.clone(),
+    };
     let mut queryables = Vec::new();
     let mut clients: HashMap<String, CommandClient> = HashMap::new();
     for n in &plan.nodes {
@@ -614,7 +657,7 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
             exprs.push(keys::commands_unbound(&cell.name, name));
         }
         for expr in exprs {
-            queryables.push(command_queryable(session, expr, tx.clone())?);
+            queryables.push(command_queryable(session, expr, gate.clone())?);
         }
         let svc = ipc::commands(&node, &cell.name, name)?;
         clients.insert(
@@ -625,26 +668,20 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
         );
     }
     while !stop.load(Ordering::SeqCst) {
-        let Ok(q) = rx.recv_timeout(Duration::from_millis(50)) else {
+        let Ok((q, sender)) = rx.recv_timeout(Duration::from_millis(50)) else {
             continue;
         };
-        c.commands.fetch_add(1, Ordering::Relaxed);
-        let sender = query_sender(&cell.name, &q);
-        let reply = if rates.admit(&sender, tandem_rt::now_ns()) {
-            answer(&q, (cell, host, session), &sender, &clients, c)
-        } else {
-            c.commands_busy.fetch_add(1, Ordering::Relaxed);
-            ReplyJson::failed(
-                "busy",
-                format!(
-                    "busy: more than {} commands per second from `{sender}`; try again",
-                    cell.command_rate_hz
-                ),
-            )
-        };
+        let reply = answer(&q, (cell, host, session), &sender, &clients, c);
         reply_json(&q, &reply);
     }
     drop(queryables);
+    // The queryables' callbacks may still hold the queue's sender: answer what is left.
+    while let Ok((q, _)) = rx.try_recv() {
+        reply_json(
+            &q,
+            &ReplyJson::failed("busy", "the gateway is stopping; try again".to_string()),
+        );
+    }
     Ok(())
 }
 
