@@ -1077,9 +1077,12 @@ impl<'c> Executive<'c> {
             if let Some(m) = link.probe_input {
                 link.arm_probe(self.objects.measuring(m));
             }
-            if let Some(a) = self.axes.get(axis) {
-                let out = a.drive_outputs();
-                self.drives.command(k, t, &out);
+            // In place where the axis stored them: no copy of the struct (a copy read them
+            // back wider than they were stored, a store-forwarding stall per axis and cycle).
+            match self.axes.get(axis).map(|a| (a.connected_outputs(), a)) {
+                Some((Some(out), _)) => self.drives.command(k, t, out),
+                Some((None, a)) => self.drives.command(k, t, &a.drive_outputs()),
+                None => {}
             }
         }
     }
