@@ -498,6 +498,9 @@ struct Ratio {
     /// `lo / hi`, for the first estimate of [`Ratio::counts`] (the same value it divided out
     /// each call before).
     lo_over_hi: f64,
+    /// `hi` split in halves ([`split`]), for the exact products of [`Ratio::units`] (the same
+    /// halves [`two_product`] would split it into each call).
+    hi_split: (f64, f64),
 }
 
 impl Ratio {
@@ -519,6 +522,7 @@ impl Ratio {
             hi,
             lo,
             lo_over_hi: lo / hi,
+            hi_split: split(hi),
         }
     }
 
@@ -532,7 +536,11 @@ impl Ratio {
             // |count - c_hi| <= 2^10: exact (i128: c_hi may be 2^63, beyond i64).
             (i128::from(count) - c_hi as i128) as f64
         };
-        let (p, e) = two_product(c_hi, self.hi);
+        // `two_product(c_hi, hi)` with `hi`'s halves split once: the same operations.
+        let p = c_hi * self.hi;
+        let (ah, al) = split(c_hi);
+        let (bh, bl) = self.hi_split;
+        let e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
         p + (e + c_hi * self.lo + c_lo * self.hi)
     }
 
