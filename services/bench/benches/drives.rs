@@ -68,7 +68,10 @@ fn cycle(axis: &mut Axis, k: i64, link: Option<(&mut Cia402Link, &mut IdealDrive
             let inputs = link.inputs(t, &drive.feedback);
             axis.set_drive_inputs(&inputs);
             axis.step(t);
-            let cmd = link.command(&axis.drive_outputs());
+            let cmd = match axis.connected_outputs() {
+                Some(out) => link.command(out),
+                None => link.command(&axis.drive_outputs()),
+            };
             drive.apply(&cmd);
         }
     }

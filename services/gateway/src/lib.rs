@@ -977,7 +977,9 @@ fn put_events(session: &zenoh::Session, cell: &Cell, names: &[&str], f: &NodeFee
 /// Each signal edge of one node since the last call, on its signal's key (docs/processes.md,
 /// "Zenoh keys").
 fn put_signals(session: &zenoh::Session, cell: &Cell, f: &NodeFeeds) {
-    use tandem_protocol::wire::{SIGNAL_INPUT, SIGNAL_LATE, SIGNAL_TIMESTAMPED};
+    use tandem_protocol::wire::{
+        SIGNAL_FLOAT, SIGNAL_INPUT, SIGNAL_INTEGER, SIGNAL_LATE, SIGNAL_TIMESTAMPED,
+    };
     let Some(sub) = &f.signals else {
         return;
     };
@@ -987,7 +989,26 @@ fn put_signals(session: &zenoh::Session, cell: &Cell, f: &NodeFeeds) {
             continue;
         };
         let input = e.flags & SIGNAL_INPUT != 0;
-        let body = if input {
+        let body = if e.flags & (SIGNAL_INTEGER | SIGNAL_FLOAT) != 0 {
+            // A new reading of an integer or float signal: the edge fields it shares, and
+            // its value and type.
+            let (ty, value) = if e.flags & SIGNAL_INTEGER != 0 {
+                ("integer", serde_json::json!(e.value as i64))
+            } else {
+                ("float", serde_json::json!(e.value))
+            };
+            serde_json::json!({
+                "signal": signal.name,
+                "node": f.name,
+                "direction": if input { "input" } else { "output" },
+                "type": ty,
+                "value": value,
+                "level": e.level != 0,
+                "time_ns": e.t_ns,
+                "sampled_ns": e.ref_ns,
+                "timestamped": false,
+            })
+        } else if input {
             serde_json::json!({
                 "signal": signal.name,
                 "node": f.name,

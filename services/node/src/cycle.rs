@@ -20,10 +20,10 @@ use tandem_motion::objects::axis::AxisStatus;
 use tandem_protocol::wire::{
     job_code, AxisTelemetry, CommandReply, Event, IoEvent, LeadingValueSample, NodeHealth,
     SignalEvent, Text, EVENT_JOB, EVENT_LOG, IO_MEASURED, IO_OUTPUT, OUTCOME_ACCEPTED,
-    OUTCOME_REJECTED, SIGNAL_INPUT, SIGNAL_LATE, SIGNAL_TIMESTAMPED,
+    OUTCOME_REJECTED, SIGNAL_FLOAT, SIGNAL_INPUT, SIGNAL_INTEGER, SIGNAL_LATE, SIGNAL_TIMESTAMPED,
 };
 use tandem_rt as rt;
-use tandem_runtime::exec::{Applied, Describe, Executive, JobNote};
+use tandem_runtime::exec::{Applied, Describe, Executive, JobNote, SignalValue};
 
 /// A trace row: the cycle's time and the status of every owned axis.
 pub(crate) type Row = (i64, Vec<AxisStatus>);
@@ -354,6 +354,7 @@ impl<'c> NodeCycle<'c> {
                 level: u32::from(e.rising),
                 flags: SIGNAL_INPUT | if ts { SIGNAL_TIMESTAMPED } else { 0 },
                 reserved: 0,
+                value: if e.rising { 1.0 } else { 0.0 },
             };
             failed += u64::from(port.send_copy(ev).is_err());
         });
@@ -373,6 +374,23 @@ impl<'c> NodeCycle<'c> {
                 flags: if ts { SIGNAL_TIMESTAMPED } else { 0 }
                     | if x.late { SIGNAL_LATE } else { 0 },
                 reserved: 0,
+                value: if x.on { 1.0 } else { 0.0 },
+            };
+            failed += u64::from(port.send_copy(ev).is_err());
+        });
+        self.exec.drain_input_values(|e| {
+            let (flags, value) = match e.value {
+                SignalValue::Integer(v) => (SIGNAL_INTEGER, v as f64),
+                SignalValue::Float(v) => (SIGNAL_FLOAT, v),
+            };
+            let ev = SignalEvent {
+                t_ns: e.sampled_ns,
+                ref_ns: e.sampled_ns,
+                signal: e.signal as u32,
+                level: u32::from(value != 0.0),
+                flags: SIGNAL_INPUT | flags,
+                reserved: 0,
+                value,
             };
             failed += u64::from(port.send_copy(ev).is_err());
         });

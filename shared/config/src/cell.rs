@@ -147,6 +147,13 @@ pub enum DeviceKind {
     SimAnalogDrive(tandem_motion::plant::analog::SimAnalogParams),
     /// A simulated digital input terminal (`kind = "sim_digital_input"`).
     SimDigitalInput(DigitalInputParams),
+    /// A simulated analog input terminal (`kind = "sim_analog_input"`): `float` channels.
+    SimAnalogInput(AnalogChannelParams),
+    /// A simulated analog output terminal (`kind = "sim_analog_output"`): `float` channels.
+    SimAnalogOutput(AnalogChannelParams),
+    /// A simulated counter terminal (`kind = "sim_counter"`): `integer` channels, each a
+    /// counter value register.
+    SimCounter(CounterParams),
 }
 
 impl DeviceKind {
@@ -157,6 +164,9 @@ impl DeviceKind {
             DeviceKind::SimDigitalOutput(_) => "sim_digital_output",
             DeviceKind::SimAnalogDrive(_) => "sim_analog_drive",
             DeviceKind::SimDigitalInput(_) => "sim_digital_input",
+            DeviceKind::SimAnalogInput(_) => "sim_analog_input",
+            DeviceKind::SimAnalogOutput(_) => "sim_analog_output",
+            DeviceKind::SimCounter(_) => "sim_counter",
         }
     }
 
@@ -171,7 +181,84 @@ impl DeviceKind {
             DeviceKind::SimDigitalInput(p) => {
                 Some((p.channels, p.timestamped, SignalDirection::Input))
             }
+            DeviceKind::SimAnalogInput(p) => Some((p.channels, false, SignalDirection::Input)),
+            DeviceKind::SimAnalogOutput(p) => Some((p.channels, false, SignalDirection::Output)),
+            DeviceKind::SimCounter(p) => Some((p.channels, false, SignalDirection::Input)),
         }
+    }
+
+    /// The type of the signals on the device's channels, for a device with channels.
+    pub fn channel_type(&self) -> Option<SignalType> {
+        match self {
+            DeviceKind::SimServo(_) | DeviceKind::SimAnalogDrive(_) => None,
+            DeviceKind::SimDigitalOutput(DigitalOutputParams { timestamped, .. })
+            | DeviceKind::SimDigitalInput(DigitalInputParams { timestamped, .. }) => {
+                Some(if *timestamped {
+                    SignalType::TimestampedBool
+                } else {
+                    SignalType::Bool
+                })
+            }
+            DeviceKind::SimAnalogInput(_) | DeviceKind::SimAnalogOutput(_) => {
+                Some(SignalType::Float)
+            }
+            DeviceKind::SimCounter(_) => Some(SignalType::Integer),
+        }
+    }
+}
+
+/// A simulated analog terminal (`sim_analog_input`, `sim_analog_output`): `channels` values in
+/// engineering units (V) over `±range`, quantized to `bits` of resolution including the sign,
+/// the way an analog terminal presents them (inferred from the signed presentation of the
+/// Beckhoff EL31xx/EL41xx terminals: full scale is `2^(bits-1) - 1`, 0x7FFF for 16 bits; an S7
+/// analog module's nominal range ends at 27648 instead, with an overrange above it).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct AnalogChannelParams {
+    /// Number of channels, 1 to [`MAX_CHANNELS`].
+    pub channels: u8,
+    /// Full scale (V): the channels measure or drive `-range ..= range`.
+    pub range: f64,
+    /// Resolution including the sign, 2 to 24 bits.
+    pub bits: u8,
+}
+
+impl AnalogChannelParams {
+    /// The largest code, `2^(bits-1) - 1` (32767 for 16 bits): it stands for `range`.
+    pub fn full_scale_code(&self) -> i32 {
+        (1i32 << (u32::from(self.bits).clamp(2, 24) - 1)) - 1
+    }
+
+    /// `value` (V) as the terminal presents it: the code `round(value · full / range)`,
+    /// clamped to `±full` (`full` = [`Self::full_scale_code`]), and that code back in V,
+    /// `code · range / full`. Returns the code and the value.
+    pub fn quantize(&self, value: f64) -> (i32, f64) {
+        let full = self.full_scale_code();
+        let code = (value * f64::from(full) / self.range)
+            .round()
+            .clamp(-f64::from(full), f64::from(full));
+        // Exact: |code| <= full < 2^23 is an integer (`as` would map a NaN to 0).
+        let code = code as i32;
+        (code, f64::from(code) * self.range / f64::from(full))
+    }
+}
+
+/// A simulated counter terminal (`sim_counter`): `channels` counter value registers of `bits`
+/// bits, read as a signed integer (an S7 TM Count's DINT `COUNT_VALUE`, a TwinCAT counter
+/// terminal's value as DINT): a value wraps modulo `2^bits` (inferred: the register overflows
+/// as the hardware's does; S7 and TwinCAT both count through the wrap).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct CounterParams {
+    /// Number of channels, 1 to [`MAX_CHANNELS`].
+    pub channels: u8,
+    /// The register's width: 16 or 32.
+    pub bits: u8,
+}
+
+impl CounterParams {
+    /// `value` as the register holds it: modulo `2^bits`, sign-extended.
+    pub fn wrap(&self, value: i64) -> i64 {
+        let shift = 64 - u32::from(self.bits).clamp(1, 64);
+        value.wrapping_shl(shift).wrapping_shr(shift)
     }
 }
 
@@ -204,10 +291,9 @@ pub struct DigitalOutputParams {
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SignalIndex(pub usize);
 
-/// The type of a signal, given by its channel. A digital channel gives `Bool` or
-/// `TimestampedBool`; an analog channel (a device kind not built yet) would add its value
-/// types here (inferred: `Integer` for a raw word, `Float` in units), bound and observed the
-/// same way.
+/// The type of a signal, given by its channel (`[signals.<name>] type` may state it, and must
+/// then agree). A digital channel gives `Bool` or `TimestampedBool`, an analog channel `Float`,
+/// a counter channel `Integer`.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum SignalType {
     /// A digital input sampled at, or output switched at, the cycle boundary.
@@ -215,6 +301,27 @@ pub enum SignalType {
     /// A digital input whose edges carry their time, or an output switched at a given time
     /// (the edge time goes with it).
     TimestampedBool,
+    /// A counter value register (`sim_counter`), sampled at the boundary.
+    Integer,
+    /// An analog value in engineering units (`sim_analog_input`, `sim_analog_output`), sampled
+    /// at the boundary and quantized as [`AnalogChannelParams::quantize`] says.
+    Float,
+}
+
+impl SignalType {
+    /// The type as `[signals.<name>] type` names it: `bool`, `integer` or `float`.
+    pub fn key(self) -> &'static str {
+        match self {
+            SignalType::Bool | SignalType::TimestampedBool => "bool",
+            SignalType::Integer => "integer",
+            SignalType::Float => "float",
+        }
+    }
+
+    /// Whether the signal carries a level (`bool`, timestamped or not).
+    pub fn is_bool(self) -> bool {
+        matches!(self, SignalType::Bool | SignalType::TimestampedBool)
+    }
 }
 
 /// Whether a signal is an input or an output of the process image (its device says).

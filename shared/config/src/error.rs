@@ -288,6 +288,16 @@ pub enum Problem {
         /// What the key needs.
         needs: &'static str,
     },
+    /// A signal whose type is not the one needed: a `type` its channel does not have, or a
+    /// consumer that needs another type.
+    ChannelType {
+        /// The signal.
+        signal: String,
+        /// What it is: its channel's type and device kind.
+        is: String,
+        /// What the key needs.
+        needs: String,
+    },
     /// An input signal already bound to another role.
     InputBound {
         /// The signal.
@@ -459,6 +469,9 @@ impl fmt::Display for Problem {
             }
             Problem::SignalType { signal, needs } => {
                 write!(f, "signal `{signal}` is a plain `bool`; this needs {needs}")
+            }
+            Problem::ChannelType { signal, is, needs } => {
+                write!(f, "signal `{signal}` is {is}; this needs {needs}")
             }
             Problem::InputBound { signal, by } => {
                 write!(f, "input signal `{signal}` is already bound to `{by}`")

@@ -55,12 +55,12 @@ pub mod script;
 pub mod security;
 
 pub use cell::{
-    AnalogDriveConnection, AxisEntry, AxisIndex, AxisInputs, CamEntry, CamTrackEntry, Cell,
-    Cia402Connection, Coupling, DeviceEntry, DeviceIndex, DeviceKind, DigitalInputParams,
-    DigitalOutputParams, DriveConnection, EncoderEntry, EncoderIndex, EncoderSource, InputBindings,
-    Leader, LeadingValueConfig, MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration,
-    SensorEntry, SignalDirection, SignalEntry, SignalIndex, SignalType, LEADING_BUFFER,
-    MAX_CHANNELS,
+    AnalogChannelParams, AnalogDriveConnection, AxisEntry, AxisIndex, AxisInputs, CamEntry,
+    CamTrackEntry, Cell, Cia402Connection, CounterParams, Coupling, DeviceEntry, DeviceIndex,
+    DeviceKind, DigitalInputParams, DigitalOutputParams, DriveConnection, EncoderEntry,
+    EncoderIndex, EncoderSource, InputBindings, Leader, LeadingValueConfig, MeasuringInputEntry,
+    Node, OutputCamEntry, Realtime, Registration, SensorEntry, SignalDirection, SignalEntry,
+    SignalIndex, SignalType, LEADING_BUFFER, MAX_CHANNELS,
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};

@@ -119,17 +119,25 @@ pub struct DeviceSection {
     pub ready_delay: Option<f64>,
     /// sim_analog_drive: offset of its analog input (V, -10 to 10, default 0).
     pub offset: Option<f64>,
-    /// sim_digital_output, sim_digital_input: the number of channels, 1 to 32 (required).
+    /// sim_digital_output, sim_digital_input, sim_analog_input, sim_analog_output,
+    /// sim_counter: the number of channels, 1 to 32 (required).
     pub channels: Option<u32>,
     /// sim_digital_output: `true` switches each channel at a given time (a timestamped output
     /// like an EL2252, one switching event per cycle); `false` (default) at the cycle boundary.
     /// sim_digital_input: `true` reports each edge with its time (like an EL1252); `false`
     /// (default) the level at the cycle boundary.
     pub timestamped: Option<bool>,
+    /// sim_analog_input, sim_analog_output: full scale (V, default 10): the channels span
+    /// `-range ..= range`.
+    pub range: Option<f64>,
+    /// sim_analog_input, sim_analog_output: resolution including the sign (2 to 24, default
+    /// 16); sim_counter: the register's width (16 or 32, default 32).
+    pub bits: Option<u32>,
 }
 
 /// `[signals.<name>]`: a named signal on a channel of a device. Its type comes from the
-/// channel: `bool` on a plain digital output, `timestamped bool` on a timestamped one.
+/// channel: `bool` on a plain digital channel, `timestamped bool` on a timestamped one,
+/// `float` on an analog channel, `integer` on a counter channel; `type` may state it.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SignalSection {
@@ -137,6 +145,10 @@ pub struct SignalSection {
     pub device: String,
     /// The channel, 1-based.
     pub channel: u32,
+    /// `bool`, `integer` or `float`: the type the signal is meant to have; refused unless its
+    /// channel has it (default: the channel's).
+    #[serde(rename = "type")]
+    pub signal_type: Option<String>,
     /// `[signals.<name>.sensor]`: an input's simulated sensor, a mark on an axis's load
     /// (`axis` required).
     pub sensor: Option<SensorSection>,

@@ -25,7 +25,10 @@
 //! A simulated input signal (`[signals.<name>]` on a `sim_digital_input`) takes `SetInput`
 //! (`value`, default `true`; `pulse`, s, default 0): the input's level from the entry's `t`
 //! exactly, and with `pulse > 0` back to `!value` that long after (a timestamped input reports
-//! both edges at those times).
+//! both edges at those times). On an `integer` or `float` input signal (a `sim_counter`,
+//! `sim_analog_input` channel) `value` is a number (whole for an `integer`), without `pulse`:
+//! the value the channel reads from the entry's `t`, sampled at the next boundary at or after
+//! it (a float quantized as its terminal does, an integer wrapped to its register).
 //! Use [`parse_cell`] to address them.
 
 use crate::command::{self, CommandError, Expected, Value};
@@ -43,8 +46,12 @@ pub struct ObjectNames<'a> {
     pub measuring_inputs: Vec<&'a str>,
     /// `[devices.<name>]`.
     pub devices: Vec<&'a str>,
-    /// The input signals (`[signals.<name>]` on a `sim_digital_input`).
+    /// The input signals (`[signals.<name>]` on a `sim_digital_input`, `sim_analog_input` or
+    /// `sim_counter`).
     pub input_signals: Vec<&'a str>,
+    /// The input signals among them that take a number (`integer`, `float`), and whether
+    /// it must be whole (`integer`).
+    pub value_signals: Vec<(&'a str, bool)>,
 }
 
 /// One timed command.
@@ -117,6 +124,16 @@ pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, C
             .iter()
             .filter(|x| x.direction == crate::cell::SignalDirection::Input)
             .map(|x| x.name.as_str())
+            .collect(),
+        value_signals: cell
+            .signals
+            .iter()
+            .filter(|x| x.direction == crate::cell::SignalDirection::Input)
+            .filter(|x| !x.signal_type.is_bool())
+            .map(|x| {
+                let whole = x.signal_type == crate::cell::SignalType::Integer;
+                (x.name.as_str(), whole)
+            })
             .collect(),
     };
     parse_with(file, src, &names, &cams, &objects)
@@ -394,7 +411,52 @@ fn object_instruction<'t>(
             known: list.iter().map(|s| s.to_string()).collect(),
         });
     }
+    if spec.0 == "SetInput" {
+        let value = objects.value_signals.iter().find(|(n, _)| *n == target);
+        if let Some(action) = set_input_value(t, value.map(|(_, whole)| *whole))? {
+            return Ok((target, spec.0, action));
+        }
+    }
     Ok((target, spec.0, object_entry(t, spec)?))
+}
+
+/// `SetInput` on an input signal that takes a number (`whole`: an `integer` one; `None`: a
+/// `bool` one, left to [`object_entry`]): `value` a number (whole for an integer), no `pulse`.
+/// A number for a `bool` signal is refused as the parameter's wrong type.
+fn set_input_value(
+    t: &toml_edit::Table,
+    whole: Option<bool>,
+) -> Result<Option<Action>, CommandError> {
+    let wrong = |param: &str, expected| CommandError::WrongType {
+        instruction: Some("SetInput"),
+        param: param.into(),
+        expected,
+    };
+    let Some(whole) = whole else {
+        return Ok(None);
+    };
+    if t.contains_key("pulse") {
+        return Err(CommandError::UnknownParameter {
+            instruction: "SetInput",
+            name: "pulse".into(),
+            known: vec!["value"],
+        });
+    }
+    let expected = if whole {
+        Expected::Integer
+    } else {
+        Expected::Number
+    };
+    let value = t
+        .get("value")
+        .and_then(num)
+        .filter(|v| v.is_finite())
+        .ok_or(wrong("value", expected))?;
+    // Whole and exact in an f64: a register of at most 32 bits is far inside 2^53.
+    if whole && !(value.fract() == 0.0 && value.abs() <= 9.007_199_254_740_992e15) {
+        return Err(wrong("value", Expected::Integer));
+    }
+    Ok(Some(Action::SetInputValue { value }))
 }
 
 /// MC_InterpolateCam of a cam technology object: `axis` names the cam, `from` another cam's

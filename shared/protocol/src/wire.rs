@@ -416,26 +416,37 @@ pub const SIGNAL_INPUT: u32 = 1;
 pub const SIGNAL_TIMESTAMPED: u32 = 2;
 /// An output switched later than its channel could (see the output stage).
 pub const SIGNAL_LATE: u32 = 4;
+/// The signal is an `integer` one: [`SignalEvent::value`] is its new reading (whole).
+pub const SIGNAL_INTEGER: u32 = 8;
+/// The signal is a `float` one: [`SignalEvent::value`] is its new reading (quantized).
+pub const SIGNAL_FLOAT: u32 = 16;
 
-/// One edge of a signal of a node's process image (docs/io.md, "Input signals" and
-/// "Outputs").
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, ZeroCopySend)]
-#[type_name("tandem.SignalEvent.v1")]
+/// One edge of a signal of a node's process image, or a new reading of an `integer` or
+/// `float` one (docs/io.md, "Input signals", "Integer and float signals" and "Outputs").
+///
+/// v2 adds [`SignalEvent::value`] after the v1 fields, which keep their places and meanings;
+/// a value change carries `SIGNAL_INTEGER` or `SIGNAL_FLOAT`, an edge neither.
+#[derive(Copy, Clone, Debug, Default, PartialEq, ZeroCopySend)]
+#[type_name("tandem.SignalEvent.v2")]
 #[repr(C)]
 pub struct SignalEvent {
     /// The instant the signal changed (ns, cell clock): an input's edge time (its own on a
-    /// timestamped input, the sampling boundary on a plain one); the instant an output switched.
+    /// timestamped input, the sampling boundary on a plain one or a value); the instant an
+    /// output switched.
     pub t_ns: i64,
-    /// An input: the boundary whose sample carried the edge; an output: the edge time the
-    /// output cam or cam track computed, its switching time (computed ahead; `t_ns` differs
-    /// from it on a plain output or when late).
+    /// An input: the boundary whose sample carried the edge or value; an output: the edge
+    /// time the output cam or cam track computed, its switching time (computed ahead; `t_ns`
+    /// differs from it on a plain output or when late).
     pub ref_ns: i64,
     /// The signal's index in the cell (`[signals.<name>]` in name order).
     pub signal: u32,
-    /// The new level: 1 on, 0 off.
+    /// The new level: 1 on, 0 off (a value: 1 when it is not 0).
     pub level: u32,
     /// `SIGNAL_*` bits.
     pub flags: u32,
     /// Reserved (0).
     pub reserved: u32,
+    /// A value change (`SIGNAL_INTEGER`, `SIGNAL_FLOAT`): the new reading (V for an analog
+    /// channel); an edge: the level, 1.0 or 0.0.
+    pub value: f64,
 }

@@ -570,6 +570,10 @@ impl Cia402Link {
     /// cycle after the latch). A first-event latch holds the first edge after arming, so a
     /// repeated value is the same mark.
     fn homing_marks(&self, fb: &DriveFeedback) -> (Option<f64>, Option<f64>) {
+        let Some(armed) = self.homing_armed else {
+            // Not armed for a mark (every cycle but a homing job's): nothing to look at.
+            return (None, None);
+        };
         let second = self.homing_probe == 2;
         let shift = if second {
             touch_probe::PROBE_2_SHIFT
@@ -589,11 +593,11 @@ impl Cia402Link {
                 .map_or(i64::from(raw), |c| c.nearest(raw as u32));
             self.scaling.drive_position(count)
         };
-        match self.homing_armed {
-            Some(HomingLatch::ZeroMark) if stored(touch_probe::STATUS_POSITIVE_STORED) => {
+        match armed {
+            HomingLatch::ZeroMark if stored(touch_probe::STATUS_POSITIVE_STORED) => {
                 (Some(at(positive)), None)
             }
-            Some(HomingLatch::ReferenceCamEdge) if stored(touch_probe::STATUS_NEGATIVE_STORED) => {
+            HomingLatch::ReferenceCamEdge if stored(touch_probe::STATUS_NEGATIVE_STORED) => {
                 (None, Some(at(negative)))
             }
             _ => (None, None),

@@ -19,12 +19,14 @@ use crate::error::ExecError;
 pub use crate::inputs::{InputDeviceStatus, InputSignalEdge, INPUT_EDGES};
 pub use crate::notes::{seconds, Describe, IoNote, JobNote, Secs, NOTES};
 pub use crate::outputs::{OutputDeviceStatus, OutputSwitch, LOOK_AHEAD_CYCLES, SWITCHES};
+pub use crate::values::{InputSignalValue, SignalValue, ValueDeviceStatus, INPUT_VALUES};
 pub use retain::{AdjustmentChange, RestoreError, Restored};
 
 use crate::inputs::Inputs;
 use crate::notes::keep;
 use crate::objects::{cycle_motion, CycleMotion, Objects};
 use crate::outputs::Outputs;
+use crate::values::Values;
 use std::io::{self, Write};
 use std::sync::Arc;
 use tandem_config::{
@@ -496,6 +498,8 @@ pub struct Executive<'c> {
     outputs: Outputs,
     /// The digital inputs of the process image, their stimuli and sensors.
     inputs: Inputs,
+    /// The analog and counter terminals of the process image (`integer`, `float` signals).
+    values: Values,
 }
 
 impl<'c> Executive<'c> {
@@ -544,6 +548,7 @@ impl<'c> Executive<'c> {
             drives,
             outputs: Outputs::new(cell, node),
             inputs,
+            values: Values::new(cell, node),
             cell,
             objects: Objects::new(cell)?,
             owned,
@@ -794,6 +799,10 @@ impl<'c> Executive<'c> {
                 let k = cell.signal(target).ok_or(ErrorId::IllegalObject)?;
                 return self.inputs.set(k.0, t, value, pulse_ns).map(|()| None);
             }
+            Action::SetInputValue { value } => {
+                let k = cell.signal(target).ok_or(ErrorId::IllegalObject)?;
+                return self.values.set(k.0, t, value).map(|()| None);
+            }
             Action::DriveFault { code } => {
                 let d = cell.devices.iter().position(|d| d.name == target);
                 let Some(d) = d.filter(|&d| self.drives.runs(d)) else {
@@ -957,6 +966,9 @@ impl<'c> Executive<'c> {
         if self.inputs.any() {
             self.input_sample(t);
         }
+        if self.values.any() {
+            self.value_sample(t, log)?;
+        }
         if self.drives.any() {
             self.drive_inputs(t);
         }
@@ -984,6 +996,24 @@ impl<'c> Executive<'c> {
                 axis.set_switch_inputs(switches);
             }
         }
+    }
+
+    /// The process image's analog and counter inputs at the boundary `t`: the terminals due
+    /// are sampled (with the digital inputs, before the axes step) and each change is logged
+    /// (`t=<t> <signal> input = <value>`, the raw word in brackets). No object takes them
+    /// ([`crate::values`]).
+    fn value_sample(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
+        self.values.sample(t);
+        for e in self.values.frame() {
+            let name = (self.cell.signals.get(e.signal)).map_or("?", |s| s.name.as_str());
+            match e.value {
+                SignalValue::Float(v) => {
+                    writeln!(log, "t={} {name} input = {v} [{}]", Secs(t), e.raw)?;
+                }
+                SignalValue::Integer(v) => writeln!(log, "t={} {name} input = {v}", Secs(t))?,
+            }
+        }
+        Ok(())
     }
 
     /// Once the cycle motions are known: the input signals' sensors add their edges to the
@@ -1047,9 +1077,12 @@ impl<'c> Executive<'c> {
             if let Some(m) = link.probe_input {
                 link.arm_probe(self.objects.measuring(m));
             }
-            if let Some(a) = self.axes.get(axis) {
-                let out = a.drive_outputs();
-                self.drives.command(k, t, &out);
+            // In place where the axis stored them: no copy of the struct (a copy read them
+            // back wider than they were stored, a store-forwarding stall per axis and cycle).
+            match self.axes.get(axis).map(|a| (a.connected_outputs(), a)) {
+                Some((Some(out), _)) => self.drives.command(k, t, out),
+                Some((None, a)) => self.drives.command(k, t, &a.drive_outputs()),
+                None => {}
             }
         }
     }
@@ -1103,6 +1136,24 @@ impl<'c> Executive<'c> {
                 Some(levels & (1u32 << (s.channel.saturating_sub(1) & 31)) != 0)
             }
         }
+    }
+
+    /// The reading of `integer` or `float` signal `signal` at the last sample (an analog
+    /// output holds 0 V), if its terminal is in this executive.
+    pub fn signal_value(&self, signal: tandem_config::SignalIndex) -> Option<SignalValue> {
+        self.values.value(signal.0)
+    }
+
+    /// The state of simulated analog or counter terminal `device` (index in
+    /// [`Cell::devices`]), if this executive runs it: its channels' readings and counters.
+    pub fn value_device(&self, device: usize) -> Option<&ValueDeviceStatus> {
+        self.values.status(device)
+    }
+
+    /// Hands each change of an `integer` or `float` input signal since the last call to `f`
+    /// (in order of the boundaries that sampled them), then forgets them.
+    pub fn drain_input_values(&mut self, f: impl FnMut(&InputSignalValue)) {
+        self.values.drain(f);
     }
 
     /// Hands each edge of an input signal since the last call to `f` (what the process image

@@ -59,5 +59,6 @@ mod notes;
 mod objects;
 mod outputs;
 pub mod sim;
+mod values;
 
 pub use error::{ExecError, SimError};

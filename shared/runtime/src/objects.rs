@@ -682,7 +682,9 @@ impl Objects {
         action: Action,
     ) -> Result<(), ErrorId> {
         match action {
-            Action::DriveFault { .. } | Action::SetInput { .. } => Err(ErrorId::IllegalObject),
+            Action::DriveFault { .. } | Action::SetInput { .. } | Action::SetInputValue { .. } => {
+                Err(ErrorId::IllegalObject)
+            }
             Action::OutputCam {
                 enable,
                 on_position,

@@ -5,8 +5,9 @@
 
 use super::{node_named, pick, Ctx};
 use crate::cell::{
-    AnalogDriveConnection, AxisEntry, Cia402Connection, DeviceEntry, DeviceIndex, DeviceKind,
-    DigitalInputParams, DigitalOutputParams, DriveConnection, Node, MAX_CHANNELS,
+    AnalogChannelParams, AnalogDriveConnection, AxisEntry, Cia402Connection, CounterParams,
+    DeviceEntry, DeviceIndex, DeviceKind, DigitalInputParams, DigitalOutputParams, DriveConnection,
+    Node, MAX_CHANNELS,
 };
 use crate::error::{ConfigError, Problem};
 use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
@@ -26,15 +27,30 @@ enum Kind {
     DigitalOutput,
     Analog,
     DigitalInput,
+    AnalogInput,
+    AnalogOutput,
+    Counter,
 }
 
 /// The device kinds by name.
-const DEVICE_KINDS: [(&str, Kind); 4] = [
+const DEVICE_KINDS: [(&str, Kind); 7] = [
     ("sim_servo", Kind::Servo),
     ("sim_digital_output", Kind::DigitalOutput),
     ("sim_analog_drive", Kind::Analog),
     ("sim_digital_input", Kind::DigitalInput),
+    ("sim_analog_input", Kind::AnalogInput),
+    ("sim_analog_output", Kind::AnalogOutput),
+    ("sim_counter", Kind::Counter),
 ];
+
+/// Default full scale of an analog terminal (V).
+const ANALOG_RANGE_V: f64 = 10.0;
+
+/// Default resolution of an analog terminal (bits including the sign).
+const ANALOG_BITS: u32 = 16;
+
+/// Default width of a counter register (bits).
+const COUNTER_BITS: u32 = 32;
 
 /// How an axis reaches its drive (`[axes.<name>.drive] type`).
 #[derive(Copy, Clone, PartialEq, Eq)]
@@ -82,7 +98,9 @@ pub(super) fn devices(
                 DeviceKind::SimServo(params)
             }
             Kind::DigitalOutput => {
-                if let Some(k) = servo_key_given(d).or_else(|| analog_key_given(d)) {
+                if let Some(k) = (servo_key_given(d).or_else(|| analog_key_given(d)))
+                    .or_else(|| value_key_given(d))
+                {
                     return Err(at(k, Problem::NotForKind("sim_digital_output")));
                 }
                 DeviceKind::SimDigitalOutput(
@@ -103,7 +121,9 @@ pub(super) fn devices(
                 DeviceKind::SimAnalogDrive(params)
             }
             Kind::DigitalInput => {
-                if let Some(k) = servo_key_given(d).or_else(|| analog_key_given(d)) {
+                if let Some(k) = (servo_key_given(d).or_else(|| analog_key_given(d)))
+                    .or_else(|| value_key_given(d))
+                {
                     return Err(at(k, Problem::NotForKind("sim_digital_input")));
                 }
                 // The same keys as an output terminal: `channels` and `timestamped`.
@@ -113,6 +133,9 @@ pub(super) fn devices(
                     channels: p.channels,
                     timestamped: p.timestamped,
                 })
+            }
+            k @ (Kind::AnalogInput | Kind::AnalogOutput | Kind::Counter) => {
+                value_device(d, k).map_err(|(key, p)| cx.at_or_table(&["devices", name, key], p))?
             }
         };
         out.push(DeviceEntry {
@@ -124,16 +147,27 @@ pub(super) fn devices(
     Ok(out)
 }
 
+/// An analog input or output terminal or a counter terminal (`kind`), its keys checked.
+fn value_device(d: &DeviceSection, kind: Kind) -> Result<DeviceKind, super::FieldError> {
+    let name = match kind {
+        Kind::AnalogInput => "sim_analog_input",
+        Kind::AnalogOutput => "sim_analog_output",
+        _ => "sim_counter",
+    };
+    if let Some(k) = value_device_foreign_key(d, kind) {
+        return Err((k, Problem::NotForKind(name)));
+    }
+    Ok(match kind {
+        Kind::AnalogInput => DeviceKind::SimAnalogInput(analog_channel_params(d)?),
+        Kind::AnalogOutput => DeviceKind::SimAnalogOutput(analog_channel_params(d)?),
+        _ => DeviceKind::SimCounter(counter_params(d)?),
+    })
+}
+
 /// The parameters of a simulated digital output: `channels` (required, 1 to
 /// [`MAX_CHANNELS`]) and `timestamped` (default `false`).
 fn output_params(d: &DeviceSection) -> Result<DigitalOutputParams, super::FieldError> {
-    let n = d
-        .channels
-        .ok_or(("channels", Problem::Missing("channels")))?;
-    let channels = u8::try_from(n)
-        .ok()
-        .filter(|n| (1..=MAX_CHANNELS).contains(n))
-        .ok_or(("channels", Problem::Invalid("must be 1 to 32")))?;
+    let channels = channel_count(d)?;
     Ok(DigitalOutputParams {
         channels,
         timestamped: d.timestamped.unwrap_or(false),
@@ -147,8 +181,84 @@ fn output_key_given(d: &DeviceSection) -> Option<&'static str> {
     } else if d.timestamped.is_some() {
         Some("timestamped")
     } else {
+        value_key_given(d)
+    }
+}
+
+/// The first key of an analog or counter terminal (`range`, `bits`) given on another kind.
+fn value_key_given(d: &DeviceSection) -> Option<&'static str> {
+    if d.range.is_some() {
+        Some("range")
+    } else if d.bits.is_some() {
+        Some("bits")
+    } else {
         None
     }
+}
+
+/// A device with value channels (analog terminals, counters) of kind `kind`: the first key
+/// it does not have (a servo's, an analog drive's, `timestamped`, and `range` on a counter).
+fn value_device_foreign_key(d: &DeviceSection, kind: Kind) -> Option<&'static str> {
+    servo_key_given(d)
+        .or_else(|| analog_key_given(d))
+        .or_else(|| d.timestamped.map(|_| "timestamped"))
+        .or_else(|| match kind {
+            Kind::Counter => d.range.map(|_| "range"),
+            _ => None,
+        })
+}
+
+/// The parameters of a simulated analog terminal: `channels` (required), `range` (V, finite,
+/// > 0, default 10) and `bits` (2 to 24, default 16).
+fn analog_channel_params(d: &DeviceSection) -> Result<AnalogChannelParams, super::FieldError> {
+    let channels = channel_count(d)?;
+    let range = d.range.unwrap_or(ANALOG_RANGE_V);
+    if !(range.is_finite() && range > 0.0) {
+        return Err((
+            "range",
+            Problem::Invalid("must be a positive full scale (V)"),
+        ));
+    }
+    let bits = u8::try_from(d.bits.unwrap_or(ANALOG_BITS))
+        .ok()
+        .filter(|b| (2..=24).contains(b))
+        .ok_or((
+            "bits",
+            Problem::Invalid("must be 2 to 24 (resolution including the sign)"),
+        ))?;
+    Ok(AnalogChannelParams {
+        channels,
+        range,
+        bits,
+    })
+}
+
+/// The parameters of a simulated counter terminal: `channels` (required) and `bits` (16 or 32,
+/// default 32).
+fn counter_params(d: &DeviceSection) -> Result<CounterParams, super::FieldError> {
+    let channels = channel_count(d)?;
+    let bits = match d.bits.unwrap_or(COUNTER_BITS) {
+        16 => 16,
+        32 => 32,
+        _ => {
+            return Err((
+                "bits",
+                Problem::Invalid("must be 16 or 32 (the register's width)"),
+            ))
+        }
+    };
+    Ok(CounterParams { channels, bits })
+}
+
+/// `channels` of a device with channels: required, 1 to [`MAX_CHANNELS`].
+fn channel_count(d: &DeviceSection) -> Result<u8, super::FieldError> {
+    let n = d
+        .channels
+        .ok_or(("channels", Problem::Missing("channels")))?;
+    u8::try_from(n)
+        .ok()
+        .filter(|n| (1..=MAX_CHANNELS).contains(n))
+        .ok_or(("channels", Problem::Invalid("must be 1 to 32")))
 }
 
 /// The first key of a servo drive given on another kind of device.
@@ -353,7 +463,11 @@ pub(super) fn drives(
                 }))
             }
             // Refused by `Bound::device` (not a drive).
-            DeviceKind::SimDigitalOutput(_) | DeviceKind::SimDigitalInput(_) => continue,
+            DeviceKind::SimDigitalOutput(_)
+            | DeviceKind::SimDigitalInput(_)
+            | DeviceKind::SimAnalogInput(_)
+            | DeviceKind::SimAnalogOutput(_)
+            | DeviceKind::SimCounter(_) => continue,
         };
     }
     Ok(())

@@ -47,14 +47,20 @@ pub(super) fn signals(
                 )
             })?;
         let dev = &devices[k];
-        let Some((channels, timestamped, direction)) = dev.kind.channels() else {
+        let (Some((channels, _, direction)), Some(signal_type)) =
+            (dev.kind.channels(), dev.kind.channel_type())
+        else {
             let problem = Problem::DeviceKind {
                 device: dev.name.clone(),
                 kind: dev.kind.name(),
-                needs: "a device with channels (`sim_digital_output`, `sim_digital_input`)",
+                needs: "a device with channels (`sim_digital_output`, `sim_digital_input`, \
+                        `sim_analog_input`, `sim_analog_output`, `sim_counter`)",
             };
             return Err(at("device", problem));
         };
+        if let Some(declared) = &s.signal_type {
+            declared_type(declared, signal_type, (name, dev)).map_err(|p| at("type", p))?;
+        }
         let channel = u8::try_from(s.channel)
             .ok()
             .filter(|c| (1..=channels).contains(c))
@@ -79,22 +85,83 @@ pub(super) fn signals(
         }
         let sensor = match &s.sensor {
             None => None,
+            Some(_) if !signal_type.is_bool() => {
+                let problem = Problem::ChannelType {
+                    signal: name.clone(),
+                    is: format!("`{}`", signal_type.key()),
+                    needs: "a `bool` input to carry a simulated sensor (a mark switches it)".into(),
+                };
+                return Err(cx.at(&["signals", name.as_str(), "sensor"], problem));
+            }
             Some(x) => Some(sensor(cx, name, x, direction, (dev, axes))?),
         };
         out.push(SignalEntry {
             name: name.clone(),
             device: DeviceIndex(k),
             channel,
-            signal_type: if timestamped {
-                SignalType::TimestampedBool
-            } else {
-                SignalType::Bool
-            },
+            signal_type,
             direction,
             sensor,
         });
     }
     Ok(out)
+}
+
+/// The signal types `[signals.<name>] type` names.
+const SIGNAL_TYPES: [&str; 3] = ["bool", "integer", "float"];
+
+/// `[signals.<name>] type = declared` against the type `has` of its channel on device `dev`:
+/// an unknown type, or one the channel does not have (a `float` signal on a digital channel,
+/// a `bool` one on an analog channel, ...), is refused.
+fn declared_type(
+    declared: &str,
+    has: SignalType,
+    (name, dev): (&str, &DeviceEntry),
+) -> Result<(), Problem> {
+    if !SIGNAL_TYPES.contains(&declared) {
+        return Err(Problem::Unknown {
+            what: "signal type",
+            name: declared.into(),
+            known: Some(SIGNAL_TYPES.iter().map(|t| t.to_string()).collect()),
+        });
+    }
+    if declared == has.key() {
+        return Ok(());
+    }
+    Err(Problem::ChannelType {
+        signal: name.into(),
+        is: format!(
+            "declared `{declared}`, but device `{}` is a `{}` with `{}` channels",
+            dev.name,
+            dev.kind.name(),
+            has.key()
+        ),
+        needs: format!(
+            "a device with `{declared}` channels ({})",
+            kinds_of(declared)
+        ),
+    })
+}
+
+/// The device kinds whose channels have signal type `t` (a name of [`SIGNAL_TYPES`]).
+fn kinds_of(t: &str) -> &'static str {
+    match t {
+        "integer" => "`sim_counter`",
+        "float" => "`sim_analog_input`, `sim_analog_output`",
+        _ => "`sim_digital_input`, `sim_digital_output`",
+    }
+}
+
+/// A `bool` signal is needed where signal `s` is bound: refused unless it is one.
+fn needs_bool(s: &SignalEntry, needs: &str) -> Result<(), Problem> {
+    if s.signal_type.is_bool() {
+        return Ok(());
+    }
+    Err(Problem::ChannelType {
+        signal: s.name.clone(),
+        is: format!("`{}`", s.signal_type.key()),
+        needs: format!("a `bool` signal: {needs}"),
+    })
 }
 
 /// `[signals.<name>.sensor]`: a mark on an axis of the node of the input's device `dev`.
@@ -206,6 +273,9 @@ impl Bindings<'_> {
                 needs: "an output (a channel of a `sim_digital_output`)",
             }));
         }
+        if let Some(x) = self.signals.get(k) {
+            needs_bool(x, "an output cam or cam track switches a digital output").map_err(at)?;
+        }
         if let Some(Some(other)) = by.get(k) {
             return Err(at(Problem::SignalDriven {
                 signal: name.into(),
@@ -288,6 +358,11 @@ impl Bindings<'_> {
                 needs: "an input (a channel of a `sim_digital_input`)",
             }));
         }
+        needs_bool(
+            s,
+            "a measuring input and an axis's switches take a digital input",
+        )
+        .map_err(at)?;
         if u.timestamped && s.signal_type != SignalType::TimestampedBool {
             return Err(at(Problem::SignalType {
                 signal: name.into(),

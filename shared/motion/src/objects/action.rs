@@ -79,4 +79,10 @@ pub enum Action {
         /// Length of the pulse (ns); 0: the level stays.
         pulse_ns: i64,
     },
+    /// The simulated `integer` or `float` input signal named by the entry set to `value` from
+    /// the entry's time (a whole number for an integer; a float in its channel's units).
+    SetInputValue {
+        /// The value from the entry's time.
+        value: f64,
+    },
 }

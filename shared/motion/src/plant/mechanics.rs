@@ -495,6 +495,12 @@ struct Ratio {
     hi: f64,
     /// Units per count, low part.
     lo: f64,
+    /// `lo / hi`, for the first estimate of [`Ratio::counts`] (the same value it divided out
+    /// each call before).
+    lo_over_hi: f64,
+    /// `hi` split in halves ([`split`]), for the exact products of [`Ratio::units`] (the same
+    /// halves [`two_product`] would split it into each call).
+    hi_split: (f64, f64),
 }
 
 impl Ratio {
@@ -509,11 +515,14 @@ impl Ratio {
         let (p, e) = two_product(hi, b_hi);
         // a - hi * b, with a_hi - p exact (Sterbenz: p is within an ulp of a_hi).
         let residual = (((a_hi - p) - e) + a_lo) - hi * b_lo;
+        let lo = residual / b_hi;
         Self {
             counts_per_period,
             units_per_period: a_hi,
             hi,
-            lo: residual / b_hi,
+            lo,
+            lo_over_hi: lo / hi,
+            hi_split: split(hi),
         }
     }
 
@@ -527,7 +536,11 @@ impl Ratio {
             // |count - c_hi| <= 2^10: exact (i128: c_hi may be 2^63, beyond i64).
             (i128::from(count) - c_hi as i128) as f64
         };
-        let (p, e) = two_product(c_hi, self.hi);
+        // `two_product(c_hi, hi)` with `hi`'s halves split once: the same operations.
+        let p = c_hi * self.hi;
+        let (ah, al) = split(c_hi);
+        let (bh, bl) = self.hi_split;
+        let e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
         p + (e + c_hi * self.lo + c_lo * self.hi)
     }
 
@@ -544,7 +557,15 @@ impl Ratio {
         // x / (hi + lo) to first order in lo / hi: within a count of the nearest for
         // |count| <= 2^52. Float to integer casts saturate.
         let q = x / self.hi;
-        let c = (q - q * (self.lo / self.hi)).round() as i64;
+        let c = (q - q * self.lo_over_hi).round() as i64;
+        // The common case without the double-double products. For |c| <= 2^40 (|lo| <=
+        // hi·2^-53): `c·hi - x` as computed is within 3·2^-12·hi of `units(c) - x`, and two
+        // neighbouring `units` are at least (1 - 2^-11)·hi apart. So `|c·hi - x| < 0.49·hi`
+        // puts `units(c)` within 0.491·hi of `x` and its neighbour towards `x` more than
+        // 0.508·hi away: `refine` would keep `c` at its first comparison. The same count.
+        if c.unsigned_abs() <= 1 << 40 && ((c as f64) * self.hi - x).abs() < 0.49 * self.hi {
+            return c;
+        }
         self.refine(c, x)
     }
 

@@ -1754,6 +1754,17 @@ impl Axis {
         }
     }
 
+    /// The outputs the axis wrote in its last cycle to its connected drive, in place (`None`
+    /// in simulation: [`Axis::drive_outputs`] computes them). For the cyclic path: the
+    /// caller reads the fields where the step stored them, without copying the struct.
+    #[inline]
+    pub fn connected_outputs(&self) -> Option<&DriveOutputs> {
+        match &self.link {
+            DriveLink::Simulation(_) => None,
+            DriveLink::Connected { outputs, .. } => Some(outputs),
+        }
+    }
+
     /// The outputs the axis wrote in its last cycle (in simulation: those applied to the
     /// simulated drive).
     pub fn drive_outputs(&self) -> DriveOutputs {
