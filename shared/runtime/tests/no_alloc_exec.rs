@@ -59,8 +59,9 @@ fn three_executives_step_without_allocating() {
     }
     assert_eq!(stepped, 6000);
     assert_eq!(allocations, 0, "allocations on the cyclic path");
-    // It did work: the followers were coupled, bridged the outage for the tolerance (4 ms:
-    // three extrapolated cycles after the last sample), then stopped with 601.
+    // It did work: the followers were coupled, bridged the outage for the tolerance (one
+    // extrapolated cycle per leader cycle of it: 100 of 1 ms in config/line.toml), then
+    // stopped with 601.
     let knife = cell.axes.iter().position(|a| a.name == "knife").unwrap();
     let feed = cell.axes.iter().position(|a| a.name == "feed").unwrap();
     for (n, a) in [(1, feed), (2, knife)] {
@@ -69,12 +70,15 @@ fn three_executives_step_without_allocating() {
         assert_eq!(st.error_detail.number, 601);
         assert_eq!(st.velocity, 0.0);
     }
+    let line = cell.leader_named("line").unwrap();
+    let bridged = (cell.leading(line).tolerance_ns / cell.leader_cycle_ns(line)) as u64;
+    assert_eq!(bridged, 100);
     assert_eq!(
         nodes[1].extrapolated,
-        2 * 4,
-        "two followers, four cycles within 4 ms"
+        2 * bridged,
+        "two followers, one extrapolated cycle per cycle of the tolerance"
     );
-    assert_eq!(nodes[2].extrapolated, 4);
+    assert_eq!(nodes[2].extrapolated, bridged);
 }
 
 /// The process image's drive stages (`config/servo.toml`: an axis on a simulated CiA 402
