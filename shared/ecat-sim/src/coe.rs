@@ -243,6 +243,14 @@ impl ObjectDictionary {
             };
         }
         // Subindex 0: the number of entries, each of which must exist and be set.
+        let capacity = self
+            .entries
+            .iter()
+            .filter(|e| e.index == index && e.subindex > 0)
+            .count();
+        if raw as usize > capacity {
+            return Err(AbortCode::VALUE_TOO_HIGH);
+        }
         for k in 1..=raw {
             let sub = u8::try_from(k).map_err(|_| AbortCode::VALUE_TOO_HIGH)?;
             match self.entry(index, sub) {

@@ -658,10 +658,12 @@ impl Esc {
                 let length = u32::from(u16::from_le_bytes([f[4], f[5]]));
                 let physical = usize::from(u16::from_le_bytes([f[8], f[9]]));
                 let (is_read, is_write, enabled) = (f[11] & 1 != 0, f[11] & 2 != 0, f[12] & 1 != 0);
-                if !enabled
-                    || (pass_write && !(is_write && writes))
-                    || (!pass_write && !(is_read && reads))
-                {
+                let moves = if pass_write {
+                    is_write && writes
+                } else {
+                    is_read && reads
+                };
+                if !enabled || !moves {
                     continue;
                 }
                 let lo = logical.max(addr);

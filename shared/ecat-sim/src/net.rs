@@ -212,7 +212,7 @@ impl RawSocket {
         if n < 0 {
             return Err(os_error("recvfrom"));
         }
-        Ok((n as usize, from.sll_pkttype == libc::PACKET_OUTGOING as u8))
+        Ok((n as usize, from.sll_pkttype == libc::PACKET_OUTGOING))
     }
 
     /// Sends one frame on the bound interface.
