@@ -17,22 +17,36 @@ pub const ETHERNET_HEADER: usize = 14;
 const DATAGRAM_HEADER: usize = 10;
 
 /// Datagram command codes.
-#[allow(missing_docs)]
 pub mod cmd {
+    /// No operation.
     pub const NOP: u8 = 0x00;
+    /// Auto-increment physical read.
     pub const APRD: u8 = 0x01;
+    /// Auto-increment physical write.
     pub const APWR: u8 = 0x02;
+    /// Auto-increment physical read-write.
     pub const APRW: u8 = 0x03;
+    /// Configured address physical read.
     pub const FPRD: u8 = 0x04;
+    /// Configured address physical write.
     pub const FPWR: u8 = 0x05;
+    /// Configured address physical read-write.
     pub const FPRW: u8 = 0x06;
+    /// Broadcast read (OR-combined).
     pub const BRD: u8 = 0x07;
+    /// Broadcast write.
     pub const BWR: u8 = 0x08;
+    /// Broadcast read-write.
     pub const BRW: u8 = 0x09;
+    /// Logical read.
     pub const LRD: u8 = 0x0A;
+    /// Logical write.
     pub const LWR: u8 = 0x0B;
+    /// Logical read-write.
     pub const LRW: u8 = 0x0C;
+    /// Auto-increment read, multiple write.
     pub const ARMW: u8 = 0x0D;
+    /// Configured address read, multiple write.
     pub const FRMW: u8 = 0x0E;
 }
 
@@ -77,6 +91,25 @@ impl fmt::Display for FrameError {
 }
 
 impl std::error::Error for FrameError {}
+
+/// Walks the datagram chain without processing it: a frame is processed whole or not at all.
+fn check_datagrams(body: &[u8]) -> Result<(), FrameError> {
+    let mut offset = 0;
+    loop {
+        let h = body
+            .get(offset..offset + DATAGRAM_HEADER)
+            .ok_or(FrameError::Truncated { offset: offset + 2 })?;
+        let flags = u16::from_le_bytes([h[6], h[7]]);
+        let end = offset + DATAGRAM_HEADER + usize::from(flags & 0x07FF) + 2;
+        if end > body.len() {
+            return Err(FrameError::Truncated { offset: offset + 2 });
+        }
+        if flags & 0x8000 == 0 {
+            return Ok(());
+        }
+        offset = end;
+    }
+}
 
 /// A line of emulated SubDevices, position 0 first.
 #[derive(Clone, Debug)]
@@ -145,29 +178,26 @@ impl Segment {
         let body = payload
             .get_mut(2..end)
             .ok_or(FrameError::Truncated { offset: 2 })?;
+        check_datagrams(body)?;
         for esc in &mut self.escs {
             esc.set_time(now_ns);
         }
         let mut offset = 0;
-        loop {
-            let h = body
-                .get(offset..offset + DATAGRAM_HEADER)
-                .ok_or(FrameError::Truncated { offset: offset + 2 })?;
+        // The chain is checked: every header, data and working counter is inside `body`.
+        while let Some(h) = body.get(offset..offset + DATAGRAM_HEADER) {
             let command = h[0];
             let mut adp = u16::from_le_bytes([h[2], h[3]]);
             let ado = u16::from_le_bytes([h[4], h[5]]);
             let flags = u16::from_le_bytes([h[6], h[7]]);
-            let n = usize::from(flags & 0x07FF);
             let data_at = offset + DATAGRAM_HEADER;
-            let wkc_at = data_at + n;
-            let wkc_bytes = body
-                .get(wkc_at..wkc_at + 2)
-                .ok_or(FrameError::Truncated { offset: offset + 2 })?;
-            let mut wkc = u16::from_le_bytes([wkc_bytes[0], wkc_bytes[1]]);
-            let data = body
-                .get_mut(data_at..wkc_at)
-                .ok_or(FrameError::Truncated { offset: offset + 2 })?;
-            wkc = wkc.wrapping_add(self.datagram(command, &mut adp, ado, data));
+            let wkc_at = data_at + usize::from(flags & 0x07FF);
+            let Some(&[lo, hi]) = body.get(wkc_at..wkc_at + 2) else {
+                break;
+            };
+            let mut wkc = u16::from_le_bytes([lo, hi]);
+            if let Some(data) = body.get_mut(data_at..wkc_at) {
+                wkc = wkc.wrapping_add(self.datagram(command, &mut adp, ado, data));
+            }
             if let Some(b) = body.get_mut(offset + 2..offset + 4) {
                 b.copy_from_slice(&adp.to_le_bytes());
             }
@@ -176,9 +206,10 @@ impl Segment {
             }
             offset = wkc_at + 2;
             if flags & 0x8000 == 0 {
-                return Ok(());
+                break;
             }
         }
+        Ok(())
     }
 
     /// One datagram through every ESC; returns the working counter increment. `adp` is

@@ -124,7 +124,12 @@ async fn main_device(seen: &mut Seen) -> Result<(), ethercrab::error::Error> {
     let (tx, rx, pdu_loop) = PDU_STORAGE.try_split().expect("split once");
     let md = MainDevice::new(
         pdu_loop,
-        Timeouts::default(),
+        // The emulator is another process on a machine shared with compilers: a reply may be
+        // later than ethercrab's 30 ms default, and a late reply ends its receive task.
+        Timeouts {
+            pdu: Duration::from_millis(500),
+            ..Timeouts::default()
+        },
         MainDeviceConfig {
             dc_static_sync_iterations: 100,
             ..MainDeviceConfig::default()
