@@ -21,6 +21,10 @@ const MAX_FRAMES: usize = 16;
 const MAX_PDU_DATA: usize = PduStorage::element_size(1100);
 /// The whole scan must finish within this (ethercrab's own timeouts are shorter).
 const SCAN_TIMEOUT: Duration = Duration::from_secs(60);
+/// How long a frame may take to come back. ethercrab's default is 30 ms; a scan is not
+/// cyclic, and a busy host (or an emulated segment on one) must not fail it: a reply later
+/// than this ends ethercrab's receive task.
+const PDU_TIMEOUT: Duration = Duration::from_millis(500);
 /// Drift compensation frames at init: enough for a listing, far fewer than ethercrab's
 /// default 10,000 (a scan does not run synchronised).
 const DC_ITERATIONS: u32 = 100;
@@ -77,7 +81,10 @@ pub fn scan(interface: &str) -> Result<Vec<ScannedSubDevice>, CliError> {
         let _io = tokio::spawn(task);
         let md = MainDevice::new(
             pdu_loop,
-            Timeouts::default(),
+            Timeouts {
+                pdu: PDU_TIMEOUT,
+                ..Timeouts::default()
+            },
             MainDeviceConfig {
                 dc_static_sync_iterations: DC_ITERATIONS,
                 ..MainDeviceConfig::default()
