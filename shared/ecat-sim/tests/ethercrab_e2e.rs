@@ -4,7 +4,8 @@
 //!
 //! Proves: ethercrab finds exactly the emulated SubDevices with their identities, reads an
 //! object over CoE, remaps the drive's TxPDO over CoE (and maps the new size), brings the
-//! group to OP, exchanges the PDI for 1,000 cycles with the
+//! group to OP, distributes the reference clock's DC system time every cycle (it advances
+//! and stays on the MainDevice's clock), exchanges the PDI for 1,000 cycles with the
 //! expected working counter (drive +3, terminal +3), a digital output comes back on the
 //! looped terminal's inputs one cycle later, and the drive's statusword follows the CiA 402
 //! enable sequence for controlwords 0x06, 0x07, 0x0F.
@@ -119,6 +120,11 @@ struct Seen {
     dio_mismatches: usize,
     statuswords: Vec<u16>,
     enabled_at: Option<usize>,
+    /// The largest |DC system time of the reference − the MainDevice's clock| (ns).
+    dc_deviation_ns: u64,
+    last_system_time: u64,
+    /// Cycles whose DC system time did not advance.
+    dc_not_increasing: usize,
     /// (inputs, outputs) bytes of each SubDevice in OP.
     image_sizes: Vec<(usize, usize)>,
     /// Round trip of each cycle's `tx_rx` (ns), reported, not asserted.
@@ -192,8 +198,16 @@ async fn main_device(seen: &mut Seen) -> Result<(), ethercrab::error::Error> {
             }
         }
         let sent = Instant::now();
-        let response = group.tx_rx(&md).await?;
+        // With the FRMW of the reference clock's system time 0x0910 in front of the LRW.
+        let response = group.tx_rx_sync_system_time(&md).await?;
         seen.round_trips.push(sent.elapsed().as_nanos() as u64);
+        let system_time = response.extra.unwrap_or(0);
+        let now = ethercat_now();
+        seen.dc_deviation_ns = seen.dc_deviation_ns.max(now.abs_diff(system_time));
+        if system_time <= seen.last_system_time {
+            seen.dc_not_increasing += 1;
+        }
+        seen.last_system_time = system_time;
         seen.working_counters.push(response.working_counter);
         for sd in group.iter(&md) {
             // Copy the inputs out: the PDI lock must not be held while the outputs are taken.
@@ -277,6 +291,16 @@ fn ethercrab_brings_the_emulated_segment_to_op_and_exchanges_pdi() {
     );
     assert_eq!(seen.device_type, 0x0002_0192);
     assert_eq!(seen.image_sizes, vec![(11, 9), (1, 1)]);
+    // The drive, the first DC SubDevice, is the reference clock: its system time (local
+    // CLOCK_MONOTONIC + the offset ethercrab wrote at init) advances every cycle and stays on
+    // the MainDevice's clock (the bound is generous: the time is read in flight, the clock
+    // after the reply).
+    assert_eq!(seen.dc_not_increasing, 0);
+    assert!(
+        seen.dc_deviation_ns < 50_000_000,
+        "{} ns",
+        seen.dc_deviation_ns
+    );
     assert_eq!(seen.working_counters.len(), 1000);
     assert!(
         seen.working_counters.iter().all(|&w| w == 6),
@@ -305,7 +329,11 @@ fn ethercrab_brings_the_emulated_segment_to_op_and_exchanges_pdi() {
     let mut rt = seen.round_trips.clone();
     rt.sort_unstable();
     eprintln!(
-        "PDI round trip over the veth pair (2 SubDevices, 22 B LRW + 2 FPRD), {} cycles: p50 {} us, p99 {} us, max {} us",
+        "DC system time vs ethercat_now(): max deviation {} us",
+        seen.dc_deviation_ns / 1000
+    );
+    eprintln!(
+        "PDI round trip over the veth pair (2 SubDevices, FRMW 0x0910 + 22 B LRW + 2 FPRD), {} cycles: p50 {} us, p99 {} us, max {} us",
         rt.len(),
         rt[rt.len() / 2] / 1000,
         rt[rt.len() * 99 / 100] / 1000,
