@@ -210,6 +210,28 @@ pub enum CliError {
     CertsExist(PathBuf),
     /// `--cert` without `--key` (or the reverse), or a client certificate without the CA.
     TlsIncomplete(&'static str),
+    /// `ethercat scan`: the raw socket on the interface could not be opened (no such
+    /// interface, or no CAP_NET_RAW).
+    EtherCatSocket {
+        /// The network interface.
+        interface: String,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// `ethercat scan`: what ethercrab said.
+    EtherCat {
+        /// The network interface.
+        interface: String,
+        /// ethercrab's error.
+        source: ethercrab::error::Error,
+    },
+    /// `ethercat scan`: the scan did not finish in time.
+    EtherCatTimeout {
+        /// The network interface.
+        interface: String,
+        /// How long it was given.
+        within: Duration,
+    },
 }
 
 impl CliError {
@@ -247,7 +269,10 @@ impl CliError {
             | Self::Busy(_)
             | Self::JobTimeout { .. }
             | Self::HostsUnreachable(_)
-            | Self::CertWrite { .. } => 3,
+            | Self::CertWrite { .. }
+            | Self::EtherCatSocket { .. }
+            | Self::EtherCat { .. }
+            | Self::EtherCatTimeout { .. } => 3,
             Self::Ipc(_)
             | Self::IpcPort { .. }
             | Self::UnknownOutcome(_)
@@ -303,6 +328,15 @@ impl fmt::Display for CliError {
             Self::Missing(name) => write!(f, "a {name} argument is required"),
             Self::Usage(m) => f.write_str(m),
             Self::NoCell => f.write_str("which cell? give --cell <cell.toml> or set TANDEM_CELL"),
+            Self::EtherCatSocket { interface, source } => {
+                write!(f, "cannot open a raw socket on {interface}: {source}")
+            }
+            Self::EtherCat { interface, source } => {
+                write!(f, "EtherCAT on {interface}: {source}")
+            }
+            Self::EtherCatTimeout { interface, within } => {
+                write!(f, "EtherCAT on {interface}: no answer within {within:?}")
+            }
             Self::UnknownCommand(name) => write!(f, "unknown command `{name}`"),
             Self::Config(e) => write!(f, "{e}"),
             Self::RecordDir { path, source } => write!(f, "{}: {source}", path.display()),
@@ -445,6 +479,8 @@ impl std::error::Error for CliError {
             Self::Ipc(e) => Some(e),
             Self::Client(e) => Some(e),
             Self::Lock { source, .. } => Some(source),
+            Self::EtherCatSocket { source, .. } => Some(source),
+            Self::EtherCat { source, .. } => Some(source),
             Self::RecordDir { source, .. }
             | Self::CreateTrace { source, .. }
             | Self::CannotStart { source, .. }

@@ -42,6 +42,7 @@ macro_rules! out {
 pub mod certs;
 pub mod cmd;
 pub mod error;
+pub mod ethercat;
 pub mod live;
 pub mod offline;
 mod output;
@@ -101,6 +102,7 @@ fn cli() -> Command {
         )
         .subcommand(cmd_command())
         .subcommand(certs_command())
+        .subcommand(ethercat_command())
         .subcommand(
             Command::new("check")
                 .about("Validate a cell file; errors name file, line and key")
@@ -190,6 +192,18 @@ fn up_command() -> Command {
         )
 }
 
+/// `tandem ethercat`'s arguments.
+fn ethercat_command() -> Command {
+    Command::new("ethercat")
+        .about("EtherCAT segments")
+        .subcommand_required(true)
+        .subcommand(
+            Command::new("scan")
+                .about("List the SubDevices on a network interface (position, identity, name, PDO sizes, DC support); needs CAP_NET_RAW")
+                .arg(Arg::new("interface").required(true)),
+        )
+}
+
 /// `tandem cmd`'s arguments.
 fn cmd_command() -> Command {
     Command::new("cmd")
@@ -251,6 +265,15 @@ fn dispatch(
     let host = m.get_one::<String>("host").map(String::as_str);
     match name {
         "check" => offline::check(required(m, "cell")?, out),
+        "ethercat" => match m.subcommand() {
+            Some(("scan", s)) => {
+                let interface = s
+                    .get_one::<String>("interface")
+                    .ok_or(CliError::Missing("interface"))?;
+                ethercat::print(&ethercat::scan(interface)?, out)
+            }
+            _ => Err(CliError::Missing("ethercat subcommand")),
+        },
         "certs" => certs::certs(
             &certs::CertsOptions {
                 cell: required(m, "cell")?.clone(),
