@@ -6,7 +6,7 @@
 //! 1. validate (finite, `|v| ≤ 1e12`, `x0 < x1`, law parameters);
 //! 2. segments in definition order: a later segment is used in full, an earlier one keeps only
 //!    what lies outside it, however narrow;
-//! 3. points sorted by x; among equal x the last one wins; points on a segment or within
+//! 3. points sorted by x; among equal x (within [`POINT_RESOLUTION`]) the last one wins; points on a segment or within
 //!    [`GAP_THRESHOLD`] of one are dropped (the segment wins);
 //! 4. gaps between segments not wider than [`GAP_THRESHOLD`] are closed by pulling both ends to
 //!    the middle (each segment is stretched, its shape kept);
@@ -18,7 +18,7 @@ use super::piece::{
 };
 use super::{
     BoundaryCondition, Cam, CamDefinition, CamError, CamValue, Interpolation, SegmentDef,
-    GAP_THRESHOLD, VALUE_LIMIT,
+    GAP_THRESHOLD, POINT_RESOLUTION, VALUE_LIMIT,
 };
 
 /// The part `[a, b]` of segment `seg` that survives, with its source parameters at `a` and `b`.
@@ -132,7 +132,8 @@ fn resolve_segments(segs: &[SegmentDef]) -> Vec<Frag> {
     frags
 }
 
-/// Points sorted by x, the last of equal x kept, those on or near a segment dropped.
+/// Points sorted by x, the last of equal x (within [`POINT_RESOLUTION`]) kept, those on or
+/// near a segment dropped.
 fn resolve_points(points: &[(f64, f64)], frags: &[Frag]) -> Vec<(f64, f64)> {
     // `+ 0.0` turns -0.0 into 0.0, so that both sort as the same x.
     let pts: Vec<(f64, f64)> = points.iter().map(|&(x, y)| (x + 0.0, y)).collect();
@@ -142,7 +143,7 @@ fn resolve_points(points: &[(f64, f64)], frags: &[Frag]) -> Vec<(f64, f64)> {
     for i in order {
         let p = pts[i];
         match out.last_mut() {
-            Some(last) if last.0 == p.0 => *last = p,
+            Some(last) if p.0 - last.0 <= POINT_RESOLUTION * last.0.abs().max(1.0) => *last = p,
             _ => out.push(p),
         }
     }
