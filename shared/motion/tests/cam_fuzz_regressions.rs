@@ -4,7 +4,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use tandem_motion::cam::{
-    parse_csv, BoundaryCondition, Cam, CamDefinition, Interpolation, POINT_RESOLUTION,
+    parse_csv, BoundaryCondition, Cam, CamDefinition, CamError, Interpolation, SegmentDef,
+    POINT_RESOLUTION,
 };
 
 /// Every interpolation and boundary condition of the points of `csv`: built, and finite at
@@ -78,6 +79,47 @@ fn a_subnormal_point_among_others_is_merged_with_its_neighbour() {
         Interpolation::Linear,
     );
     assert_eq!(Cam::interpolate(&def).unwrap().piece_count(), 2);
+}
+
+#[test]
+fn a_segment_whose_derivatives_overflow_is_refused() {
+    // cell seed 2051882513 index 11080: config/cross-cutter.toml's cam `cut` with the
+    // transition's u^5 coefficient replaced by 1e308. Every coefficient is finite, so the cell
+    // was accepted, and MC_GetCamFollowingValue answered a second derivative of +inf at x = 250.
+    let poly = |x0: f64, x1: f64, c: &[f64]| {
+        let mut coeffs = [0.0; 8];
+        coeffs[..c.len()].copy_from_slice(c);
+        SegmentDef::Polynomial { x0, x1, coeffs }
+    };
+    let mut def = CamDefinition::from_points(Vec::new(), Interpolation::CubicSpline);
+    def.segments = vec![
+        poly(0.0, 50.0, &[0.0, 45.0]),
+        poly(
+            50.0,
+            450.0,
+            &[45.0, 360.0, 0.0, 0.0, -3150.0, 1e308, -6300.0, 1800.0],
+        ),
+        poly(450.0, 500.0, &[315.0, 45.0]),
+    ];
+    assert_eq!(
+        Cam::interpolate(&def).unwrap_err(),
+        CamError::InvalidSegment { index: 1 }
+    );
+    // The file's own coefficient (7560) builds a cam, finite everywhere.
+    if let Some(SegmentDef::Polynomial { coeffs, .. }) = def.segments.get_mut(1) {
+        coeffs[5] = 7560.0;
+    }
+    let cam = Cam::interpolate(&def).unwrap();
+    for k in 0..=100 {
+        let v = cam.following(5.0 * f64::from(k)).unwrap();
+        assert!(v.second_derivative.is_finite(), "{k}: {v:?}");
+    }
+    // A span so narrow that 1/w² overflows.
+    def.segments = vec![poly(0.0, 1e-200, &[0.0, 1.0, 1.0])];
+    assert_eq!(
+        Cam::interpolate(&def).unwrap_err(),
+        CamError::InvalidSegment { index: 0 }
+    );
 }
 
 fn hex(h: &str) -> Vec<u8> {

@@ -154,6 +154,26 @@ fn resolve_points(points: &[(f64, f64)], frags: &[Frag]) -> Vec<(f64, f64)> {
     out
 }
 
+/// Refuses a segment whose value or derivatives are not finite on its span, sampled at nine
+/// evenly spaced leading values: finite coefficients can still overflow (a polynomial
+/// coefficient of `1e308`, a span of `1e-300`), and the axis that follows the cam takes these
+/// values as setpoints. Inferred: the manuals name the `±1.0E12` range of points and segment
+/// ends, not of derived values; a segment that cannot be evaluated is invalid
+/// ([`CamError::InvalidSegment`]).
+fn finite_segments(frags: &[Frag], pieces: &[Piece]) -> Result<(), CamError> {
+    for (f, p) in frags.iter().zip(pieces) {
+        let finite = (0..=8).all(|k| {
+            let x = p.xa + (p.xb - p.xa) * f64::from(k) / 8.0;
+            let v = p.eval(x);
+            v.value.is_finite() && v.first_derivative.is_finite() && v.second_derivative.is_finite()
+        });
+        if !finite {
+            return Err(CamError::InvalidSegment { index: f.seg });
+        }
+    }
+    Ok(())
+}
+
 fn frag_piece(f: &Frag, seg: &SegmentDef) -> Piece {
     let formula = match *seg {
         SegmentDef::Polynomial { coeffs, .. } => Formula::Poly(coeffs),
@@ -249,6 +269,7 @@ pub(super) fn build(def: &CamDefinition) -> Result<Cam, CamError> {
         .iter()
         .map(|f| frag_piece(f, &def.segments[f.seg]))
         .collect();
+    finite_segments(&frags, &seg_pieces)?;
     let chains = make_chains(&points, &seg_pieces);
 
     let outer_left = chains.first().is_some_and(|c| c.left.is_none());

@@ -132,7 +132,8 @@ pub enum CamError {
         index: usize,
     },
     /// The segment with this index is invalid: `x0 ≥ x1`, a value not finite or beyond
-    /// [`VALUE_LIMIT`], an invalid law parameter, or a sine with period 0 (`16#80AC`).
+    /// [`VALUE_LIMIT`], an invalid law parameter, a sine with period 0, or a value or derivative
+    /// on its span that is not finite (`16#80AC`).
     InvalidSegment {
         /// Index into [`CamDefinition::segments`].
         index: usize,
