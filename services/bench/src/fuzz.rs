@@ -282,6 +282,8 @@ pub struct Fixture {
     press: Option<Cell>,
     /// Encoded leading values.
     samples: Vec<Vec<u8>>,
+    /// Cells made from the bundled ones: config/cross-cutter.toml with cam points.
+    points_cells: Vec<String>,
 }
 
 impl Default for Fixture {
@@ -337,16 +339,35 @@ impl Fixture {
             },
         )
         .collect();
+        let cross_cutter = CELLS.get(1).map_or("", |c| c.1);
+        let points_cells = ["cubic_spline", "linear", "bezier"]
+            .iter()
+            .map(|i| {
+                cross_cutter
+                    .replace(
+                        "# points = [[0.0, 0.0], [250.0, 180.0]]",
+                        "points = [[0.0, 0.0], [250.0, 180.0], [400.0, 300.0], [500.0, 360.0]]",
+                    )
+                    .replace("\"cubic_spline\"   #", &format!("\"{i}\" #"))
+                    .replace("\"none\"        ", "\"equal_first_derivative\"")
+            })
+            .collect();
         Fixture {
             cells,
             press,
             samples,
+            points_cells,
         }
     }
 
     /// The number of bundled cells that parsed (the others need files beside them).
     pub fn cells(&self) -> usize {
         self.cells.len()
+    }
+
+    /// The cells with cam points the cell target starts from too (they parse).
+    pub fn points_cells(&self) -> &[String] {
+        &self.points_cells
     }
 
     /// The seeds of `target`: real inputs to mutate.
@@ -365,7 +386,11 @@ impl Fixture {
                 .map(|s| s.as_bytes())
                 .collect(),
             Target::Text => TEXT_COMMANDS.iter().map(|s| s.as_bytes()).collect(),
-            Target::Cell => CELLS.iter().map(|(_, c, _)| c.as_bytes()).collect(),
+            Target::Cell => CELLS
+                .iter()
+                .map(|(_, c, _)| c.as_bytes())
+                .chain(self.points_cells.iter().map(|c| c.as_bytes()))
+                .collect(),
             Target::Script => self.cells.iter().map(|(_, s)| s.as_bytes()).collect(),
             Target::Cam => CAM_CSV.iter().map(|s| s.as_bytes()).collect(),
         }
@@ -408,7 +433,7 @@ pub fn generate(fixture: &Fixture, seed: u64, target: Target, index: u64) -> Vec
 /// One mutation of `input`.
 fn mutate(rng: &mut Rng, input: &mut Vec<u8>, seeds: &[&[u8]], target: Target) {
     let len = input.len();
-    match rng.below(if target == Target::Wire { 10 } else { 9 }) {
+    match rng.below(if target == Target::Wire { 12 } else { 11 }) {
         // Flip 1 to 8 bits.
         0 => {
             for _ in 0..=rng.below(8) {
@@ -465,6 +490,10 @@ fn mutate(rng: &mut Rng, input: &mut Vec<u8>, seeds: &[&[u8]], target: Target) {
                 .collect();
             input.splice(to..to, add);
         }
+        // Replace a quoted string by a name from the input or the dictionary.
+        9 => replace_string(rng, input),
+        // Duplicate, delete or swap lines.
+        10 => shuffle_lines(rng, input),
         // Wire only: overwrite a field of the 64-byte sample with boundary bits.
         _ => {
             let field = rng.below(8) * 8;
@@ -487,6 +516,80 @@ fn mutate(rng: &mut Rng, input: &mut Vec<u8>, seeds: &[&[u8]], target: Target) {
             }
         }
     }
+}
+
+/// Strings a mutation puts in place of a quoted string.
+const NAMES: [&str; 14] = [
+    "",
+    " ",
+    "a/b",
+    "tandem/**",
+    "*",
+    "$*",
+    "lv",
+    "\\u0000",
+    "\\\"",
+    "\u{e9}t\u{e9}",
+    "MC_GearIn",
+    "master",
+    "0",
+    "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa",
+];
+
+/// The spans `(start, end)` of the double-quoted strings of `input` (contents only).
+fn quoted(input: &[u8]) -> Vec<(usize, usize)> {
+    let mut spans = Vec::new();
+    let mut open = None;
+    for (i, &b) in input.iter().enumerate() {
+        match (b, open) {
+            (b'"', None) => open = Some(i + 1),
+            (b'"', Some(start)) => {
+                spans.push((start, i));
+                open = None;
+            }
+            (b'\n', Some(_)) => open = None,
+            _ => {}
+        }
+    }
+    spans
+}
+
+/// Replaces the contents of one quoted string of `input` by those of another, or by a name
+/// from [`NAMES`].
+fn replace_string(rng: &mut Rng, input: &mut Vec<u8>) {
+    let spans = quoted(input);
+    let Some(&(start, end)) = rng.pick(&spans) else {
+        return;
+    };
+    let with: Vec<u8> = if rng.one_in(2) {
+        rng.pick(&NAMES)
+            .map(|n| n.as_bytes().to_vec())
+            .unwrap_or_default()
+    } else {
+        rng.pick(&spans)
+            .and_then(|&(a, b)| input.get(a..b))
+            .map(<[u8]>::to_vec)
+            .unwrap_or_default()
+    };
+    input.splice(start..end, with);
+}
+
+/// Duplicates a line elsewhere, deletes one, or swaps two.
+fn shuffle_lines(rng: &mut Rng, input: &mut Vec<u8>) {
+    let mut lines: Vec<Vec<u8>> = input.split(|&b| b == b'\n').map(<[u8]>::to_vec).collect();
+    let (a, b) = (rng.below(lines.len()), rng.below(lines.len() + 1));
+    match rng.below(3) {
+        0 => {
+            let line = lines.get(a).cloned().unwrap_or_default();
+            lines.insert(b.min(lines.len()), line);
+        }
+        1 if a < lines.len() => {
+            lines.remove(a);
+        }
+        _ if b < lines.len() => lines.swap(a, b),
+        _ => {}
+    }
+    *input = lines.join(&b'\n');
 }
 
 /// Replaces one number token of `input` (digits with sign, point and exponent) by a boundary
@@ -619,14 +722,22 @@ pub fn feed(fixture: &Fixture, target: Target, index: u64, input: &[u8]) -> Resu
             Ok(observed || command)
         }
         Target::Text => Ok(command_line(fixture, &text)),
-        Target::Cell => Ok(tandem_config::parse("fuzz.toml", &text).is_ok()),
+        Target::Cell => match tandem_config::parse("fuzz.toml", &text) {
+            Ok(cell) => {
+                for c in &cell.cams {
+                    finite_over_range(&c.cam).map_err(|e| format!("cam `{}`: {e}", c.name))?;
+                }
+                Ok(true)
+            }
+            Err(_) => Ok(false),
+        },
         Target::Script => {
             let Some((cell, _)) = fixture.cells.get(script_cell(fixture, index)) else {
                 return Ok(false);
             };
             Ok(tandem_config::script::parse_cell("fuzz-script.toml", &text, cell).is_ok())
         }
-        Target::Cam => Ok(cam(&text)),
+        Target::Cam => cam(&text),
     }
 }
 
@@ -646,13 +757,30 @@ fn command_line(fixture: &Fixture, text: &str) -> bool {
     tandem_config::script::parse_command(cell, object, &c.instruction, &c.params).is_ok()
 }
 
-/// Cam CSV parsed, then interpolated every way and evaluated; true when some cam was built.
-fn cam(text: &str) -> bool {
+/// A built cam answers finite values over its whole range (the axis that follows it takes
+/// them as setpoints): checked at both ends and in the middle.
+fn finite_over_range(cam: &Cam) -> Result<(), String> {
+    let (x0, x1) = cam.leading_range();
+    for x in [x0, x1, 0.5 * (x0 + x1)] {
+        match cam.following(x) {
+            Ok(v)
+                if [v.value, v.first_derivative, v.second_derivative]
+                    .iter()
+                    .all(|c| c.is_finite()) => {}
+            other => return Err(format!("{other:?} at x = {x}")),
+        }
+    }
+    Ok(())
+}
+
+/// Cam CSV parsed, then interpolated every way and evaluated; true when some cam was built,
+/// an error when a built cam answers a non-finite value inside its range.
+fn cam(text: &str) -> Result<bool, String> {
     let Ok(points) = tandem_motion::cam::parse_csv(text) else {
-        return false;
+        return Ok(false);
     };
     if points.len() > MAX_CAM_POINTS {
-        return false;
+        return Ok(false);
     }
     let mut built = false;
     for interpolation in [
@@ -672,8 +800,14 @@ fn cam(text: &str) -> bool {
                 continue;
             };
             built = true;
-            let (x0, x1) = cam.leading_range();
-            for x in [x0, x1, 0.5 * (x0 + x1), x0 - 1.0, f64::NAN, f64::INFINITY] {
+            let (x0, _) = cam.leading_range();
+            finite_over_range(&cam).map_err(|e| {
+                format!(
+                    "{interpolation:?}/{boundary:?} cam of {} points: {e}",
+                    points.len()
+                )
+            })?;
+            for x in [x0 - 1.0, f64::NAN, f64::INFINITY] {
                 // Outside the range or not a number is an error; either answer passes.
                 let _ = cam.following(x);
             }
@@ -684,7 +818,7 @@ fn cam(text: &str) -> bool {
             }
         }
     }
-    built
+    Ok(built)
 }
 
 /// Which targets, how many inputs in total, from which seed.

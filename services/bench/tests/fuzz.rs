@@ -90,3 +90,15 @@ fn the_seeds_are_accepted_unmutated() {
     assert!(!accepted(Target::Cam, b"x,y\n0,NaN\n"));
     assert!(!accepted(Target::Wire, &[0u8; 63]));
 }
+
+#[test]
+fn the_cells_with_cam_points_parse() {
+    // The cell target reaches Cam::interpolate with points through these.
+    let fixture = Fixture::new();
+    assert_eq!(fixture.points_cells().len(), 3);
+    for (i, c) in fixture.points_cells().iter().enumerate() {
+        assert!(c.contains("points = [[0.0, 0.0]"), "{i}");
+        let cell = tandem_config::parse("points.toml", c).unwrap();
+        assert_eq!(cell.cams.len(), 1);
+    }
+}
