@@ -4,7 +4,8 @@
 //! `cargo bench -p tandem-bench --bench fuzz -- --inputs 10000000 --seed 1` feeds 10^7
 //! generated inputs from seed 1, shared evenly by the targets, and prints per target the
 //! inputs, the accepted ones, the failures (panics, wrong answers, each with its reproduction),
-//! the hangs (over 1 s), the slowest input and the rate. `--target cell` (repeatable) runs one
+//! the hangs (over 1 s twice), the stalls (over 1 s once: the thread was preempted), the
+//! slowest input (and its time fed again alone) and the rate. `--target cell` (repeatable) runs one
 //! target; `--index N` feeds one input and prints it, to reproduce a failure. An input that
 //! does not return within 10 s is reported by a watchdog, which then ends the run (exit 2).
 //! Exit 1 when anything failed.
@@ -86,12 +87,13 @@ fn main() {
     let reports = fuzz::run(&fixture, &plan, &watch, |f| println!("{f}"));
     let wall = start.elapsed().as_secs_f64();
     println!(
-        "{:<7} {:>10} {:>10} {:>8} {:>6} {:>12} {:>10} {:>12} {:>10}",
+        "{:<7} {:>10} {:>10} {:>8} {:>6} {:>6} {:>12} {:>10} {:>12} {:>10}",
         "target",
         "inputs",
         "accepted",
         "failures",
         "hangs",
+        "stalls",
         "slowest",
         "at index",
         "re-run",
@@ -112,12 +114,13 @@ fn main() {
             .min()
             .unwrap_or_default();
         println!(
-            "{:<7} {:>10} {:>10} {:>8} {:>6} {:>10.3}ms {:>10} {:>10.3}ms {:>10.0}",
+            "{:<7} {:>10} {:>10} {:>8} {:>6} {:>6} {:>10.3}ms {:>10} {:>10.3}ms {:>10.0}",
             r.target.name(),
             r.inputs,
             r.accepted,
             r.failures,
             r.hangs,
+            r.stalls,
             r.slowest_ns as f64 / 1e6,
             r.slowest_index,
             alone.as_secs_f64() * 1e3,
