@@ -20,6 +20,8 @@
 use std::path::PathBuf;
 use tandem_rt as rt;
 
+pub mod fuzz;
+
 /// Durations in 1 ns bins up to a limit, the rest kept exactly.
 #[derive(Debug, Clone)]
 pub struct Hist {

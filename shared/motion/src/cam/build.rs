@@ -6,7 +6,7 @@
 //! 1. validate (finite, `|v| ≤ 1e12`, `x0 < x1`, law parameters);
 //! 2. segments in definition order: a later segment is used in full, an earlier one keeps only
 //!    what lies outside it, however narrow;
-//! 3. points sorted by x; among equal x the last one wins; points on a segment or within
+//! 3. points sorted by x; among equal x (within [`POINT_RESOLUTION`]) the last one wins; points on a segment or within
 //!    [`GAP_THRESHOLD`] of one are dropped (the segment wins);
 //! 4. gaps between segments not wider than [`GAP_THRESHOLD`] are closed by pulling both ends to
 //!    the middle (each segment is stretched, its shape kept);
@@ -18,7 +18,7 @@ use super::piece::{
 };
 use super::{
     BoundaryCondition, Cam, CamDefinition, CamError, CamValue, Interpolation, SegmentDef,
-    GAP_THRESHOLD, VALUE_LIMIT,
+    GAP_THRESHOLD, POINT_RESOLUTION, VALUE_LIMIT,
 };
 
 /// The part `[a, b]` of segment `seg` that survives, with its source parameters at `a` and `b`.
@@ -132,7 +132,8 @@ fn resolve_segments(segs: &[SegmentDef]) -> Vec<Frag> {
     frags
 }
 
-/// Points sorted by x, the last of equal x kept, those on or near a segment dropped.
+/// Points sorted by x, the last of equal x (within [`POINT_RESOLUTION`]) kept, those on or
+/// near a segment dropped.
 fn resolve_points(points: &[(f64, f64)], frags: &[Frag]) -> Vec<(f64, f64)> {
     // `+ 0.0` turns -0.0 into 0.0, so that both sort as the same x.
     let pts: Vec<(f64, f64)> = points.iter().map(|&(x, y)| (x + 0.0, y)).collect();
@@ -142,7 +143,7 @@ fn resolve_points(points: &[(f64, f64)], frags: &[Frag]) -> Vec<(f64, f64)> {
     for i in order {
         let p = pts[i];
         match out.last_mut() {
-            Some(last) if last.0 == p.0 => *last = p,
+            Some(last) if p.0 - last.0 <= POINT_RESOLUTION * last.0.abs().max(1.0) => *last = p,
             _ => out.push(p),
         }
     }
@@ -151,6 +152,26 @@ fn resolve_points(points: &[(f64, f64)], frags: &[Frag]) -> Vec<(f64, f64)> {
         !(i < frags.len() && frags[i].a - GAP_THRESHOLD <= x)
     });
     out
+}
+
+/// Refuses a segment whose value or derivatives are not finite on its span, sampled at nine
+/// evenly spaced leading values: finite coefficients can still overflow (a polynomial
+/// coefficient of `1e308`, a span of `1e-300`), and the axis that follows the cam takes these
+/// values as setpoints. Inferred: the manuals name the `±1.0E12` range of points and segment
+/// ends, not of derived values; a segment that cannot be evaluated is invalid
+/// ([`CamError::InvalidSegment`]).
+fn finite_segments(frags: &[Frag], pieces: &[Piece]) -> Result<(), CamError> {
+    for (f, p) in frags.iter().zip(pieces) {
+        let finite = (0..=8).all(|k| {
+            let x = p.xa + (p.xb - p.xa) * f64::from(k) / 8.0;
+            let v = p.eval(x);
+            v.value.is_finite() && v.first_derivative.is_finite() && v.second_derivative.is_finite()
+        });
+        if !finite {
+            return Err(CamError::InvalidSegment { index: f.seg });
+        }
+    }
+    Ok(())
 }
 
 fn frag_piece(f: &Frag, seg: &SegmentDef) -> Piece {
@@ -248,6 +269,7 @@ pub(super) fn build(def: &CamDefinition) -> Result<Cam, CamError> {
         .iter()
         .map(|f| frag_piece(f, &def.segments[f.seg]))
         .collect();
+    finite_segments(&frags, &seg_pieces)?;
     let chains = make_chains(&points, &seg_pieces);
 
     let outer_left = chains.first().is_some_and(|c| c.left.is_none());

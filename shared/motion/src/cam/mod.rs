@@ -16,7 +16,8 @@
 //! # Rules (S7-1500T Motion Control V4.0 function manual, 3.10 'Cam technology object',
 //! S7-Technology V4.1 function manual, 3.5 '"Cam disk" technology object')
 //!
-//! * Points may come in any order; among points with equal `x` the last one wins.
+//! * Points may come in any order; among points with equal `x` the last one wins (`x` closer
+//!   than [`POINT_RESOLUTION`] relative counts as equal).
 //! * Overlapping segments: the later segment is used in full; the earlier one keeps its parts
 //!   outside it. A segment wins over points on it or within [`GAP_THRESHOLD`] of its ends.
 //! * Gaps between segments up to [`GAP_THRESHOLD`] (`1e-4`) are closed by pulling the segment
@@ -88,6 +89,12 @@ use piece::{Formula, Piece};
 /// `MC_InterpolateCam`).
 pub const GAP_THRESHOLD: f64 = 1e-4;
 
+/// Points whose x differ by at most this much, relative to `max(1, |x|)`, are one x: the later
+/// point wins, as for equal x. Inferred (the manuals name no resolution): without it two points
+/// `1e-320` apart give a span whose slope and curvature are infinite, and a cam that answers
+/// NaN. At `1e-9` a span between two points within [`VALUE_LIMIT`] has finite derivatives.
+pub const POINT_RESOLUTION: f64 = 1e-9;
+
 /// Largest magnitude of an x or y value (the `-1.0E12 to 1.0E12` range of the S7 cam tags).
 pub const VALUE_LIMIT: f64 = 1e12;
 
@@ -125,7 +132,8 @@ pub enum CamError {
         index: usize,
     },
     /// The segment with this index is invalid: `x0 ≥ x1`, a value not finite or beyond
-    /// [`VALUE_LIMIT`], an invalid law parameter, or a sine with period 0 (`16#80AC`).
+    /// [`VALUE_LIMIT`], an invalid law parameter, a sine with period 0, or a value or derivative
+    /// on its span that is not finite (`16#80AC`).
     InvalidSegment {
         /// Index into [`CamDefinition::segments`].
         index: usize,
