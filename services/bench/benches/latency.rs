@@ -36,12 +36,13 @@ const PERIOD_NS: i64 = 1_000_000;
 const STOP: u64 = u64::MAX;
 /// The sequence number of the handshake probes.
 const PROBE: u64 = u64::MAX - 1;
-/// Leading-value delay D and tolerance of the follower work on the tandem path (ns). The
-/// tolerance is that of `config/line.toml`; D is its 3 ms less half a cycle, so that `t - D`
-/// falls between two samples and the lookup interpolates (the costlier case).
+/// Leading-value delay D and tolerance of the follower work on the tandem path (ns): those of
+/// a line cell on a real-time core (`config/line.toml` sizes them for a shared machine), D
+/// 3 ms less half a cycle, so that `t - D` falls between two samples and the lookup
+/// interpolates (the costlier case).
 const DELAY_NS: i64 = 2_500_000;
 const TOLERANCE_NS: i64 = 4_000_000;
-/// The history a node gives the leading-value service of the line's leader (delay 3 ms,
+/// The history a node gives the leading-value service of such a leader (delay 3 ms,
 /// tolerance 4 ms, 1 ms cycle): `(D + tolerance) / cycle + 4`.
 const HISTORY: usize = 11;
 /// Round trips before each measurement that are not recorded.

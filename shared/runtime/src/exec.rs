@@ -41,7 +41,12 @@ use tandem_motion::objects::job::{Instruction, JobEvent, JobId};
 use tandem_motion::objects::leading::{
     LeaderId, LeadingSample, LeadingValue, LeadingValueBuffer, Lookup, Missing, Rejected,
 };
+use tandem_motion::objects::rejoin::{Rejoin, Rejoined};
 use tandem_motion::plant::sensor::InputEdge;
+
+/// A rejoin after an extrapolation is logged when the step it removed exceeds this (in the
+/// leader's unit; smaller ones are the rounding of an extrapolation at constant acceleration).
+const REJOIN_LOGGED: f64 = 1e-6;
 
 fn gcd(a: i64, b: i64) -> i64 {
     if b == 0 {
@@ -158,6 +163,10 @@ struct LeaderBuffer {
     missing: Option<Missing>,
     /// The outage was logged.
     logged: bool,
+    /// The rejoin of an extrapolated value with the real one.
+    rejoin: Rejoin,
+    /// The rejoin that started this step, to log.
+    rejoined: Option<Rejoined>,
 }
 
 /// How a follower reads one leader: the coupling, and the buffer of samples if it reads it
@@ -400,6 +409,8 @@ fn leader_buffers(cell: &Cell, owned: &Owned) -> Vec<LeaderBuffer> {
                 seq: 0,
                 missing: None,
                 logged: false,
+                rejoin: Rejoin::new(),
+                rejoined: None,
             });
         }
     }
@@ -901,7 +912,11 @@ impl<'c> Executive<'c> {
                 None
             };
         };
-        match b.samples.at(t - b.delay_ns, b.tolerance_ns) {
+        let (lookup, rejoined) = b.rejoin.at(&b.samples, t - b.delay_ns, b.tolerance_ns);
+        if rejoined.is_some() {
+            b.rejoined = rejoined;
+        }
+        match lookup {
             Lookup::Interpolated(v) => {
                 b.missing = None;
                 b.logged = false;
@@ -921,9 +936,26 @@ impl<'c> Executive<'c> {
     }
 
     /// Logs each leader whose value went missing this step, once per outage: which leader,
-    /// why, and the newest sample's time.
+    /// why, and the newest sample's time; and each rejoin after an extrapolation that removed
+    /// a step of more than [`REJOIN_LOGGED`].
     fn log_missing(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
+        for b in &mut self.buffers {
+            let Some(r) = b.rejoined.take().filter(|r| r.dp.abs() > REJOIN_LOGGED) else {
+                continue;
+            };
+            writeln!(
+                log,
+                "t={} leading value of {} rejoined after {} ms of extrapolation: a step of {:.6} \
+                 ({:.6}/s) removed over {} ms",
+                Secs(t),
+                cell.leader_name(b.leader),
+                r.extrapolated_ns as f64 * 1e-6,
+                r.dp,
+                r.dv,
+                r.duration_ns as f64 * 1e-6
+            )?;
+        }
         for b in self.buffers.iter_mut().filter(|b| !b.logged) {
             let Some(m) = b.missing else {
                 continue;

@@ -1,7 +1,8 @@
 //! The node's cyclic path does not allocate: the three executives of `config/line.toml` (a
 //! leader, geared followers reading it at t - D from their buffers, a cam follower with an
 //! output cam and a measuring input) step 6,000 cycles, exchanging leading values as the nodes
-//! do, with 0 allocations once the commands are applied.
+//! do, with 0 allocations once the commands are applied, through a stall of the leader's samples
+//! longer than D (extrapolation, then the rejoin when they come) and an outage (alarm 601).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use tandem_config::Coupling;
@@ -26,6 +27,9 @@ fn three_executives_step_without_allocating() {
     let mut next = 0;
     let mut allocations = 0;
     let mut stepped = 0;
+    // The samples held back by a stall, delivered at once when it ends.
+    let mut held = Vec::with_capacity(200);
+    let (stall_from, stall_to) = (2520, 2625);
     for k in 0..6000i64 {
         let t = k * 1_000_000;
         // Commands (which may allocate: a job takes its cam) between the counted steps.
@@ -44,8 +48,18 @@ fn three_executives_step_without_allocating() {
             nodes[0].step(t, &mut log).unwrap();
         }
         let s = nodes[0].sample(line, Coupling::Setpoint, t, k as u64);
+        // From 2.52 s the samples are held back for 105 ms (longer than D = 100 ms), while the
+        // line accelerates: the followers extrapolate for 5 cycles, then rejoin.
+        if (stall_from..stall_to).contains(&k) {
+            held.push(s);
+        }
         for x in nodes[1..].iter_mut() {
-            if alive {
+            if k == stall_to {
+                for h in &held {
+                    x.feed(line, Coupling::Setpoint, *h).unwrap();
+                }
+            }
+            if alive && !(stall_from..stall_to).contains(&k) {
                 x.feed(line, Coupling::Setpoint, s).unwrap();
             }
             x.step(t, &mut log).unwrap();
@@ -59,9 +73,9 @@ fn three_executives_step_without_allocating() {
     }
     assert_eq!(stepped, 6000);
     assert_eq!(allocations, 0, "allocations on the cyclic path");
-    // It did work: the followers were coupled, bridged the outage for the tolerance (one
-    // extrapolated cycle per leader cycle of it: 100 of 1 ms in config/line.toml), then
-    // stopped with 601.
+    // It did work: the followers were coupled, bridged the stall for 5 cycles and the outage
+    // for the tolerance (one extrapolated cycle per leader cycle of it: 10 of 1 ms in
+    // config/line.toml), then stopped with 601.
     let knife = cell.axes.iter().position(|a| a.name == "knife").unwrap();
     let feed = cell.axes.iter().position(|a| a.name == "feed").unwrap();
     for (n, a) in [(1, feed), (2, knife)] {
@@ -72,13 +86,13 @@ fn three_executives_step_without_allocating() {
     }
     let line = cell.leader_named("line").unwrap();
     let bridged = (cell.leading(line).tolerance_ns / cell.leader_cycle_ns(line)) as u64;
-    assert_eq!(bridged, 100);
+    assert_eq!(bridged, 10);
     assert_eq!(
         nodes[1].extrapolated,
-        2 * bridged,
-        "two followers, one extrapolated cycle per cycle of the tolerance"
+        2 * (5 + bridged),
+        "two followers, one extrapolated cycle per cycle of the stall beyond D and of the tolerance"
     );
-    assert_eq!(nodes[2].extrapolated, bridged);
+    assert_eq!(nodes[2].extrapolated, 5 + bridged);
 }
 
 /// The process image's drive stages (`config/servo.toml`: an axis on a simulated CiA 402

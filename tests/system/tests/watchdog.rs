@@ -25,8 +25,8 @@ static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 /// The watchdog time of the test cell (ms).
 const WATCHDOG_MS: f64 = 300.0;
 
-/// The bundled line cell (three 1 ms nodes on one host) under a cell name of its own, with a
-/// leading-value delay of 100 ms and tolerance of 150 ms (room for a shared VM's stalls), a
+/// The bundled line cell (three 1 ms nodes on one host) under a cell name of its own, with its
+/// leading-value delay of 100 ms and a tolerance of 150 ms (room for a shared VM's stalls), a
 /// 300 ms watchdog and a restart after `restart_ms`.
 fn cell(dir: &Path, name: &str, restart_ms: u32) -> PathBuf {
     let src = std::fs::read_to_string(root().join("config/line.toml")).unwrap();
@@ -37,9 +37,9 @@ fn cell(dir: &Path, name: &str, restart_ms: u32) -> PathBuf {
                 "name = \"{name}\"\nwatchdog_ms = {WATCHDOG_MS}\nwatchdog_restart_ms = {restart_ms}\n"
             ),
         )
-        .replace("delay_us = 10000", "delay_us = 100000")
-        .replace("tolerance_us = 100000", "tolerance_us = 150000");
-    assert!(src.contains("watchdog_restart_ms") && src.contains("delay_us = 100000"));
+        .replace("tolerance_us = 10000 ", "tolerance_us = 150000 ");
+    assert!(src.contains("watchdog_restart_ms") && src.contains("delay_us = 100000 "));
+    assert!(src.contains("tolerance_us = 150000 "));
     let p = dir.join("cell.toml");
     std::fs::write(&p, src).unwrap();
     p

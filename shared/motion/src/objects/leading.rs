@@ -393,7 +393,7 @@ impl<const N: usize> LeadingValueBuffer<N> {
 /// In the normalised time `s = (t - t_a) / h`: `p = p_a + c1 s + ... + c5 s^5` with
 /// `c1 = v_a h`, `c2 = a_a h² / 2` and `c3..c5` matching `p`, `v`, `a` of `b` at `s = 1`.
 #[inline]
-fn hermite(a: &LeadingSample, b: &LeadingSample, t_ns: i64) -> LeadingValue {
+pub(crate) fn hermite(a: &LeadingSample, b: &LeadingSample, t_ns: i64) -> LeadingValue {
     // Differences in ns are exact in f64 below 2^53 ns (104 days).
     let h_ns = b.t_ns.saturating_sub(a.t_ns) as f64;
     let s = t_ns.saturating_sub(a.t_ns) as f64 / h_ns;

@@ -12,3 +12,4 @@ pub mod job;
 pub mod leading;
 pub mod measuring;
 pub mod output_cam;
+pub mod rejoin;
