@@ -667,13 +667,20 @@ fn commands(x: &Ctx) -> Result<(), GatewayError> {
                 .map_err(GatewayError::port("command client"))?,
         );
     }
+    let mut flight = InFlight::default();
     while !stop.load(Ordering::SeqCst) {
-        let Ok((q, sender)) = rx.recv_timeout(Duration::from_millis(50)) else {
-            continue;
-        };
-        let reply = answer(&q, (cell, host, session), &sender, &clients, c);
-        reply_json(&q, &reply);
+        // Block for the next query only when no reply is awaited; otherwise look every ms.
+        let wait = if flight.is_empty() { 50 } else { 1 };
+        if let Ok(first) = rx.recv_timeout(Duration::from_millis(wait)) {
+            flight.waiting.push_back(first);
+            while let Ok(more) = rx.try_recv() {
+                flight.waiting.push_back(more);
+            }
+        }
+        flight.start(&clients, (cell, host, session), c);
+        flight.finish((cell, session));
     }
+    flight.abandon();
     drop(queryables);
     // The queryables' callbacks may still hold the queue's sender: answer what is left.
     while let Ok((q, _)) = rx.try_recv() {
@@ -736,24 +743,129 @@ fn claimed_sender(q: &zenoh::query::Query) -> Option<String> {
     from_attachment.or_else(from_json).filter(|s| !s.is_empty())
 }
 
-/// The reply to one command query, in a `command` span (node, object, instruction, job):
-/// the node's, or why it was not forwarded.
-fn answer(
+/// Commands forwarded to a node at most at once per node (each node's command thread queues
+/// them for its cycle, which applies all it has each cycle; at most
+/// [`ipc::COMMANDS_IN_FLIGHT`]): a command waits behind at most this many others to the same
+/// node (docs/gateway.md, "Command rate").
+const IN_FLIGHT_PER_NODE: usize = 8;
+
+/// A command forwarded to a node, waiting for its reply.
+struct Forwarded {
+    query: zenoh::query::Query,
+    node: String,
+    object: String,
+    line: String,
+    sender: String,
+    pending: iceoryx2::pending_response::PendingResponse<
+        iceoryx2::prelude::ipc::Service,
+        CommandRequest,
+        (),
+        tandem_protocol::wire::CommandReply,
+        (),
+    >,
+    deadline: Instant,
+    span: tracing::Span,
+}
+
+/// The command thread's queries: waiting to be forwarded (first come, first served), and
+/// forwarded, waiting for their node's reply.
+#[derive(Default)]
+struct InFlight {
+    waiting: std::collections::VecDeque<(zenoh::query::Query, String)>,
+    forwarded: Vec<Forwarded>,
+}
+
+impl InFlight {
+    /// Nothing forwarded and nothing waiting.
+    fn is_empty(&self) -> bool {
+        self.waiting.is_empty() && self.forwarded.is_empty()
+    }
+
+    /// Forwards the waiting queries in their order, as long as their node has fewer than
+    /// [`IN_FLIGHT_PER_NODE`] in flight; those that cannot be forwarded are answered.
+    fn start(
+        &mut self,
+        clients: &HashMap<String, CommandClient>,
+        at: (&Cell, &str, &zenoh::Session),
+        c: &Counters,
+    ) {
+        let mut kept = std::collections::VecDeque::new();
+        while let Some((q, sender)) = self.waiting.pop_front() {
+            let node = keys::parse_command(&at.0.name, q.key_expr().as_str()).map(|k| k.node);
+            let busy = |n: &str| self.forwarded.iter().filter(|f| f.node == n).count();
+            if node.is_some_and(|n| busy(n) >= IN_FLIGHT_PER_NODE) {
+                kept.push_back((q, sender));
+                continue;
+            }
+            match forward_start(&q, at, sender, clients, c) {
+                Ok(f) => self.forwarded.push(f),
+                Err(reply) => reply_json(&q, &reply),
+            }
+        }
+        self.waiting = kept;
+    }
+
+    /// Answers every forwarded query whose node replied, or whose 5 s are over.
+    fn finish(&mut self, at: (&Cell, &zenoh::Session)) {
+        let now = Instant::now();
+        let mut i = 0;
+        while let Some(f) = self.forwarded.get(i) {
+            let reply = match f.pending.receive() {
+                Ok(Some(r)) => ReplyJson::from_reply(r.payload()),
+                Ok(None) if now < f.deadline => {
+                    i += 1;
+                    continue;
+                }
+                Ok(None) => ReplyJson::failed(
+                    "unreachable",
+                    if f.pending.number_of_server_connections() == 0 {
+                        "the node is not running".to_string()
+                    } else {
+                        "the node did not answer within 5 s".to_string()
+                    },
+                ),
+                Err(e) => ReplyJson::failed("unreachable", format!("{e}")),
+            };
+            let f = self.forwarded.swap_remove(i);
+            forward_end(&f, at, &reply);
+            reply_json(&f.query, &reply);
+        }
+    }
+
+    /// Answers what is left when the gateway stops.
+    fn abandon(&mut self) {
+        let stopping =
+            || ReplyJson::failed("busy", "the gateway is stopping; try again".to_string());
+        for (q, _) in self.waiting.drain(..) {
+            reply_json(&q, &stopping());
+        }
+        for f in self.forwarded.drain(..) {
+            reply_json(&f.query, &stopping());
+        }
+    }
+}
+
+/// Forwards command query `q` to its node, in a `command` span (node, object, instruction,
+/// job); or the reply saying why it was not forwarded.
+fn forward_start(
     q: &zenoh::query::Query,
-    (cell, host, session): (&Cell, &str, &zenoh::Session),
-    sender: &str,
+    (cell, host, _): (&Cell, &str, &zenoh::Session),
+    sender: String,
     clients: &HashMap<String, CommandClient>,
     c: &Counters,
-) -> ReplyJson {
-    let key = q.key_expr().as_str();
+) -> Result<Forwarded, ReplyJson> {
+    let key = q.key_expr().as_str().to_string();
     let Some(keys::CommandKey {
         node: node_name,
         object,
         ..
-    }) = keys::parse_command(&cell.name, key)
+    }) = keys::parse_command(&cell.name, &key)
     else {
         debug!(key, "not a command key");
-        return ReplyJson::failed("invalid", format!("`{key}` is not a command key"));
+        return Err(ReplyJson::failed(
+            "invalid",
+            format!("`{key}` is not a command key"),
+        ));
     };
     let span = tracing::info_span!(
         "command",
@@ -763,41 +875,65 @@ fn answer(
         instruction = tracing::field::Empty,
         job = tracing::field::Empty
     );
-    let _entered = span.enter();
     let line = command_line(q);
     if let Ok(l) = &line {
         span.record("instruction", l.split_whitespace().next().unwrap_or(""));
     }
-    let reply = match (line, clients.get(node_name)) {
+    let failed = |reply: ReplyJson| {
+        let _in = span.enter();
+        debug!(outcome = %reply.outcome, message = %reply.message, "command answered");
+        Err(reply)
+    };
+    let (line, client) = match (line, clients.get(node_name)) {
         (Err(m), _) => {
             c.malformed.fetch_add(1, Ordering::Relaxed);
-            ReplyJson::failed("invalid", m)
+            return failed(ReplyJson::failed("invalid", m));
         }
-        (Ok(_), None) => ReplyJson::failed(
-            "invalid",
-            format!("node `{node_name}` is not on host `{host}`"),
-        ),
-        (Ok(line), Some(client)) => {
-            let reply = forward(client, &format!("{object} {line}"), sender);
-            // Who commanded what, with what outcome, for every observer (the node's audit
-            // file has the same record).
-            let event = EventJson::command(object, sender, &line, &reply);
-            put(
-                session,
-                keys::events(&cell.name, node_name, object),
-                serde_json::to_string(&event).unwrap_or_default(),
-            );
-            reply
+        (Ok(_), None) => {
+            let m = format!("node `{node_name}` is not on host `{host}`");
+            return failed(ReplyJson::failed("invalid", m));
+        }
+        (Ok(line), Some(client)) => (line, client),
+    };
+    let pending = match client.send_copy(CommandRequest {
+        text: Text::new(&format!("{object} {line}")),
+        sender: Text::new(&sender),
+    }) {
+        Ok(p) => p,
+        Err(e) => {
+            let m = format!("sending to the node: {e}");
+            return failed(ReplyJson::failed("unreachable", m));
         }
     };
-    span.record("job", reply.job);
+    Ok(Forwarded {
+        node: node_name.to_string(),
+        object: object.to_string(),
+        line,
+        sender,
+        pending,
+        deadline: Instant::now() + Duration::from_secs(5),
+        span: span.clone(),
+        query: q.clone(),
+    })
+}
+
+/// Publishes who commanded what with what outcome, for every observer (the node's audit file
+/// has the same record), and logs the outcome in the command's span.
+fn forward_end(f: &Forwarded, (cell, session): (&Cell, &zenoh::Session), reply: &ReplyJson) {
+    let event = EventJson::command(&f.object, &f.sender, &f.line, reply);
+    put(
+        session,
+        keys::events(&cell.name, &f.node, &f.object),
+        serde_json::to_string(&event).unwrap_or_default(),
+    );
+    f.span.record("job", reply.job);
+    let _in = f.span.enter();
     debug!(
         outcome = %reply.outcome,
         error_id = %reply.error_id,
         message = %reply.message,
         "command answered"
     );
-    reply
 }
 
 /// The command line of a query's payload: text as it is, or the JSON form turned into text.
@@ -813,33 +949,6 @@ fn command_line(q: &zenoh::query::Query) -> Result<String, String> {
             .and_then(|c| c.to_line().map_err(|e| e.to_string())),
         Ok(t) => Ok(t),
     }
-}
-
-/// Sends one command line to a node and waits up to 5 s for its reply.
-fn forward(client: &CommandClient, line: &str, sender: &str) -> ReplyJson {
-    let pending = match client.send_copy(CommandRequest {
-        text: Text::new(line),
-        sender: Text::new(sender),
-    }) {
-        Ok(p) => p,
-        Err(e) => return ReplyJson::failed("unreachable", format!("sending to the node: {e}")),
-    };
-    let deadline = Instant::now() + Duration::from_secs(5);
-    while Instant::now() < deadline {
-        match pending.receive() {
-            Ok(Some(r)) => return ReplyJson::from_reply(r.payload()),
-            Ok(None) => std::thread::sleep(Duration::from_millis(1)),
-            Err(e) => return ReplyJson::failed("unreachable", format!("{e}")),
-        }
-    }
-    ReplyJson::failed(
-        "unreachable",
-        if pending.number_of_server_connections() == 0 {
-            "the node is not running".to_string()
-        } else {
-            "the node did not answer within 5 s".to_string()
-        },
-    )
 }
 
 /// The telemetry and event subscribers of one node.

@@ -152,6 +152,24 @@ fn admit(
     None
 }
 
+/// Sends the cycle's answer `d` to the request waiting for it, and audits it.
+fn reply(pending: &mut Vec<Pending>, d: Done, audit: &mut Audit) {
+    let Some(i) = pending.iter().position(|x| x.id == d.id) else {
+        return;
+    };
+    let p = pending.swap_remove(i);
+    log_reply(&p.span, &d.reply);
+    let sender = match p.request.sender.as_str() {
+        "" => ANONYMOUS,
+        s => s,
+    };
+    audit.record(sender, p.request.text.as_str(), &d.reply);
+    if p.active.send_copy(d.reply).is_err() {
+        let _in = p.span.enter();
+        warn!("the reply could not be sent");
+    }
+}
+
 /// The command loop.
 fn serve(
     cell: &Cell,
@@ -215,25 +233,14 @@ fn serve(
                 Err(TrySendError::Disconnected(_)) => return Ok(()),
             }
         }
-        while let Ok(d) = links.done.try_recv() {
-            if let Some(i) = pending.iter().position(|x| x.id == d.id) {
-                let p = pending.swap_remove(i);
-                log_reply(&p.span, &d.reply);
-                let sender = match p.request.sender.as_str() {
-                    "" => ANONYMOUS,
-                    s => s,
-                };
-                audit.record(sender, p.request.text.as_str(), &d.reply);
-                if p.active.send_copy(d.reply).is_err() {
-                    let _in = p.span.enter();
-                    warn!("the reply could not be sent");
-                }
-            }
+        // Wait for the cycle's answers at most 1 ms (then look for new requests again): a
+        // reply leaves as soon as the cycle answered, at a cost of 1,000 wake-ups a second.
+        let mut next = links.done.recv_timeout(Duration::from_millis(1)).ok();
+        while let Some(d) = next {
+            reply(&mut pending, d, &mut audit);
+            next = links.done.try_recv().ok();
         }
         audit.sync();
-        // Commands are for people and supervisors: 5 ms is well below what they notice
-        // and costs a fraction of a per cent of a core.
-        std::thread::sleep(Duration::from_millis(5));
     }
     Ok(())
 }

@@ -215,12 +215,17 @@ pub fn io(node: &IpcNode, cell: &str, object: &str) -> Result<IoService, IpcErro
     pubsub(node, &names::io(cell, object), 16, 256)
 }
 
+/// Requests one client (a gateway, `tandem cmd`) may have unanswered on a node's command
+/// service at once.
+pub const COMMANDS_IN_FLIGHT: usize = 16;
+
 /// The command service of `node_name`.
 pub fn commands(node: &IpcNode, cell: &str, node_name: &str) -> Result<CommandService, IpcError> {
     let name = names::commands(cell, node_name);
     ctx(
         node.service_builder(&service_name(&name)?)
             .request_response::<CommandRequest, CommandReply>()
+            .max_active_requests_per_client(COMMANDS_IN_FLIGHT)
             .max_clients(16)
             .max_servers(2)
             .max_nodes(32)
