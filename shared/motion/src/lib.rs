@@ -16,7 +16,8 @@
 //! | [`kinematics`] | `profile`, `modulo`, `dynamics`, `cycle_motion`, `crossing`, `extrapolation`, `timed_list` | 1-DoF trajectories, the motion of one cycle and its exact crossing times, filters |
 //! | [`cam`] | `cam` | the cam object: a position-to-position law built from points and segments |
 //! | [`plant`] | `drive`, `sensor` | the simulated drive and sensors that stand in for the hardware |
-//! | [`objects`] | `axis`, `encoder`, `leading`, `output_cam`, `cam_track`, `measuring`, `job`, `action` | the technology objects, stepped once per cycle, and the command type |
+//! | [`objects`] | `axis`, `encoder`, `leading`, `rejoin`, `output_cam`, `cam_track`, `measuring`, `job`, `action` | the technology objects, stepped once per cycle, and the command type |
+//! | [`hydraulic`] | `finish`, `valve_table` | the stages of a hydraulic axis of the Beckhoff hydraulic positioning library |
 //!
 //! The principal types are re-exported here ([`Axis`], [`Profile`], [`Cam`], ...); their home
 //! modules are the paths to import.
@@ -66,6 +67,7 @@
 
 pub mod cam;
 pub mod catalog;
+pub mod hydraulic;
 pub mod kinematics;
 pub mod objects;
 pub mod plant;

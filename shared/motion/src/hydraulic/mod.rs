@@ -1,0 +1,13 @@
+//! Hydraulic axes as the Beckhoff TwinCAT PLC Hydraulic Positioning library (`*_BkPlcMc`)
+//! runs them: per cycle, actual values → enables → commands → generator → position controller →
+//! extra controllers → Finish → drive output (the library's 'Cyclic organisation').
+//!
+//! Built so far, pure and allocation-free, not yet an axis kind of its own:
+//! - [`finish`]: the Finish stage, `MC_AxRtFinish_BkPlcMc` (sectional linearisation: feed
+//!   forward, area ratio, bend point, ramped overlap compensation, clamping output, offset) and
+//!   `MC_AxRtFinishLinear_BkPlcMc` (a characteristic curve);
+//! - [`valve_table`]: the characteristic curve of a valve and cylinder, read from the library's
+//!   table file format and checked.
+
+pub mod finish;
+pub mod valve_table;
