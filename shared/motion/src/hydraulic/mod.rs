@@ -3,6 +3,8 @@
 //! extra controllers → Finish → drive output (the library's 'Cyclic organisation').
 //!
 //! Built so far, pure and allocation-free, not yet an axis kind of its own:
+//! - [`generator`]: the displacement-based set value generator `iTcMc_ProfileCtrlBased` (start
+//!   ramp, travel, square-root braking ramp to creep speed, creep, idle; stops);
 //! - [`finish`]: the Finish stage, `MC_AxRtFinish_BkPlcMc` (sectional linearisation: feed
 //!   forward, area ratio, bend point, ramped overlap compensation, clamping output, offset) and
 //!   `MC_AxRtFinishLinear_BkPlcMc` (a characteristic curve);
@@ -10,4 +12,5 @@
 //!   table file format and checked.
 
 pub mod finish;
+pub mod generator;
 pub mod valve_table;

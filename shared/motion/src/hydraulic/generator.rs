@@ -1,0 +1,668 @@
+//! The displacement-based set value generator of a hydraulic axis, `iTcMc_ProfileCtrlBased`
+//! (Beckhoff TwinCAT PLC Hydraulic Positioning library, 'Profile types': the standard profile;
+//! its states `E_TcHydAxState`, 4.3.3).
+//!
+//! The profile of the control value (the set velocity), in the library's words and numbers:
+//! 1. a **time-controlled start ramp** to the travel velocity, with the smallest of `fMaxAcc`,
+//!    `fAcc` and the command's acceleration (`iTcHydStateTcAccP/M`);
+//! 2. **travel** at the smallest of `fRefVelo`, `fMaxVelo` and the command's velocity
+//!    (`iTcHydStateConstVeloP/M`), "until a point is reached that was recalculated at the
+//!    start";
+//! 3. a **displacement-controlled braking ramp** ("square root generator"), with the smallest of
+//!    `fMaxDec`, `fDec` and the command's deceleration, from the travel velocity down to the
+//!    creep velocity, "reached at a specified distance from the target" (`fCreepDistance`;
+//!    `iTcHydStatePcDecP/M`);
+//! 4. **creep** at `fCreepSpeed` (`iTcHydStateCreepVeloP/M`) until the remaining distance is
+//!    below the braking distance `fBrakeDistance + fBrakeDeadTime·|v_act|`;
+//! 5. **idle** (`iTcHydStateIdle`): the set velocity 0 and the set position the target, for the
+//!    position controller at standstill.
+//!
+//! The arithmetic is inferred from that description and stated: the brake point is the remaining
+//! distance `fCreepDistance + (v_travel² - v_creep²) / (2·dec)` (where a ramp at `dec` from the
+//! travel velocity reaches creep velocity at the creep distance), computed at the start; in the
+//! braking ramp the set velocity is `sqrt(v_creep² + 2·dec·(d - fCreepDistance))` of the remaining
+//! distance `d` measured from the **actual** position (displacement-controlled), never above the
+//! travel velocity; a short move that reaches its brake point while still accelerating goes on
+//! accelerating until it meets that curve; the creep velocity too is reached with the
+//! acceleration, not in one step (inferred: the library says nothing of moves shorter than their
+//! ramps). The braking distance is measured from the actual position too. A restart with a
+//! lower velocity ramps down to it with the deceleration.
+//! With `bAsymmetricalTargeting` the `…M` creep speed, creep distance, brake distance and dead time
+//! serve the negative direction.
+//!
+//! A stop (`MC_Stop_BkPlcMc`, a lost feed enable) ramps the set velocity down in time,
+//! `fStopRamp` seconds from `fRefVelo` to 0 (the ramp is referred to the reference velocity, not
+//! to the current one: a slower axis stops sooner), `iTcHydStateTcDecP/M`; an emergency stop
+//! with `fEmergencyRamp` (`iTcHydStateEmergencyBreak`).
+//!
+//! Pure: no IO, no clock (the cycle time is an input), no allocation.
+
+/// The generator's state, as the library names it (`E_TcHydAxState`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum HydState {
+    /// `iTcHydStateIdle`: not moving; the set position is the target.
+    Idle,
+    /// `iTcHydStateTcAccP` / `TcAccM`: the time-controlled start ramp.
+    TcAcc,
+    /// `iTcHydStateConstVeloP` / `ConstVeloM`: travel at the command's velocity.
+    ConstVelo,
+    /// `iTcHydStatePcDecP` / `PcDecM`: the displacement-controlled braking ramp.
+    PcDec,
+    /// `iTcHydStateCreepVeloP` / `CreepVeloM`: creep to the target.
+    CreepVelo,
+    /// `iTcHydStateTcDecP` / `TcDecM`: a regular stop with `fStopRamp`.
+    TcDec,
+    /// `iTcHydStateEmergencyBreak`: an emergency stop with `fEmergencyRamp`.
+    EmergencyBreak,
+}
+
+impl HydState {
+    /// The library's name of the state in direction `positive`.
+    pub const fn name(self, positive: bool) -> &'static str {
+        match (self, positive) {
+            (Self::Idle, _) => "iTcHydStateIdle",
+            (Self::TcAcc, true) => "iTcHydStateTcAccP",
+            (Self::TcAcc, false) => "iTcHydStateTcAccM",
+            (Self::ConstVelo, true) => "iTcHydStateConstVeloP",
+            (Self::ConstVelo, false) => "iTcHydStateConstVeloM",
+            (Self::PcDec, true) => "iTcHydStatePcDecP",
+            (Self::PcDec, false) => "iTcHydStatePcDecM",
+            (Self::CreepVelo, true) => "iTcHydStateCreepVeloP",
+            (Self::CreepVelo, false) => "iTcHydStateCreepVeloM",
+            (Self::TcDec, true) => "iTcHydStateTcDecP",
+            (Self::TcDec, false) => "iTcHydStateTcDecM",
+            (Self::EmergencyBreak, _) => "iTcHydStateEmergencyBreak",
+        }
+    }
+}
+
+/// The target approach of one direction (members of `ST_TcHydAxParam`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Approach {
+    /// `fCreepSpeedP/M` (mm/s, > 0).
+    pub creep_speed: f64,
+    /// `fCreepDistanceP/M` (mm, >= 0).
+    pub creep_distance: f64,
+    /// `fBrakeDistanceP/M` (mm, >= 0).
+    pub brake_distance: f64,
+    /// `fBrakeDeadTimeP/M` (s, >= 0).
+    pub brake_dead_time: f64,
+}
+
+/// The generator's parameters (members of `ST_TcHydAxParam`; defaults as the library's).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct GeneratorParams {
+    /// `fRefVelo` (mm/s, > 0).
+    pub ref_velo: f64,
+    /// `fMaxVelo` (mm/s, > 0; above `fRefVelo` it is `fRefVelo`).
+    pub max_velo: f64,
+    /// `fAcc` (mm/s², > 0).
+    pub acc: f64,
+    /// `fMaxAcc` (mm/s², > 0).
+    pub max_acc: f64,
+    /// `fDec` (mm/s², > 0).
+    pub dec: f64,
+    /// `fMaxDec` (mm/s², > 0).
+    pub max_dec: f64,
+    /// The approach of the positive direction (and of both without asymmetrical targeting).
+    pub approach_p: Approach,
+    /// The approach of the negative direction, with [`GeneratorParams::asymmetrical`].
+    pub approach_m: Approach,
+    /// `bAsymmetricalTargeting`.
+    pub asymmetrical: bool,
+    /// `fStopRamp` (s, > 0): a stop's ramp from `fRefVelo` to 0.
+    pub stop_ramp: f64,
+    /// `fEmergencyRamp` (s, > 0): an emergency stop's ramp from `fRefVelo` to 0.
+    pub emergency_ramp: f64,
+}
+
+impl Default for GeneratorParams {
+    /// The library's defaults: `fRefVelo` and `fMaxVelo` 500 mm/s, `fAcc`/`fDec` 2000 mm/s²,
+    /// `fMaxAcc`/`fMaxDec` 500 mm/s², creep 80 mm/s from 1.0 mm, brake distance 0.1 mm, no dead
+    /// time, stop ramp 1.0 s, emergency ramp 0.1 s.
+    fn default() -> Self {
+        let approach = Approach {
+            creep_speed: 80.0,
+            creep_distance: 1.0,
+            brake_distance: 0.1,
+            brake_dead_time: 0.0,
+        };
+        Self {
+            ref_velo: 500.0,
+            max_velo: 500.0,
+            acc: 2000.0,
+            max_acc: 500.0,
+            dec: 2000.0,
+            max_dec: 500.0,
+            approach_p: approach,
+            approach_m: approach,
+            asymmetrical: false,
+            stop_ramp: 1.0,
+            emergency_ramp: 0.1,
+        }
+    }
+}
+
+/// Why the generator refused parameters or a command (nothing changes).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum GeneratorError {
+    /// A parameter or a command's value that must be finite and above 0 (or at least 0).
+    Invalid {
+        /// Its name (the library's for parameters; `Position`, `Velocity`, `Acceleration`,
+        /// `Deceleration` for a command's inputs).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+}
+
+impl core::fmt::Display for GeneratorError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let Self::Invalid { name, value } = *self;
+        write!(f, "{name} = {value} is not valid here")
+    }
+}
+
+impl std::error::Error for GeneratorError {}
+
+/// One cycle of the generator's output.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Setpoint {
+    /// `fSetVelo` (mm/s): the control value.
+    pub velocity: f64,
+    /// `fSetPos` (mm): the set position (the integral of the set velocity while moving, the
+    /// target when idle).
+    pub position: f64,
+    /// The state after the cycle.
+    pub state: HydState,
+    /// The direction of the motion (`true`: positive).
+    pub positive: bool,
+}
+
+/// A move the generator runs (the command's values, already limited by the parameters).
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct Move {
+    target: f64,
+    velocity: f64,
+    acc: f64,
+    dec: f64,
+    /// Remaining distance at which the braking ramp begins.
+    brake_point: f64,
+}
+
+/// The displacement-based generator `iTcMc_ProfileCtrlBased` (see the module documentation).
+#[doc(alias = "iTcMc_ProfileCtrlBased")]
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct CtrlBasedGenerator {
+    p: GeneratorParams,
+    state: HydState,
+    positive: bool,
+    velocity: f64,
+    position: f64,
+    mv: Move,
+    /// A move in the other direction waits for the stop ramp.
+    reverse_pending: bool,
+}
+
+impl CtrlBasedGenerator {
+    /// The generator with parameters `p`, idle at position `x`.
+    pub fn new(p: GeneratorParams, x: f64) -> Result<Self, GeneratorError> {
+        let positive = [
+            ("fRefVelo", p.ref_velo),
+            ("fMaxVelo", p.max_velo),
+            ("fAcc", p.acc),
+            ("fMaxAcc", p.max_acc),
+            ("fDec", p.dec),
+            ("fMaxDec", p.max_dec),
+            ("fStopRamp", p.stop_ramp),
+            ("fEmergencyRamp", p.emergency_ramp),
+            ("fCreepSpeedP", p.approach_p.creep_speed),
+            ("fCreepSpeedM", p.approach_m.creep_speed),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(GeneratorError::Invalid { name, value });
+            }
+        }
+        let at_least_0 = [
+            ("fCreepDistanceP", p.approach_p.creep_distance),
+            ("fCreepDistanceM", p.approach_m.creep_distance),
+            ("fBrakeDistanceP", p.approach_p.brake_distance),
+            ("fBrakeDistanceM", p.approach_m.brake_distance),
+            ("fBrakeDeadTimeP", p.approach_p.brake_dead_time),
+            ("fBrakeDeadTimeM", p.approach_m.brake_dead_time),
+        ];
+        for (name, value) in at_least_0 {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(GeneratorError::Invalid { name, value });
+            }
+        }
+        if !x.is_finite() {
+            return Err(GeneratorError::Invalid {
+                name: "Position",
+                value: x,
+            });
+        }
+        Ok(Self {
+            p,
+            state: HydState::Idle,
+            positive: true,
+            velocity: 0.0,
+            position: x,
+            mv: Move {
+                target: x,
+                velocity: 0.0,
+                acc: p.acc.min(p.max_acc),
+                dec: p.dec.min(p.max_dec),
+                brake_point: 0.0,
+            },
+            reverse_pending: false,
+        })
+    }
+
+    /// The state.
+    pub fn state(&self) -> HydState {
+        self.state
+    }
+
+    /// The target of the running or last move (`fTargetPos`).
+    pub fn target(&self) -> f64 {
+        self.mv.target
+    }
+
+    /// The remaining distance at which the braking ramp of the running move begins.
+    pub fn brake_point(&self) -> f64 {
+        self.mv.brake_point
+    }
+
+    /// The approach of direction `positive`.
+    fn approach(&self, positive: bool) -> &Approach {
+        if positive || !self.p.asymmetrical {
+            &self.p.approach_p
+        } else {
+            &self.p.approach_m
+        }
+    }
+
+    /// Starts a move to `target` (`MC_MoveAbsolute_BkPlcMc`) from the actual position
+    /// `actual`: the smallest of the parameters' and the command's velocity, acceleration and
+    /// deceleration (a value of 0 for the command's acceleration or deceleration takes the
+    /// parameters'). A move while moving in the other direction first stops with the stop ramp,
+    /// then starts (inferred).
+    pub fn move_absolute(
+        &mut self,
+        target: f64,
+        velocity: f64,
+        acceleration: f64,
+        deceleration: f64,
+        actual: f64,
+    ) -> Result<(), GeneratorError> {
+        for (name, value) in [("Position", target), ("Velocity", velocity)] {
+            if !value.is_finite() || (name == "Velocity" && value <= 0.0) {
+                return Err(GeneratorError::Invalid { name, value });
+            }
+        }
+        for (name, value) in [
+            ("Acceleration", acceleration),
+            ("Deceleration", deceleration),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(GeneratorError::Invalid { name, value });
+            }
+        }
+        let p = &self.p;
+        let limit = |param: f64, max: f64, cmd: f64| {
+            let l = param.min(max);
+            if cmd > 0.0 {
+                l.min(cmd)
+            } else {
+                l
+            }
+        };
+        let positive = target >= actual;
+        let approach = *self.approach(positive);
+        let v = velocity
+            .min(p.ref_velo)
+            .min(p.max_velo)
+            .max(approach.creep_speed);
+        let acc = limit(p.acc, p.max_acc, acceleration);
+        let dec = limit(p.dec, p.max_dec, deceleration);
+        let vc = approach.creep_speed;
+        self.mv = Move {
+            target,
+            velocity: v,
+            acc,
+            dec,
+            brake_point: approach.creep_distance + (v * v - vc * vc).max(0.0) / (2.0 * dec),
+        };
+        let moving_other_way = self.velocity != 0.0 && (self.velocity > 0.0) != positive;
+        self.reverse_pending = moving_other_way;
+        if moving_other_way {
+            self.state = HydState::TcDec;
+        } else {
+            self.positive = positive;
+            self.state = HydState::TcAcc;
+        }
+        if self.velocity == 0.0 {
+            self.position = actual;
+        }
+        Ok(())
+    }
+
+    /// A regular stop (`MC_Stop_BkPlcMc`): the set velocity ramps to 0 with `fStopRamp`.
+    pub fn stop(&mut self) {
+        if self.state != HydState::Idle && self.state != HydState::EmergencyBreak {
+            self.state = HydState::TcDec;
+            self.reverse_pending = false;
+        }
+    }
+
+    /// An emergency stop: the set velocity ramps to 0 with `fEmergencyRamp`.
+    pub fn emergency_stop(&mut self) {
+        if self.state != HydState::Idle {
+            self.state = HydState::EmergencyBreak;
+            self.reverse_pending = false;
+        }
+    }
+
+    /// One cycle of `dt` seconds with the actual position `actual` and actual velocity
+    /// `actual_velocity` (for the dead-time term of the braking distance).
+    pub fn step(&mut self, dt: f64, actual: f64, actual_velocity: f64) -> Setpoint {
+        if dt.is_finite() && dt > 0.0 && actual.is_finite() && actual_velocity.is_finite() {
+            self.advance(dt, actual, actual_velocity);
+        }
+        Setpoint {
+            velocity: self.velocity,
+            position: self.position,
+            state: self.state,
+            positive: self.positive,
+        }
+    }
+
+    /// The state machine of one cycle.
+    fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
+        let sign = if self.positive { 1.0 } else { -1.0 };
+        let approach = *self.approach(self.positive);
+        let speed = self.velocity.abs();
+        let m = self.mv;
+        match self.state {
+            HydState::Idle => {
+                self.velocity = 0.0;
+                self.position = m.target;
+                return;
+            }
+            HydState::TcDec | HydState::EmergencyBreak => {
+                let ramp = if self.state == HydState::TcDec {
+                    self.p.stop_ramp
+                } else {
+                    self.p.emergency_ramp
+                };
+                let s = (speed - self.p.ref_velo / ramp * dt).max(0.0);
+                self.set(s * sign, dt);
+                if s == 0.0 {
+                    self.finish_stop();
+                }
+                return;
+            }
+            _ => {}
+        }
+        let remaining = (m.target - actual) * sign;
+        if remaining <= approach.brake_distance + approach.brake_dead_time * actual_velocity.abs() {
+            self.state = HydState::Idle;
+            self.velocity = 0.0;
+            self.position = m.target;
+            return;
+        }
+        let vc = approach.creep_speed;
+        let up = speed + m.acc * dt;
+        let s = if self.state == HydState::CreepVelo || remaining <= approach.creep_distance {
+            self.state = HydState::CreepVelo;
+            up.min(vc)
+        } else if self.state == HydState::PcDec || remaining <= m.brake_point {
+            self.state = HydState::PcDec;
+            let root = (vc * vc + 2.0 * m.dec * (remaining - approach.creep_distance)).sqrt();
+            root.min(up)
+        } else if speed > m.velocity {
+            // A restart with a lower velocity: down to it with the deceleration.
+            self.state = HydState::TcAcc;
+            (speed - m.dec * dt).max(m.velocity)
+        } else {
+            let s = up.min(m.velocity);
+            self.state = if s >= m.velocity {
+                HydState::ConstVelo
+            } else {
+                HydState::TcAcc
+            };
+            s
+        };
+        self.set(s * sign, dt);
+    }
+
+    /// Sets the set velocity and integrates the set position.
+    fn set(&mut self, v: f64, dt: f64) {
+        self.position += 0.5 * (self.velocity + v) * dt;
+        self.velocity = v;
+    }
+
+    /// A stop ramp has reached 0: the move in the other direction that waited for it starts,
+    /// or the axis is idle at its set position.
+    fn finish_stop(&mut self) {
+        if self.reverse_pending && self.state == HydState::TcDec {
+            self.reverse_pending = false;
+            self.positive = !self.positive;
+            self.state = HydState::TcAcc;
+        } else {
+            self.reverse_pending = false;
+            self.state = HydState::Idle;
+            self.mv.target = self.position;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+    use super::*;
+
+    const DT: f64 = 1e-3;
+
+    fn params() -> GeneratorParams {
+        let approach = Approach {
+            creep_speed: 10.0,
+            creep_distance: 1.0,
+            brake_distance: 0.1,
+            brake_dead_time: 0.0,
+        };
+        GeneratorParams {
+            acc: 500.0,
+            max_acc: 500.0,
+            dec: 500.0,
+            max_dec: 500.0,
+            approach_p: approach,
+            approach_m: approach,
+            ..GeneratorParams::default()
+        }
+    }
+
+    /// Runs `g` on an ideal axis (the actual position is the set position of the cycle
+    /// before) until idle or `cycles`; returns the setpoints.
+    fn run(g: &mut CtrlBasedGenerator, cycles: usize) -> Vec<Setpoint> {
+        let mut out = Vec::new();
+        let (mut x, mut v) = (g.position, g.velocity);
+        for _ in 0..cycles {
+            let s = g.step(DT, x, v);
+            out.push(s);
+            (x, v) = (s.position, s.velocity);
+            if s.state == HydState::Idle {
+                break;
+            }
+        }
+        out
+    }
+
+    /// The set velocity of two cycles changes within 500 mm/s²: exactly in the time ramps; in
+    /// the square-root ramp, sampled once a cycle from the actual position that lags a cycle,
+    /// up to `dec·(1 + 2·dec·dt/v)` (1 % at 100 mm/s, 10 % at 10 mm/s); the step to 0 at the
+    /// braking distance aside.
+    fn within_dynamics(w: &[Setpoint]) -> bool {
+        let dv = (w[1].velocity - w[0].velocity).abs() / DT;
+        let slack = 2.0 * 500.0 * DT / w[1].velocity.abs().max(1.0);
+        dv <= 500.0 * (1.0 + slack) + 1e-9 || w[1].state == HydState::Idle
+    }
+
+    #[test]
+    fn a_move_runs_the_standard_profile_with_its_numbers() {
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        g.move_absolute(100.0, 100.0, 0.0, 0.0, 0.0).unwrap();
+        // Brake point: creep distance + (100² - 10²) / (2 · 500) = 1 + 9.9.
+        assert!((g.brake_point() - 10.9).abs() < 1e-12);
+        let out = run(&mut g, 10_000);
+        // The states in the library's order, each once.
+        let mut states: Vec<HydState> = out.iter().map(|s| s.state).collect();
+        states.dedup();
+        assert_eq!(
+            states,
+            [
+                HydState::TcAcc,
+                HydState::ConstVelo,
+                HydState::PcDec,
+                HydState::CreepVelo,
+                HydState::Idle
+            ]
+        );
+        // The start ramp: 100 mm/s at 500 mm/s² in 0.2 s (200 cycles).
+        let acc = out.iter().filter(|s| s.state == HydState::TcAcc).count();
+        assert_eq!(acc + 1, 200, "cycles of the start ramp");
+        // Never above the travel velocity, never faster changes than acc and dec allow.
+        for w in out.windows(2) {
+            assert!(w[1].velocity <= 100.0 + 1e-12);
+            assert!(within_dynamics(w), "{w:?}");
+        }
+        // The braking ramp follows the square root of the remaining distance: v² - vc² = 2 ·
+        // dec · (d - creep distance), d measured at the cycle's start.
+        let mut x = 0.0_f64;
+        for s in &out {
+            if s.state == HydState::PcDec {
+                let d: f64 = 100.0 - x;
+                let want = (100.0 + 1000.0 * (d - 1.0)).sqrt().min(100.0);
+                assert!((s.velocity - want).abs() < 1e-9, "{} vs {want}", s.velocity);
+            }
+            x = s.position;
+        }
+        // Creep at 10 mm/s, then idle with the set position at the target, the (ideal) actual
+        // position within the braking distance before it.
+        let creep: Vec<_> = out
+            .iter()
+            .filter(|s| s.state == HydState::CreepVelo)
+            .collect();
+        assert!(creep.iter().all(|s| (s.velocity - 10.0).abs() < 1e-9));
+        let last = out.last().unwrap();
+        assert_eq!(
+            (last.state, last.velocity, last.position),
+            (HydState::Idle, 0.0, 100.0)
+        );
+        let before = out[out.len() - 2].position;
+        assert!(
+            (99.9..100.0).contains(&before),
+            "stopped creeping at {before}"
+        );
+    }
+
+    #[test]
+    fn the_negative_direction_takes_its_own_approach_when_asymmetrical() {
+        let mut p = params();
+        p.asymmetrical = true;
+        p.approach_m.creep_speed = 5.0;
+        p.approach_m.creep_distance = 2.0;
+        let mut g = CtrlBasedGenerator::new(p, 50.0).unwrap();
+        g.move_absolute(0.0, 100.0, 0.0, 0.0, 50.0).unwrap();
+        assert!((g.brake_point() - (2.0 + (100.0 * 100.0 - 25.0) / 1000.0)).abs() < 1e-12);
+        let out = run(&mut g, 10_000);
+        assert!(out.iter().all(|s| s.velocity <= 0.0 && !s.positive));
+        let creep: Vec<_> = out
+            .iter()
+            .filter(|s| s.state == HydState::CreepVelo)
+            .collect();
+        assert!(!creep.is_empty() && creep.iter().all(|s| (s.velocity + 5.0).abs() < 1e-9));
+        assert_eq!(out.last().unwrap().position, 0.0);
+        assert_eq!(HydState::CreepVelo.name(false), "iTcHydStateCreepVeloM");
+    }
+
+    #[test]
+    fn a_stop_ramps_down_in_the_stop_ramp_referred_to_the_reference_velocity() {
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        g.move_absolute(1000.0, 100.0, 0.0, 0.0, 0.0).unwrap();
+        let out = run(&mut g, 300);
+        assert_eq!(out.last().unwrap().state, HydState::ConstVelo);
+        g.stop();
+        // fStopRamp 1 s from fRefVelo 500: 500 mm/s², so 100 mm/s stop in 0.2 s.
+        let out = run(&mut g, 1000);
+        let ramp = out.iter().filter(|s| s.state == HydState::TcDec).count();
+        assert_eq!(ramp + 1, 200);
+        let last = out.last().unwrap();
+        assert_eq!((last.state, last.velocity), (HydState::Idle, 0.0));
+        assert_eq!(g.target(), last.position);
+    }
+
+    #[test]
+    fn a_move_the_other_way_stops_first_then_reverses() {
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        g.move_absolute(1000.0, 100.0, 0.0, 0.0, 0.0).unwrap();
+        let out = run(&mut g, 300);
+        let x = out.last().unwrap().position;
+        g.move_absolute(0.0, 50.0, 0.0, 0.0, x).unwrap();
+        let out = run(&mut g, 20_000);
+        let mut states: Vec<(HydState, bool)> = out.iter().map(|s| (s.state, s.positive)).collect();
+        states.dedup();
+        assert_eq!(states[0], (HydState::TcDec, true));
+        assert_eq!(states[1], (HydState::TcAcc, false));
+        assert_eq!(out.last().unwrap().position, 0.0);
+        // No step in the set velocity through the reversal.
+        for w in out.windows(2) {
+            assert!(within_dynamics(w), "{w:?}");
+        }
+    }
+
+    #[test]
+    fn the_braking_distance_grows_with_the_dead_time_and_the_actual_velocity() {
+        let mut p = params();
+        p.approach_p.brake_dead_time = 0.05;
+        let mut g = CtrlBasedGenerator::new(p, 0.0).unwrap();
+        g.move_absolute(100.0, 100.0, 0.0, 0.0, 0.0).unwrap();
+        let out = run(&mut g, 10_000);
+        // Creeping at 10 mm/s: idle from 0.1 + 0.05 · 10 = 0.6 mm before the target.
+        let before = out[out.len() - 2].position;
+        assert!(
+            (99.4..99.41).contains(&before),
+            "stopped creeping at {before}"
+        );
+    }
+
+    #[test]
+    fn bad_parameters_and_commands_are_refused_and_change_nothing() {
+        let mut p = params();
+        p.max_dec = 0.0;
+        assert_eq!(
+            CtrlBasedGenerator::new(p, 0.0).unwrap_err(),
+            GeneratorError::Invalid {
+                name: "fMaxDec",
+                value: 0.0
+            }
+        );
+        let mut p = params();
+        p.approach_m.brake_distance = -1.0;
+        assert!(CtrlBasedGenerator::new(p, 0.0).is_err());
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        let before = g;
+        assert!(g.move_absolute(f64::NAN, 100.0, 0.0, 0.0, 0.0).is_err());
+        assert!(g.move_absolute(10.0, 0.0, 0.0, 0.0, 0.0).is_err());
+        assert!(g.move_absolute(10.0, 10.0, -1.0, 0.0, 0.0).is_err());
+        assert_eq!(g, before);
+        // A cycle with a NaN actual changes nothing either.
+        g.move_absolute(10.0, 10.0, 0.0, 0.0, 0.0).unwrap();
+        let moving = g;
+        g.step(DT, f64::NAN, 0.0);
+        assert_eq!(g, moving);
+    }
+}
