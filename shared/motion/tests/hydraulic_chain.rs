@@ -15,6 +15,7 @@ use tandem_motion::hydraulic::finish::{Finish, FinishInput, FinishParams};
 use tandem_motion::hydraulic::generator::{
     Approach, CtrlBasedGenerator, GeneratorParams, HydState,
 };
+use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
 use tandem_motion::plant::hydraulic::{CylinderParams, SimCylinder};
 
 const DT: f64 = 1e-3;
@@ -91,6 +92,14 @@ fn a_commissioned_hydraulic_axis_positions_out_and_back() {
         gen.move_absolute(target, velocity, 0.0, 0.0, s.position)
             .unwrap();
         let (mut last_v, mut idle_at, mut worst) = (0.0_f64, None, 0.0_f64);
+        // Done: idle, within 1 mm, and within 0.2 mm for 0.2 s.
+        let mut monitor = TargetMonitor::new(MonitorParams {
+            position_range: 1.0,
+            target_range: 0.2,
+            target_filter: 0.2,
+        })
+        .unwrap();
+        let mut done_at = None;
         for k in 0..8000 {
             let s = *cyl.state();
             let sp = gen.step(DT, s.position, s.velocity);
@@ -116,11 +125,18 @@ fn a_commissioned_hydraulic_axis_positions_out_and_back() {
                 clamping_output: 0.0,
             });
             cyl.step(out.output, DT);
+            let st = monitor.step(DT, s.position, gen.target(), sp.state == HydState::Idle);
+            if st.done {
+                done_at.get_or_insert(k);
+            }
         }
         eprintln!("to {target}: largest change of the set velocity {worst:.0} mm/s²");
         let s = *cyl.state();
         let idle = idle_at.expect("the move ended");
         assert!(idle < 6000, "idle after {idle} ms");
+        let done = done_at.expect("the move reported Done");
+        eprintln!("to {target}: Done after {done} ms");
+        assert!(done >= idle + 200);
         // Within the target window, standing: 0.2 mm (the library's default fMonTargetRange is
         // 1.0 mm). The controller's output must pass the overlap, which the compensation
         // ramps in only above creep speed: below an error of about 0.1 mm here (and the

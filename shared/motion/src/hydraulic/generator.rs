@@ -15,7 +15,10 @@
 //! 4. **creep** at `fCreepSpeed` (`iTcHydStateCreepVeloP/M`) until the remaining distance is
 //!    below the braking distance `fBrakeDistance + fBrakeDeadTime·|v_act|`;
 //! 5. **idle** (`iTcHydStateIdle`): the set velocity 0 and the set position the target, for the
-//!    position controller at standstill.
+//!    position controller at standstill; or, with `fTargetClamping`, that output (V) with the
+//!    sign of the approach and no position control (a pressing axis); with `fReposDistance`, an
+//!    automatic start of a positioning to the same target once the actual position is further
+//!    from it than that.
 //!
 //! The arithmetic is inferred from that description and stated: the brake point is the remaining
 //! distance `fCreepDistance + (v_travel² - v_creep²) / (2·dec)` (where a ramp at `dec` from the
@@ -114,12 +117,18 @@ pub struct GeneratorParams {
     pub stop_ramp: f64,
     /// `fEmergencyRamp` (s, > 0): an emergency stop's ramp from `fRefVelo` to 0.
     pub emergency_ramp: f64,
+    /// `fTargetClamping` (V, 0..10): when greater than 0, at the target this output is given
+    /// with the sign of the approach and the position control is suppressed (a pressing axis).
+    pub target_clamping: f64,
+    /// `fReposDistance` (mm, >= 0): when greater than 0, an idle axis further than this from
+    /// its target starts a positioning to it again by itself.
+    pub repos_distance: f64,
 }
 
 impl Default for GeneratorParams {
     /// The library's defaults: `fRefVelo` and `fMaxVelo` 500 mm/s, `fAcc`/`fDec` 2000 mm/s²,
     /// `fMaxAcc`/`fMaxDec` 500 mm/s², creep 80 mm/s from 1.0 mm, brake distance 0.1 mm, no dead
-    /// time, stop ramp 1.0 s, emergency ramp 0.1 s.
+    /// time, stop ramp 1.0 s, emergency ramp 0.1 s, no target clamping, no repositioning.
     fn default() -> Self {
         let approach = Approach {
             creep_speed: 80.0,
@@ -139,6 +148,8 @@ impl Default for GeneratorParams {
             asymmetrical: false,
             stop_ramp: 1.0,
             emergency_ramp: 0.1,
+            target_clamping: 0.0,
+            repos_distance: 0.0,
         }
     }
 }
@@ -177,6 +188,12 @@ pub struct Setpoint {
     pub state: HydState,
     /// The direction of the motion (`true`: positive).
     pub positive: bool,
+    /// `fClampingOutput` (V): at the target with `fTargetClamping`, that output with the sign
+    /// of the approach; 0 otherwise.
+    pub clamping_output: f64,
+    /// The position controller acts (idle at the target without target clamping; the library's
+    /// displacement mode closes the loop only at standstill).
+    pub position_control: bool,
 }
 
 /// A move the generator runs (the command's values, already limited by the parameters).
@@ -202,6 +219,8 @@ pub struct CtrlBasedGenerator {
     mv: Move,
     /// A move in the other direction waits for the stop ramp.
     reverse_pending: bool,
+    /// Automatic starts by `fReposDistance`.
+    repositioned: u64,
 }
 
 impl CtrlBasedGenerator {
@@ -231,11 +250,18 @@ impl CtrlBasedGenerator {
             ("fBrakeDistanceM", p.approach_m.brake_distance),
             ("fBrakeDeadTimeP", p.approach_p.brake_dead_time),
             ("fBrakeDeadTimeM", p.approach_m.brake_dead_time),
+            ("fReposDistance", p.repos_distance),
         ];
         for (name, value) in at_least_0 {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(GeneratorError::Invalid { name, value });
             }
+        }
+        if !(p.target_clamping.is_finite() && (0.0..=10.0).contains(&p.target_clamping)) {
+            return Err(GeneratorError::Invalid {
+                name: "fTargetClamping",
+                value: p.target_clamping,
+            });
         }
         if !x.is_finite() {
             return Err(GeneratorError::Invalid {
@@ -257,6 +283,7 @@ impl CtrlBasedGenerator {
                 brake_point: 0.0,
             },
             reverse_pending: false,
+            repositioned: 0,
         })
     }
 
@@ -268,6 +295,11 @@ impl CtrlBasedGenerator {
     /// The target of the running or last move (`fTargetPos`).
     pub fn target(&self) -> f64 {
         self.mv.target
+    }
+
+    /// Automatic starts by `fReposDistance` since creation.
+    pub fn repositioned(&self) -> u64 {
+        self.repositioned
     }
 
     /// The remaining distance at which the braking ramp of the running move begins.
@@ -371,11 +403,20 @@ impl CtrlBasedGenerator {
         if dt.is_finite() && dt > 0.0 && actual.is_finite() && actual_velocity.is_finite() {
             self.advance(dt, actual, actual_velocity);
         }
+        let idle = self.state == HydState::Idle;
         Setpoint {
             velocity: self.velocity,
             position: self.position,
             state: self.state,
             positive: self.positive,
+            clamping_output: if idle && self.p.target_clamping > 0.0 {
+                self.p
+                    .target_clamping
+                    .copysign(if self.positive { 1.0 } else { -1.0 })
+            } else {
+                0.0
+            },
+            position_control: idle && self.p.target_clamping == 0.0,
         }
     }
 
@@ -389,6 +430,15 @@ impl CtrlBasedGenerator {
             HydState::Idle => {
                 self.velocity = 0.0;
                 self.position = m.target;
+                let off = (actual - m.target).abs();
+                if self.p.repos_distance > 0.0 && off > self.p.repos_distance {
+                    // The automatic start: a positioning to the same target with the last
+                    // move's dynamics, from the actual position.
+                    self.positive = m.target >= actual;
+                    self.position = actual;
+                    self.state = HydState::TcAcc;
+                    self.repositioned += 1;
+                }
                 return;
             }
             HydState::TcDec | HydState::EmergencyBreak => {
@@ -637,6 +687,49 @@ mod tests {
             (99.4..99.41).contains(&before),
             "stopped creeping at {before}"
         );
+    }
+
+    #[test]
+    fn target_clamping_presses_with_the_sign_of_the_approach_without_position_control() {
+        let mut p = params();
+        p.target_clamping = 2.5;
+        let mut g = CtrlBasedGenerator::new(p, 50.0).unwrap();
+        g.move_absolute(0.0, 50.0, 0.0, 0.0, 50.0).unwrap();
+        let out = run(&mut g, 10_000);
+        let moving = &out[..out.len() - 1];
+        assert!(moving
+            .iter()
+            .all(|s| s.clamping_output == 0.0 && !s.position_control));
+        let last = out.last().unwrap();
+        assert_eq!(last.state, HydState::Idle);
+        assert_eq!((last.clamping_output, last.position_control), (-2.5, false));
+        // Without it: position control at the target.
+        let mut g = CtrlBasedGenerator::new(params(), 50.0).unwrap();
+        g.move_absolute(0.0, 50.0, 0.0, 0.0, 50.0).unwrap();
+        let last = *run(&mut g, 10_000).last().unwrap();
+        assert_eq!((last.clamping_output, last.position_control), (0.0, true));
+    }
+
+    #[test]
+    fn an_idle_axis_pushed_beyond_the_repositioning_distance_positions_again() {
+        let mut p = params();
+        p.repos_distance = 0.5;
+        let mut g = CtrlBasedGenerator::new(p, 0.0).unwrap();
+        g.move_absolute(10.0, 50.0, 0.0, 0.0, 0.0).unwrap();
+        run(&mut g, 10_000);
+        assert_eq!(g.state(), HydState::Idle);
+        // Pushed 0.4 mm: stays idle.
+        let s = g.step(DT, 9.6, 0.0);
+        assert_eq!((s.state, g.repositioned()), (HydState::Idle, 0));
+        // Pushed 0.6 mm: starts again towards the same target, and gets there.
+        g.step(DT, 9.4, 0.0);
+        assert_eq!(
+            (g.state(), g.repositioned(), g.target()),
+            (HydState::TcAcc, 1, 10.0)
+        );
+        let out = run(&mut g, 10_000);
+        assert!(out.iter().all(|s| s.velocity >= 0.0));
+        assert_eq!(out.last().unwrap().position, 10.0);
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! Built so far, pure and allocation-free, not yet an axis kind of its own:
 //! - [`generator`]: the displacement-based set value generator `iTcMc_ProfileCtrlBased` (start
 //!   ramp, travel, square-root braking ramp to creep speed, creep, idle; stops);
+//! - [`monitor`]: the target window monitoring (InTargRng, InTarget with its filter time, Done);
 //! - [`finish`]: the Finish stage, `MC_AxRtFinish_BkPlcMc` (sectional linearisation: feed
 //!   forward, area ratio, bend point, ramped overlap compensation, clamping output, offset) and
 //!   `MC_AxRtFinishLinear_BkPlcMc` (a characteristic curve);
@@ -13,4 +14,5 @@
 
 pub mod finish;
 pub mod generator;
+pub mod monitor;
 pub mod valve_table;
