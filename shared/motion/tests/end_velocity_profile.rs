@@ -236,3 +236,56 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(config(0xB1E4_D015))]
+
+    /// An end velocity above the velocity limit (blending into a faster job): |v| stays within
+    /// the limit until the final ramp, which ends exactly at (target, end velocity, 0).
+    #[test]
+    fn end_velocity_above_the_limit(
+        vel in 1.0f64..300.0,
+        acc in 10.0f64..5000.0,
+        jerk_sel in 0u8..3,
+        jerk_f in 5.0f64..200.0,
+        dist in 1.0f64..3000.0,
+        over in 1.01f64..3.0,
+        neg in any::<bool>(),
+    ) {
+        let jerk = if jerk_sel == 0 { 0.0 } else { acc * jerk_f };
+        let l = lim(vel, acc, acc, jerk);
+        let sign = if neg { -1.0 } else { 1.0 };
+        let w = sign * vel * over;
+        let target = sign * dist;
+        let p = plan_position_velocity(State::rest(0.0), target, w, &l).unwrap();
+        let raised = lim(vel * over, acc, acc, jerk);
+        check(&p, State::rest(0.0), &raised, target);
+        let e = p.end().v;
+        prop_assert!(e * w >= 0.0 && e.abs() <= w.abs() * (1.0 + 1e-12));
+        // With room for the final ramp, the requested end velocity exactly, and the velocity
+        // limit kept until the last ramp: the profile reaches |v| > vel only in its last
+        // (at most three) segments.
+        let jt = if jerk == 0.0 { 0.0 } else { acc / jerk };
+        let room = 2.0 * (w * w / (2.0 * acc) + w.abs() * jt);
+        if dist > room {
+            prop_assert!((e - w).abs() <= 1e-12 * w.abs(), "end velocity {e} instead of {w}");
+            let segs = p.segments();
+            let keep = segs.len().saturating_sub(3);
+            for s in &segs[..keep] {
+                prop_assert!(s.start.v.abs() <= vel * (1.0 + 1e-9));
+            }
+        }
+    }
+}
+
+#[test]
+fn blending_next_into_a_faster_job_known_answer() {
+    // Trapezoid: from rest to 1000 with vel 50, acc 10, end velocity 70: accelerate to 50 (125),
+    // cruise, accelerate 50 -> 70 over (70^2 - 50^2) / 20 = 120 ending at 1000.
+    let l = lim(50.0, 10.0, 10.0, 0.0);
+    let p = plan_position_velocity(State::rest(0.0), 1000.0, 70.0, &l).unwrap();
+    assert_eq!(p.end().v, 70.0);
+    // 5 s up, (1000 - 125 - 120) / 50 = 15.1 s cruise, 2 s to 70.
+    assert!((p.duration() - 22.1).abs() < 1e-9, "{}", p.duration());
+    check(&p, State::rest(0.0), &lim(70.0, 10.0, 10.0, 0.0), 1000.0);
+}

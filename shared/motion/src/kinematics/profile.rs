@@ -869,8 +869,8 @@ pub fn plan_velocity(start: State, target_v: f64, lim: &Limits) -> Result<Profil
 
 /// Plans a time-optimal profile from `start` to the target position `target`, reached with the
 /// velocity `end_v` and zero acceleration (PLCopen Motion Control Part 1, 'BufferMode': the
-/// seam of two blended jobs). `end_v = 0` is exactly [`plan_position`]; `|end_v|` above
-/// `lim.vel` is clamped to it.
+/// seam of two blended jobs). `end_v = 0` is exactly [`plan_position`]. An `|end_v|` above
+/// `lim.vel` is reached in the final ramp: the profile keeps `|v| <= lim.vel` until then.
 ///
 /// The families are those of [`plan_position`] with the end velocity `end_v` in place of rest:
 /// a direct ramp to `end_v`, a relaxed deceleration then the ramp, or a peak velocity (up to
@@ -894,15 +894,63 @@ pub fn plan_position_velocity(
     if !finite_state(&start) || !target.is_finite() || !end_v.is_finite() {
         return Err(ProfileError::NonFiniteInput);
     }
-    let w = end_v.abs().min(lim.vel);
-    if w == 0.0 {
+    let want = end_v.abs();
+    if want == 0.0 {
         return plan_position(start, target, lim);
     }
+    if want <= lim.vel {
+        return match plan_end(start, target, end_v, lim, None) {
+            Some(p) => Ok(p),
+            None => plan_position(start, target, lim),
+        };
+    }
+    // Inferred: an end velocity above the velocity limit (PLCopen mcBlendingNext/High into a
+    // faster job) is reached in the final ramp only: the job keeps to its limit until then.
+    // If the distance is too short for that, the profile runs under the end velocity as limit.
+    let sigma = if end_v < 0.0 { -1.0 } else { 1.0 };
+    let mut up = Builder::<0>::new(
+        State {
+            p: 0.0,
+            v: lim.vel,
+            a: 0.0,
+        },
+        lim,
+    );
+    up.vel_ramp(want);
+    let ramp = up.s.p;
+    if let Some(p) = plan_end(
+        start,
+        target - sigma * ramp,
+        sigma * lim.vel,
+        lim,
+        Some((target, end_v)),
+    ) {
+        return Ok(p);
+    }
+    let raised = Limits { vel: want, ..*lim };
+    match plan_end(start, target, end_v, &raised, None) {
+        Some(p) => Ok(p),
+        None => plan_position(start, target, lim),
+    }
+}
+
+/// [`plan_position_velocity`] with `0 < |end_v| <= lim.vel` (inputs checked); `then`: the
+/// profile goes on from `(target, end_v)` with a ramp to the final `(target, end velocity)`.
+/// `None` when no forward profile reaches the target with `a = 0` (or, with `then`, when the
+/// end velocity had to be changed).
+fn plan_end(
+    start: State,
+    target: f64,
+    end_v: f64,
+    lim: &Limits,
+    then: Option<(f64, f64)>,
+) -> Option<Profile> {
+    let w = end_v.abs().min(lim.vel);
     let vmax = lim.vel;
     // Mirrored so that the end velocity is positive.
     let sigma = if end_v < 0.0 { -1.0 } else { 1.0 };
     let rel = State { p: 0.0, ..start }.mirrored(sigma);
-    let goal = sigma * (target - start.p);
+    let goal = sigma * (then.map_or(target, |t| t.0) - start.p);
     let mut pre = Builder::<MAX_SEGMENTS>::new(rel, lim);
     if pre.v_nat() < -vmax {
         pre.vel_ramp(-vmax);
@@ -910,7 +958,7 @@ pub fn plan_position_velocity(
         recover(&mut pre, vmax);
     }
     let s0 = pre.s;
-    let d = goal - s0.p;
+    let d = sigma * (target - start.p) - s0.p;
     let sub = State { p: 0.0, ..s0 };
     let trap = pre.trapezoidal();
     let vn = if trap { s0.v } else { pre.v_nat() };
@@ -928,26 +976,31 @@ pub fn plan_position_velocity(
         },
         tol: 1e-13 * goal.abs().max(s0.p.abs()).max(w * w / lim.dec).max(1e-9),
     };
-    let Some((fam, x, cruise, w_end)) = ends.select() else {
-        return plan_position(start, target, lim);
-    };
+    let (fam, x, cruise, w_end) = ends.select()?;
     let mut b = pre;
     b.apply_end(fam, x, cruise, w_end);
+    let mut end = State {
+        p: target,
+        v: sigma * w_end,
+        a: 0.0,
+    };
+    if let Some((final_target, final_v)) = then {
+        if w_end != w {
+            return None;
+        }
+        b.vel_ramp(sigma * final_v);
+        end = State {
+            p: final_target,
+            v: final_v,
+            a: 0.0,
+        };
+    }
     let scale = goal.abs().max(s0.p.abs()).max(1e-9);
     if (b.s.p - goal).abs() > 1e-10 * scale || b.n > MAX_SEGMENTS {
-        // Not landed (a family was not monotonic where it was assumed to be): end at rest.
-        return plan_position(start, target, lim);
+        // Not landed (a family was not monotonic where it was assumed to be).
+        return None;
     }
-    Ok(finish(
-        b,
-        start.p,
-        sigma,
-        State {
-            p: target,
-            v: sigma * w_end,
-            a: 0.0,
-        },
-    ))
+    Some(finish(b, start.p, sigma, end))
 }
 
 /// The families of [`plan_position_velocity`] (mirrored frame, end velocity `w > 0`).
