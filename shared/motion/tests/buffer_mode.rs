@@ -80,7 +80,8 @@ fn run_to(r: &mut Rig, job: JobId, kind: JobEventKind, max: usize, vs: &mut Vec<
 
 #[test]
 fn append_stops_at_the_first_target_then_continues() {
-    // S7-Technology FB410 MC_MoveAbsolute, example "append": v1 = 50 to 1000, the second to
+    // S7-Technology V4.1 function manual, 6.2.6 'FB410 MC_MoveAbsolute - Absolute
+    // positioning', example "Append motion": v1 = 50 to 1000, the second to
     // 1500: the first decelerates to 0 at 1000 (Done_1), the second starts right after.
     let mut r = homed();
     let j1 = r
@@ -139,7 +140,7 @@ fn blend(mode: BufferMode, v2: f64, second: f64) -> (f64, f64) {
 
 #[test]
 fn blend_passes_the_seam_at_min_v1_v2_without_a_gap() {
-    // S7-Technology FB410 examples "overlay": 50 then 30: passes 1000 at 30; 50 then 70:
+    // S7-Technology V4.1 function manual, 6.2.6, examples "Overlay motion 1/2/3": 50 then 30: passes 1000 at 30; 50 then 70:
     // passes 1000 at 50; reversal (1000 then 700): passes 1000 at 0, no gap.
     let (v, vmin) = blend(BufferMode::BlendingLow, 30.0, 1500.0);
     assert!((v - 30.0).abs() < 1e-9, "{v}");
@@ -179,7 +180,8 @@ fn seam_velocity_of_each_blending_variant() {
 
 #[test]
 fn relative_append_counts_from_the_previous_target() {
-    // S7-Technology FB411 MC_MoveRelative examples: 1000 then 500 ends at 1500.
+    // S7-Technology V4.1 function manual, 6.2.7 'FB411 MC_MoveRelative - Relative
+    // positioning' examples: 1000 then 500 ends at 1500.
     let mut r = homed();
     r.cmd(buffered(rel(1000.0, s7(50.0)), BufferMode::Aborting))
         .unwrap();
@@ -193,7 +195,8 @@ fn relative_append_counts_from_the_previous_target() {
 
 #[test]
 fn move_additive_adds_to_the_running_target() {
-    // S7-Technology FB412 MC_MoveAdditive: a second MoveAdditive before the first finishes:
+    // S7-Technology V4.1 function manual, 6.2.8 'FB412 MC_MoveAdditive - Relative positioning
+    // to current target position': a second MoveAdditive before the first finishes:
     // target = first target + second distance.
     let mut r = homed();
     let d = dynamics(100.0, 1000.0, 1000.0, 10_000.0);
@@ -319,7 +322,8 @@ fn refusals_with_8055_counterpart_change_nothing() {
         current: false,
         position_controlled: true,
     };
-    // MoveVelocity cannot append to MoveVelocity (S7-Technology FB414 `Mode`).
+    // MoveVelocity cannot append to MoveVelocity (S7-Technology V4.1 function manual, 6.2.10
+    // 'FB 414 MC_MoveVelocity - Motion with speed preset', `Mode`).
     let mut r = homed();
     r.cmd(buffered(v(50.0), BufferMode::Aborting)).unwrap();
     r.step(5);

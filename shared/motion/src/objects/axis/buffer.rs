@@ -1,6 +1,9 @@
 //! Buffered and blended moves: the per-axis queue of pending jobs (PLCopen Motion Control Part 1,
-//! 'BufferMode'; S7-Technology `Mode` 1 append and 2 blend of FB410 MC_MoveAbsolute, FB411
-//! MC_MoveRelative, FB414 MC_MoveVelocity) and MC_MoveAdditive (FB412). A tandem extension: the
+//! 'BufferMode'; the `Mode` 1 append and 2 overlay of S7-Technology V4.1 function manual, 6.2.6
+//! 'FB410 MC_MoveAbsolute - Absolute positioning', 6.2.7 'FB411 MC_MoveRelative - Relative
+//! positioning' and 6.2.10 'FB 414 MC_MoveVelocity - Motion with speed preset') and
+//! MC_MoveAdditive (6.2.8 'FB412 MC_MoveAdditive - Relative positioning to current target
+//! position'). A tandem extension: the
 //! S7-1500T Motion Control V4.0 function manual has no BufferMode (3.4 'No buffering or blending
 //! in V4.0'); with [`BufferMode::Aborting`] (the default) every job behaves exactly as before.
 //!
@@ -10,8 +13,9 @@
 //! # Rules (each one in docs/override-tables.md)
 //! - A Buffered or blending job with no job running starts at once, as an aborting one.
 //! - It may only follow a MoveAbsolute, MoveRelative, MoveAdditive or MoveVelocity; not while a
-//!   synchronous operation is active or pending, nor behind MC_Halt (S7-Technology `8055`), nor a
-//!   MoveVelocity behind a MoveVelocity (S7-Technology FB414 `Mode`): [`ErrorId::BufferModeNotAllowed`].
+//!   synchronous operation is active or pending, nor behind MC_Halt (S7-Technology `8055`
+//!   "Latching motion not allowed in current state", 6.2.6), nor a MoveVelocity behind a
+//!   MoveVelocity (6.2.10, `Mode`): [`ErrorId::BufferModeNotAllowed`].
 //! - A full queue refuses it with [`ErrorId::NoJobMemory`] (S7-1500 `16#8014`, S7-Technology
 //!   `8005` "command memory full").
 //! - A job that aborts the running job (every aborting motion job, MC_Halt, MC_Stop, a
@@ -26,7 +30,7 @@
 //!   `Active` and continues from the seam state without a stop. Blending behind a MoveVelocity
 //!   acts as Buffered (there is no target to blend at).
 //! - Relative and additive distances of queued jobs count from the target of the job before
-//!   (S7-Technology MC_MoveRelative examples: 1000 then 500 ends at 1500); behind a
+//!   (S7-Technology 6.2.7 examples: 1000 then 500 ends at 1500); behind a
 //!   MoveVelocity, from the position where the job starts.
 
 use super::{Axis, Goal, MotionJob};

@@ -71,9 +71,10 @@ impl VelocityDirection {
 }
 
 /// `BufferMode` of the motion instructions (PLCopen Motion Control Part 1, 'BufferMode';
-/// S7-Technology `Mode` 0 override, 1 append, 2 blend). A tandem extension beyond S7-1500T
-/// Motion Control V4.0 (3.4 'No buffering or blending in V4.0'), whose jobs all act as
-/// [`BufferMode::Aborting`] (the default).
+/// `Mode` 0 override, 1 append, 2 overlay of S7-Technology V4.1 function manual, 6.2.6 'FB410
+/// MC_MoveAbsolute - Absolute positioning'). A tandem extension beyond the S7-1500T Motion
+/// Control V4.0 function manual, which has none (every job acts as [`BufferMode::Aborting`],
+/// the default).
 ///
 /// The seam velocity of the blending modes is taken from the commanded velocities `v1` of the
 /// job before and `v2` of the queued job; it is 0 when the direction reverses at the seam.
@@ -373,7 +374,8 @@ pub enum Command {
         /// Dynamics.
         dynamics: Dynamics,
     },
-    /// `MC_MoveAdditive` (S7-Technology FB412; PLCopen Motion Control Part 1): the new target
+    /// `MC_MoveAdditive` (S7-Technology V4.1 function manual, 6.2.8 'FB412 MC_MoveAdditive -
+    /// Relative positioning to current target position'; PLCopen Motion Control Part 1): the new target
     /// is the target of the running positioning job plus `distance`; with no positioning job
     /// running (standstill, a velocity job) it acts as MC_MoveRelative.
     #[doc(alias = "MC_MoveAdditive")]
