@@ -54,3 +54,24 @@ fn buffer_mode_by_name_or_number() {
     let bad = entry("buffer_mode = 9").unwrap_err();
     assert!(bad.contains("0..5"), "{bad}");
 }
+
+#[test]
+fn buffer_mode_on_the_command_line() {
+    // `tandem cmd main/slide MC_MoveRelative --distance 5 --buffer_mode BlendingLow` and the
+    // Zenoh command JSON (which becomes the same line) go through `parse_command`.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let cell = tandem_config::load(&root.join("config/example-cell.toml")).unwrap();
+    let params = |mode: &str| {
+        vec![
+            ("distance".to_string(), "5".to_string()),
+            ("buffer_mode".to_string(), mode.to_string()),
+        ]
+    };
+    let e =
+        script::parse_command(&cell, "slide", "MC_MoveRelative", &params("BlendingLow")).unwrap();
+    assert_eq!(e.action, queued(BufferMode::BlendingLow));
+    let e = script::parse_command(&cell, "slide", "MoveRelative", &params("1")).unwrap();
+    assert_eq!(e.action, queued(BufferMode::Buffered));
+    let bad = script::parse_command(&cell, "slide", "MoveRelative", &params("Often")).unwrap_err();
+    assert!(bad.to_string().contains("buffer_mode"), "{bad}");
+}
