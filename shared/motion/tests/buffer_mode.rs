@@ -536,3 +536,40 @@ proptest! {
         prop_assert!((queued - single).abs() <= 1e-9, "{queued} vs {single}");
     }
 }
+
+#[test]
+fn blend_into_a_velocity_job() {
+    // A MoveVelocity blended behind a positioning job: the positioning job passes its target at
+    // min(v1, v2) (Done there), the velocity job continues from it and reports InVelocity.
+    let mut r = homed();
+    let j1 = r
+        .cmd(buffered(abs(1000.0, s7(50.0)), BufferMode::Aborting))
+        .unwrap();
+    let v = BufferedMotion::MoveVelocity {
+        dynamics: s7(30.0),
+        direction: VelocityDirection::BySign,
+        current: false,
+        position_controlled: true,
+    };
+    let j2 = r.cmd(buffered(v, BufferMode::BlendingLow)).unwrap();
+    r.until(j1, JobEventKind::Done, 40_000);
+    let s = r.axis.status_value();
+    assert!((s.velocity - 30.0).abs() < 1e-9, "{}", s.velocity);
+    assert!((s.position - 1000.0).abs() <= 0.03 + 1e-9, "{}", s.position);
+    r.until(j2, JobEventKind::InVelocity, 10);
+    // Against the direction of travel: the seam is at rest.
+    let mut r = homed();
+    let j1 = r
+        .cmd(buffered(abs(100.0, s7(50.0)), BufferMode::Aborting))
+        .unwrap();
+    let back = BufferedMotion::MoveVelocity {
+        dynamics: s7(-30.0),
+        direction: VelocityDirection::BySign,
+        current: false,
+        position_controlled: true,
+    };
+    r.cmd(buffered(back, BufferMode::BlendingHigh)).unwrap();
+    r.until(j1, JobEventKind::Done, 40_000);
+    assert_eq!(r.axis.status_value().velocity, 0.0);
+    assert_eq!(r.axis.status_value().position, 100.0);
+}
