@@ -410,33 +410,48 @@ type Move = (f64, f64, f64, f64, usize);
 /// continuous, every Done at its target (at rest, or passing it at a blend). Returns the final
 /// position.
 fn run_sequence(moves: &[Move], modes: Option<BufferMode>) -> f64 {
+    run_sequence_with_delays(moves, modes, &[])
+}
+
+/// [`run_sequence`] with job `k` issued `delays[k]` cycles after job `k - 1` (while the jobs
+/// before move, so that blends replan a moving job; a job issued after the one before ended
+/// starts at once).
+fn run_sequence_with_delays(moves: &[Move], modes: Option<BufferMode>, delays: &[usize]) -> f64 {
     let mut r = homed();
-    let mut ids = Vec::new();
+    let mut ids: Vec<JobId> = Vec::new();
     let mut targets = Vec::new();
     let mut target = 0.0;
     let (mut vmax, mut amax, mut jmax) = (0.0f64, 0.0f64, 0.0f64);
-    for (k, &(dist, v, a, j, m)) in moves.iter().enumerate() {
-        let mode = match (k, modes) {
-            (0, _) => BufferMode::Aborting,
-            (_, Some(all)) => all,
-            (_, None) => MODES[m % MODES.len()],
-        };
-        let id = r
-            .cmd(buffered(rel(dist, dynamics(v, a, a, j)), mode))
-            .unwrap();
-        target += dist;
-        ids.push((id, mode));
-        targets.push(target);
+    for &(_, v, a, j, _) in moves {
         vmax = vmax.max(v);
         amax = amax.max(a);
         // A trapezoidal move may jump in acceleration.
         jmax = if j == 0.0 { f64::INFINITY } else { jmax.max(j) };
     }
-    let last = ids.last().unwrap().0;
     let dt = 0.001;
     let mut prev = r.axis.status_value();
-    let mut checked = 0;
+    let (mut checked, mut wait) = (0, 0);
     for _ in 0..200_000 {
+        // The next job when its delay has passed.
+        if let Some(&(dist, v, a, j, m)) = moves.get(ids.len()) {
+            let k = ids.len();
+            if wait >= delays.get(k).copied().unwrap_or(0) {
+                let mode = match (k, modes) {
+                    (0, _) => BufferMode::Aborting,
+                    (_, Some(all)) => all,
+                    (_, None) => MODES[m % MODES.len()],
+                };
+                ids.push(
+                    r.cmd(buffered(rel(dist, dynamics(v, a, a, j)), mode))
+                        .unwrap(),
+                );
+                target += dist;
+                targets.push(target);
+                wait = 0;
+                continue;
+            }
+            wait += 1;
+        }
         r.step(1);
         let s = r.axis.status_value();
         assert!(
@@ -460,7 +475,7 @@ fn run_sequence(moves: &[Move], modes: Option<BufferMode>) -> f64 {
         prev = s;
         // Every Done at its target: at rest inside the positioning window, or (at a blend)
         // passing it within one cycle's travel.
-        while let Some(&(id, _)) = ids.get(checked) {
+        while let Some(&id) = ids.get(checked) {
             let Some(e) = r
                 .events
                 .iter()
@@ -477,8 +492,7 @@ fn run_sequence(moves: &[Move], modes: Option<BufferMode>) -> f64 {
             );
             checked += 1;
         }
-        if r.has(last, JobEventKind::Done) {
-            assert_eq!(checked, moves.len());
+        if ids.len() == moves.len() && checked == moves.len() {
             assert!(r.events.iter().all(|e| !matches!(
                 e.kind,
                 JobEventKind::CommandAborted | JobEventKind::Error(_)
@@ -528,6 +542,17 @@ proptest! {
         prop_assert!((end - sum).abs() <= 1e-9, "{end} vs {sum}");
     }
 
+    /// Jobs queued while the ones before move (blends replan a moving job): the same checks.
+    #[test]
+    fn jobs_queued_while_moving_keep_limits_and_reach_each_target(
+        ms in moves(),
+        delays in proptest::collection::vec(0usize..400, 5),
+    ) {
+        let end = run_sequence_with_delays(&ms, None, &delays);
+        let sum: f64 = ms.iter().fold(0.0, |acc, m| acc + m.0);
+        prop_assert!((end - sum).abs() <= 1e-9, "{end} vs {sum}");
+    }
+
     /// A Buffered sequence ends where the sequence of single moves ends.
     #[test]
     fn buffered_sequence_ends_where_single_moves_end(ms in moves()) {
@@ -572,4 +597,34 @@ fn blend_into_a_velocity_job() {
     r.until(j1, JobEventKind::Done, 40_000);
     assert_eq!(r.axis.status_value().velocity, 0.0);
     assert_eq!(r.axis.status_value().position, 100.0);
+}
+
+#[test]
+fn seams_between_queued_jobs() {
+    // Three jobs queued at once: 1000 at 50, +500 at 30, +500 at 60, blended with BlendingLow
+    // then BlendingNext: the first seam at min(50, 30) = 30, the second (between two queued
+    // jobs) at 60.
+    let mut r = homed();
+    let j1 = r
+        .cmd(buffered(rel(1000.0, s7(50.0)), BufferMode::Aborting))
+        .unwrap();
+    let j2 = r
+        .cmd(buffered(rel(500.0, s7(30.0)), BufferMode::BlendingLow))
+        .unwrap();
+    let j3 = r
+        .cmd(buffered(rel(500.0, s7(60.0)), BufferMode::BlendingNext))
+        .unwrap();
+    assert_eq!(r.axis.queue_depth(), 2);
+    r.until(j1, JobEventKind::Done, 60_000);
+    assert!((r.axis.status_value().velocity - 30.0).abs() < 1e-9);
+    r.until(j2, JobEventKind::Done, 60_000);
+    let s = r.axis.status_value();
+    assert!((s.velocity - 60.0).abs() < 1e-9, "{}", s.velocity);
+    assert!((s.position - 1500.0).abs() <= 0.06 + 1e-9, "{}", s.position);
+    assert_eq!(
+        at(&r, j3, JobEventKind::Active),
+        at(&r, j2, JobEventKind::Done)
+    );
+    r.until(j3, JobEventKind::Done, 60_000);
+    assert_eq!(r.axis.status_value().position, 2000.0);
 }
