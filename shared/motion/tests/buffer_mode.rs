@@ -628,3 +628,47 @@ fn seams_between_queued_jobs() {
     r.until(j3, JobEventKind::Done, 60_000);
     assert_eq!(r.axis.status_value().position, 2000.0);
 }
+
+#[test]
+fn queued_absolute_moves_on_a_modulo_axis_go_on_from_the_target_before() {
+    // Modulo 0..360: to 350 in the positive direction, then 10 in the positive direction
+    // blended: over 360, ending at 370 continuous (10 shown), passing 350 at min(v1, v2)
+    // without a stop.
+    let mut cfg = AxisConfig::example(0.001);
+    cfg.modulo = Some(tandem_motion::kinematics::modulo::Modulo {
+        start: 0.0,
+        length: 360.0,
+    });
+    let mut r = Rig::enabled(cfg);
+    let h = r
+        .cmd(Command::Home {
+            mode: 0,
+            position: 0.0,
+        })
+        .unwrap();
+    r.until(h, JobEventKind::Done, 10);
+    let d = dynamics(100.0, 1000.0, 1000.0, 10_000.0);
+    let j1 = r
+        .cmd(Command::MoveAbsolute {
+            position: 350.0,
+            dynamics: d,
+            direction: Direction::Positive,
+        })
+        .unwrap();
+    let j2 = r
+        .cmd(buffered(
+            BufferedMotion::MoveAbsolute {
+                position: 10.0,
+                dynamics: dynamics(40.0, 1000.0, 1000.0, 10_000.0),
+                direction: Direction::Positive,
+            },
+            BufferMode::BlendingLow,
+        ))
+        .unwrap();
+    r.until(j1, JobEventKind::Done, 10_000);
+    assert!((r.axis.status_value().velocity - 40.0).abs() < 1e-9);
+    r.until(j2, JobEventKind::Done, 10_000);
+    let s = r.axis.status_value();
+    assert_eq!(s.position_unwrapped, 370.0);
+    assert!((s.position - 10.0).abs() < 1e-9, "{}", s.position);
+}
