@@ -882,6 +882,10 @@ pub fn plan_velocity(start: State, target_v: f64, lim: &Limits) -> Result<Profil
 /// to `end_v` (lower when the axis cannot speed up enough, higher when it cannot slow down
 /// enough); when no forward profile reaches the target with `a = 0` at all, the profile ends at
 /// rest as [`plan_position`] plans it. [`Profile::end`] tells the velocity actually planned.
+///
+/// Not proven time-optimal in one corner: speeding up to an end velocity above the released
+/// velocity searches only the peak family (no "relaxed acceleration" family, the mirror of the
+/// relaxed brake); the profile is within the limits and exact, possibly not the fastest.
 #[doc(alias = "BufferMode")]
 #[doc(alias = "mcBlendingLow")]
 pub fn plan_position_velocity(
