@@ -7,8 +7,8 @@
 use core::fmt;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
-    ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
-    SyncProfileReference, VelocityDirection,
+    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, StartMode, StopMode,
+    SyncDirection, SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::objects::leading::LeaderId;
 
@@ -29,6 +29,11 @@ pub struct InstructionSpec {
     /// Parameters: name and default (`None` = required).
     pub params: &'static [(&'static str, Option<Value>)],
 }
+
+/// `BufferMode` (PLCopen Motion Control Part 1): 0 Aborting (default) .. 5 BlendingHigh; a
+/// script or command line may also give the name (`buffer_mode = "BlendingLow"`), see
+/// [`named_value`].
+const BUFFER_MODE: (&str, Option<Value>) = ("buffer_mode", Some(Value::Num(0.0)));
 
 const DYN: [(&str, Option<Value>); 4] = [
     ("velocity", Some(Value::Num(-1.0))),
@@ -83,11 +88,30 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             DYN[2],
             DYN[3],
             ("direction", Some(Value::Num(1.0))),
+            BUFFER_MODE,
         ],
     },
     InstructionSpec {
         name: "MC_MoveRelative",
-        params: &[("distance", None), DYN[0], DYN[1], DYN[2], DYN[3]],
+        params: &[
+            ("distance", None),
+            DYN[0],
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            BUFFER_MODE,
+        ],
+    },
+    InstructionSpec {
+        name: "MC_MoveAdditive",
+        params: &[
+            ("distance", None),
+            DYN[0],
+            DYN[1],
+            DYN[2],
+            DYN[3],
+            BUFFER_MODE,
+        ],
     },
     InstructionSpec {
         name: "MC_MoveVelocity",
@@ -99,6 +123,7 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("direction", Some(Value::Num(0.0))),
             ("current", Some(Value::Bool(false))),
             ("position_controlled", Some(Value::Bool(true))),
+            BUFFER_MODE,
         ],
     },
     InstructionSpec {
@@ -529,6 +554,15 @@ impl Args<'_> {
             })
     }
 
+    /// `buffer_mode`: the PLCopen number (a name was mapped to it by [`named_value`]).
+    fn buffer_mode(&self) -> Result<BufferMode, CommandError> {
+        BufferMode::from_code(self.code("buffer_mode")?).ok_or(CommandError::BadValue {
+            instruction: self.spec.name,
+            param: "buffer_mode",
+            allowed: BUFFER_MODES,
+        })
+    }
+
     fn dynamics_no_velocity(&self) -> Result<Dynamics, CommandError> {
         Ok(Dynamics {
             velocity: -1.0,
@@ -564,6 +598,32 @@ impl Args<'_> {
             self.code("ratio_numerator")?,
             self.code("ratio_denominator")?,
         ))
+    }
+}
+
+/// The values `buffer_mode` accepts.
+const BUFFER_MODES: &str = "0..5 or Aborting, Buffered, BlendingLow, BlendingPrevious, \
+     BlendingNext, BlendingHigh";
+
+/// The number a parameter given as a name stands for: `buffer_mode = "BlendingLow"` is 2 (the
+/// PLCopen names, with or without `mc`, and S7-Technology's `override`, `append`, `blend`).
+/// `None` for other parameters and unknown names (the value is then refused as not a number).
+pub fn named_value(param: &str, name: &str) -> Option<Value> {
+    match param {
+        "buffer_mode" => BufferMode::from_name(name).map(|m| Value::Num(f64::from(m.code()))),
+        _ => None,
+    }
+}
+
+/// A queued motion job, or the plain command for [`BufferMode::Aborting`] (unchanged).
+fn with_buffer_mode(motion: BufferedMotion, buffer_mode: BufferMode) -> Command {
+    if buffer_mode == BufferMode::Aborting {
+        motion.aborting()
+    } else {
+        Command::Buffered {
+            motion,
+            buffer_mode,
+        }
     }
 }
 
@@ -773,23 +833,39 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
             deceleration: a.num("deceleration")?,
             jerk: a.num("jerk")?,
         },
-        "MC_MoveAbsolute" => Command::MoveAbsolute {
-            position: a.num("position")?,
-            dynamics: a.dynamics("velocity")?,
-            direction: Direction::from_code(a.code("direction")?)
-                .ok_or(bad("direction", "1, 2 or 3"))?,
-        },
-        "MC_MoveRelative" => Command::MoveRelative {
-            distance: a.num("distance")?,
-            dynamics: a.dynamics("velocity")?,
-        },
-        "MC_MoveVelocity" => Command::MoveVelocity {
-            dynamics: a.dynamics("velocity")?,
-            direction: VelocityDirection::from_code(a.code("direction")?)
-                .ok_or(bad("direction", "0, 1 or 2"))?,
-            current: a.flag("current")?,
-            position_controlled: a.flag("position_controlled")?,
-        },
+        "MC_MoveAbsolute" => with_buffer_mode(
+            BufferedMotion::MoveAbsolute {
+                position: a.num("position")?,
+                dynamics: a.dynamics("velocity")?,
+                direction: Direction::from_code(a.code("direction")?)
+                    .ok_or(bad("direction", "1, 2 or 3"))?,
+            },
+            a.buffer_mode()?,
+        ),
+        "MC_MoveRelative" => with_buffer_mode(
+            BufferedMotion::MoveRelative {
+                distance: a.num("distance")?,
+                dynamics: a.dynamics("velocity")?,
+            },
+            a.buffer_mode()?,
+        ),
+        "MC_MoveAdditive" => with_buffer_mode(
+            BufferedMotion::MoveAdditive {
+                distance: a.num("distance")?,
+                dynamics: a.dynamics("velocity")?,
+            },
+            a.buffer_mode()?,
+        ),
+        "MC_MoveVelocity" => with_buffer_mode(
+            BufferedMotion::MoveVelocity {
+                dynamics: a.dynamics("velocity")?,
+                direction: VelocityDirection::from_code(a.code("direction")?)
+                    .ok_or(bad("direction", "0, 1 or 2"))?,
+                current: a.flag("current")?,
+                position_controlled: a.flag("position_controlled")?,
+            },
+            a.buffer_mode()?,
+        ),
         "MC_MoveJog" => Command::MoveJog {
             forward: a.flag("jog_forward")?,
             backward: a.flag("jog_backward")?,
@@ -883,6 +959,68 @@ mod tests {
                 .to_string()
                 .contains("integer")
         );
+    }
+
+    #[test]
+    fn buffer_mode_by_number_and_by_name() {
+        let c = parse(
+            "MC_MoveRelative",
+            &[
+                p("distance", Value::Num(5.0)),
+                p("buffer_mode", Value::Num(2.0)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::Buffered {
+                motion: BufferedMotion::MoveRelative {
+                    distance: 5.0,
+                    dynamics: Dynamics::DEFAULT
+                },
+                buffer_mode: BufferMode::BlendingLow
+            }
+        );
+        // Aborting (the default, 0) is the plain command.
+        let plain = parse(
+            "MC_MoveRelative",
+            &[
+                p("distance", Value::Num(5.0)),
+                p("buffer_mode", Value::Num(0.0)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            plain,
+            Command::MoveRelative {
+                distance: 5.0,
+                dynamics: Dynamics::DEFAULT
+            }
+        );
+        assert_eq!(
+            named_value("buffer_mode", "BlendingHigh"),
+            Some(Value::Num(5.0))
+        );
+        assert_eq!(
+            named_value("buffer_mode", "mcBuffered"),
+            Some(Value::Num(1.0))
+        );
+        assert_eq!(named_value("buffer_mode", "blend"), Some(Value::Num(2.0)));
+        assert_eq!(named_value("buffer_mode", "Sometimes"), None);
+        assert_eq!(named_value("direction", "Positive"), None);
+        assert!(parse(
+            "MC_MoveAdditive",
+            &[
+                p("distance", Value::Num(1.0)),
+                p("buffer_mode", Value::Num(6.0))
+            ],
+            Refs::default()
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("buffer_mode must be 0..5"));
     }
 
     #[test]

@@ -529,6 +529,9 @@ fn axis_instruction<'t>(
             Value::Bool(b)
         } else if let Some(x) = num(v) {
             Value::Num(x)
+        } else if let Some(named) = v.as_str().and_then(|n| command::named_value(k, n)) {
+            // A parameter given by name (`buffer_mode = "BlendingLow"`).
+            named
         } else {
             return Err(CommandError::WrongType {
                 instruction: None,

@@ -137,6 +137,9 @@ pub struct AxisState {
     pub sync: String,
     /// The running job, 0 for none.
     pub job: u32,
+    /// Jobs queued behind the running one (PLCopen `BufferMode`).
+    #[serde(default)]
+    pub queue_depth: u32,
 }
 
 impl AxisState {
@@ -166,6 +169,7 @@ impl AxisState {
             }
             .into(),
             job: a.job,
+            queue_depth: a.queue_depth,
         }
     }
 }

@@ -359,6 +359,8 @@ pub struct AxisTelemetry {
     pub following_error: f64,
     /// Velocity override (%).
     pub override_velocity: f64,
+    /// Jobs queued behind the running one (PLCopen `BufferMode`).
+    pub queue_depth: u32,
 }
 
 impl AxisTelemetry {
@@ -381,6 +383,7 @@ impl AxisTelemetry {
             actual_velocity: s.actual_velocity,
             following_error: s.following_error,
             override_velocity: s.override_velocity,
+            queue_depth: s.queue_depth,
         }
     }
 

@@ -2,7 +2,7 @@
 //!
 //! One variant per ErrorID of the S7-1500T Motion Control V4.0 function manual, appendix A.9
 //! A.9 'Error ID for Motion Control instructions', plus a small block of **tandem extensions** at
-//! `16#80F0`–`16#80F3`, a range that the reference does not use (S7-1500T Motion Control V4.0
+//! `16#80F0`–`16#80F4`, a range that the reference does not use (S7-1500T Motion Control V4.0
 //! function manual, A.9 'Error ID for Motion Control instructions' uses `16#8001`–`16#8076`,
 //! `16#80A1`–`16#80AE` and `16#8FFF`).
 //!
@@ -21,6 +21,7 @@
 //! | `16#80F1` | [`ErrorId::IllegalOverride`] | S7-1500 clamps `Override.Velocity` (a DIR tag, S7-1500T Motion Control V4.0 function manual, A.2.20 'Override tags (positioning axis/synchronous axis)'); tandem's job interface can also reject an override outside 0..200 %. |
 //! | `16#80F2` | [`ErrorId::NotHomed`] | S7-1500 reacts to MC_MoveAbsolute on an axis that is not homed with technology alarm 321 (E-stop, ErrorID `16#8001`, S7-1500T Motion Control V4.0 function manual, 10.5.1 'MC_MoveAbsolute: Position axis absolutely V4'); the reference has no plain ErrorID for it. This code is for a rejection without an alarm. |
 //! | `16#80F3` | [`ErrorId::JobRejectedInErrorStop`] | PLCopen ErrorStop: a motion job while a stopping technology alarm is pending and not acknowledged. S7-1500 has no own code for it; its manual only tells the user to check `ErrorDetail` before starting a job (S7-1500T Motion Control V4.0 function manual, 6.3 'Motion Control instructions'). |
+//! | `16#80F4` | [`ErrorId::BufferModeNotAllowed`] | S7-Technology rejects append and blend with `8055` while a synchronous operation or MC_Halt is active and a MoveVelocity appended to a MoveVelocity (S7-Technology V4.1 function manual, 6.2.6 'FB410 MC_MoveAbsolute - Absolute positioning', 6.2.10 'FB 414 MC_MoveVelocity - Motion with speed preset'); S7-1500 has no BufferMode (S7-1500T Motion Control V4.0 function manual, 3.4 'No buffering or blending in V4.0'), and tandem keeps its own codes in the free `16#80F0` block rather than take S7-Technology's number inside the reference's range. A full queue is the reference's [`ErrorId::NoJobMemory`] (`16#8014`, S7-Technology `8005`). |
 //!
 //! Whether the axis reports a missing homing as alarm 321 (S7-compatible) or as
 //! [`ErrorId::NotHomed`] is the axis's choice. This module only defines the codes.
@@ -181,6 +182,15 @@ error_ids! {
         /// **Tandem extension.** PLCopen ErrorStop: a technology alarm with a stopping reaction
         /// (1..=5) is pending and not yet acknowledged with MC_Reset.
         JobRejectedInErrorStop = 0x80F3 => "Tandem extension: job rejected, a stopping technology alarm is pending (ErrorStop).",
+        /// **Tandem extension.** A Buffered or blending job (`BufferMode` 1..5) where the
+        /// references do not allow one: a synchronous operation is active or pending, the
+        /// running job is not a MoveAbsolute, MoveRelative, MoveAdditive or MoveVelocity (e.g.
+        /// MC_Halt), or a MoveVelocity behind a MoveVelocity. S7-Technology rejects these with
+        /// `8055` "Latching motion not allowed in current state" (S7-Technology V4.1 function
+        /// manual, 6.2.6 'FB410 MC_MoveAbsolute - Absolute positioning' and 6.2.10 'FB 414
+        /// MC_MoveVelocity - Motion with speed preset', `Mode`); S7-1500 has no BufferMode and
+        /// no code for it.
+        BufferModeNotAllowed = 0x80F4 => "Tandem extension: BufferMode not allowed now (synchronous operation, MC_Halt, or MoveVelocity behind MoveVelocity).",
         Unspecified = 0x8FFF => "Unspecified error.",
     }
 }
@@ -205,6 +215,7 @@ impl ErrorId {
                 | ErrorId::IllegalOverride
                 | ErrorId::NotHomed
                 | ErrorId::JobRejectedInErrorStop
+                | ErrorId::BufferModeNotAllowed
         )
     }
 }
@@ -286,13 +297,13 @@ mod tests {
             assert_eq!(ErrorId::from_code(code), None);
         }
         // 73 codes in S7-1500T Motion Control V4.0 function manual, A.9 'Error ID for Motion
-        // Control instructions', plus 4 tandem extensions.
+        // Control instructions', plus 5 tandem extensions.
         let reference = ErrorId::ALL
             .iter()
             .filter(|e| !e.is_tandem_extension())
             .count();
         assert_eq!(reference, 73);
-        assert_eq!(ErrorId::ALL.len(), 77);
+        assert_eq!(ErrorId::ALL.len(), 78);
     }
 
     #[test]

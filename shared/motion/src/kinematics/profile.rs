@@ -867,6 +867,263 @@ pub fn plan_velocity(start: State, target_v: f64, lim: &Limits) -> Result<Profil
     ))
 }
 
+/// Plans a time-optimal profile from `start` to the target position `target`, reached with the
+/// velocity `end_v` and zero acceleration (PLCopen Motion Control Part 1, 'BufferMode': the
+/// seam of two blended jobs). `end_v = 0` is exactly [`plan_position`]. An `|end_v|` above
+/// `lim.vel` is reached in the final ramp: the profile keeps `|v| <= lim.vel` until then.
+///
+/// The families are those of [`plan_position`] with the end velocity `end_v` in place of rest:
+/// a direct ramp to `end_v`, a relaxed deceleration then the ramp, or a peak velocity (up to
+/// `lim.vel`, then a cruise) then the ramp down to `end_v`.
+///
+/// Inferred (the references do not say what happens when the seam velocity cannot be reached
+/// within the distance): the profile never reverses to make room for it. When the distance is
+/// too short to reach `end_v` going forward, the end velocity becomes the reachable one closest
+/// to `end_v` (lower when the axis cannot speed up enough, higher when it cannot slow down
+/// enough); when no forward profile reaches the target with `a = 0` at all, the profile ends at
+/// rest as [`plan_position`] plans it. [`Profile::end`] tells the velocity actually planned.
+///
+/// Not proven time-optimal in one corner: speeding up to an end velocity above the released
+/// velocity searches only the peak family (no "relaxed acceleration" family, the mirror of the
+/// relaxed brake); the profile is within the limits and exact, possibly not the fastest.
+#[doc(alias = "BufferMode")]
+#[doc(alias = "mcBlendingLow")]
+pub fn plan_position_velocity(
+    start: State,
+    target: f64,
+    end_v: f64,
+    lim: &Limits,
+) -> Result<Profile, ProfileError> {
+    check_limits(lim)?;
+    if !finite_state(&start) || !target.is_finite() || !end_v.is_finite() {
+        return Err(ProfileError::NonFiniteInput);
+    }
+    let want = end_v.abs();
+    if want == 0.0 {
+        return plan_position(start, target, lim);
+    }
+    if want <= lim.vel {
+        return match plan_end(start, target, end_v, lim, None) {
+            Some(p) => Ok(p),
+            None => plan_position(start, target, lim),
+        };
+    }
+    // Inferred: an end velocity above the velocity limit (PLCopen mcBlendingNext/High into a
+    // faster job) is reached in the final ramp only: the job keeps to its limit until then.
+    // If the distance is too short for that, the profile runs under the end velocity as limit.
+    let sigma = if end_v < 0.0 { -1.0 } else { 1.0 };
+    let mut up = Builder::<0>::new(
+        State {
+            p: 0.0,
+            v: lim.vel,
+            a: 0.0,
+        },
+        lim,
+    );
+    up.vel_ramp(want);
+    let ramp = up.s.p;
+    if let Some(p) = plan_end(
+        start,
+        target - sigma * ramp,
+        sigma * lim.vel,
+        lim,
+        Some((target, end_v)),
+    ) {
+        return Ok(p);
+    }
+    let raised = Limits { vel: want, ..*lim };
+    match plan_end(start, target, end_v, &raised, None) {
+        Some(p) => Ok(p),
+        None => plan_position(start, target, lim),
+    }
+}
+
+/// [`plan_position_velocity`] with `0 < |end_v| <= lim.vel` (inputs checked); `then`: the
+/// profile goes on from `(target, end_v)` with a ramp to the final `(target, end velocity)`.
+/// `None` when no forward profile reaches the target with `a = 0` (or, with `then`, when the
+/// end velocity had to be changed).
+fn plan_end(
+    start: State,
+    target: f64,
+    end_v: f64,
+    lim: &Limits,
+    then: Option<(f64, f64)>,
+) -> Option<Profile> {
+    let w = end_v.abs().min(lim.vel);
+    let vmax = lim.vel;
+    // Mirrored so that the end velocity is positive.
+    let sigma = if end_v < 0.0 { -1.0 } else { 1.0 };
+    let rel = State { p: 0.0, ..start }.mirrored(sigma);
+    let goal = sigma * (then.map_or(target, |t| t.0) - start.p);
+    let mut pre = Builder::<MAX_SEGMENTS>::new(rel, lim);
+    if pre.v_nat() < -vmax {
+        pre.vel_ramp(-vmax);
+    } else {
+        recover(&mut pre, vmax);
+    }
+    let s0 = pre.s;
+    let d = sigma * (target - start.p) - s0.p;
+    let sub = State { p: 0.0, ..s0 };
+    let trap = pre.trapezoidal();
+    let vn = if trap { s0.v } else { pre.v_nat() };
+    let ends = EndChoice {
+        sub,
+        lim,
+        d,
+        w,
+        vn,
+        vmax,
+        tau_max: if !trap && s0.a < 0.0 && w < vn {
+            -s0.a / pre.jerk
+        } else {
+            0.0
+        },
+        tol: 1e-13 * goal.abs().max(s0.p.abs()).max(w * w / lim.dec).max(1e-9),
+    };
+    let (fam, x, cruise, w_end) = ends.select()?;
+    let mut b = pre;
+    b.apply_end(fam, x, cruise, w_end);
+    let mut end = State {
+        p: target,
+        v: sigma * w_end,
+        a: 0.0,
+    };
+    if let Some((final_target, final_v)) = then {
+        if w_end != w {
+            return None;
+        }
+        b.vel_ramp(sigma * final_v);
+        end = State {
+            p: final_target,
+            v: final_v,
+            a: 0.0,
+        };
+    }
+    let scale = goal.abs().max(s0.p.abs()).max(1e-9);
+    if (b.s.p - goal).abs() > 1e-10 * scale || b.n > MAX_SEGMENTS {
+        // Not landed (a family was not monotonic where it was assumed to be).
+        return None;
+    }
+    Some(finish(b, start.p, sigma, end))
+}
+
+/// The families of [`plan_position_velocity`] (mirrored frame, end velocity `w > 0`).
+#[derive(Copy, Clone)]
+enum EndFamily {
+    /// Ramp to the peak velocity `x`, cruise, then ramp to the end velocity (`x = w`: the
+    /// direct ramp).
+    Peak,
+    /// Release the deceleration for `x` seconds at full jerk, then ramp to the end velocity.
+    Relaxed,
+}
+
+impl<const N: usize> Builder<N> {
+    /// Appends the profile of `fam` with parameter `x` ending at velocity `w`, `a = 0`.
+    #[inline(always)]
+    fn apply_end(&mut self, fam: EndFamily, x: f64, cruise: f64, w: f64) {
+        match fam {
+            EndFamily::Peak => {
+                self.vel_ramp(x);
+                self.cruise(cruise);
+            }
+            EndFamily::Relaxed => self.push(self.jerk, x),
+        }
+        self.vel_ramp(w);
+    }
+}
+
+/// The choice of the family for [`plan_position_velocity`]: the distance `d` to go from `sub`
+/// (position 0), the end velocity `w > 0`, the released velocity `vn`.
+struct EndChoice<'a> {
+    sub: State,
+    lim: &'a Limits,
+    d: f64,
+    w: f64,
+    vn: f64,
+    vmax: f64,
+    /// The longest relaxation (> 0 only when decelerating towards an end velocity below `vn`).
+    tau_max: f64,
+    tol: f64,
+}
+
+impl EndChoice<'_> {
+    fn dist(&self, fam: EndFamily, x: f64, w: f64) -> f64 {
+        let mut b = Builder::<0>::new(self.sub, self.lim);
+        b.apply_end(fam, x, 0.0, w);
+        b.s.p
+    }
+
+    /// The distance of the direct ramp to the end velocity `w`.
+    fn direct(&self, w: f64) -> f64 {
+        self.dist(EndFamily::Peak, w, w)
+    }
+
+    /// `(family, parameter, cruise, end velocity)`, or `None` when no forward profile reaches
+    /// the target with `a = 0`.
+    fn select(&self) -> Option<(EndFamily, f64, f64, f64)> {
+        let (d, w, vn, vmax) = (self.d, self.w, self.vn, self.vmax);
+        let d_direct = self.direct(w);
+        if d < d_direct {
+            return self.reachable().map(|w2| (EndFamily::Peak, w2, 0.0, w2));
+        }
+        let lo = vn.max(w).min(vmax);
+        let d_lo = self.dist(EndFamily::Peak, lo, w);
+        if self.tau_max > 0.0 && d < d_lo {
+            let x = brent(
+                |x| self.dist(EndFamily::Relaxed, x, w) - d,
+                (0.0, self.tau_max),
+                (d_direct - d, d_lo - d),
+                self.tol,
+            )?;
+            return Some((EndFamily::Relaxed, x, 0.0, w));
+        }
+        let d_hi = self.dist(EndFamily::Peak, vmax, w);
+        if d >= d_hi {
+            return Some((EndFamily::Peak, vmax, (d - d_hi) / vmax, w));
+        }
+        if d <= d_lo {
+            return Some((EndFamily::Peak, lo, 0.0, w));
+        }
+        let x = brent(
+            |x| self.dist(EndFamily::Peak, x, w) - d,
+            (lo, vmax),
+            (d_lo - d, d_hi - d),
+            self.tol,
+        )?;
+        Some((EndFamily::Peak, x, 0.0, w))
+    }
+
+    /// The end velocity closest to `w` whose direct ramp ends exactly at `d` (the distance is
+    /// too short for `w`): lower than `w` when the axis cannot speed up to it, higher when it
+    /// cannot slow down to it. The direct ramp's distance is smallest at the released velocity.
+    fn reachable(&self) -> Option<f64> {
+        let (d, w) = (self.d, self.w);
+        let pivot = self.vn.max(0.0).min(self.vmax);
+        let d_pivot = self.direct(pivot);
+        if d < d_pivot {
+            return None;
+        }
+        let d_w = self.direct(w);
+        let w2 = if w > pivot {
+            brent(
+                |x| self.direct(x) - d,
+                (pivot, w),
+                (d_pivot - d, d_w - d),
+                self.tol,
+            )?
+        } else {
+            // Decreasing in the end velocity on [w, pivot]: solve the mirrored residual.
+            brent(
+                |x| d - self.direct(x),
+                (w, pivot),
+                (d - d_w, d - d_pivot),
+                self.tol,
+            )?
+        };
+        (w2 > 0.0).then_some(w2)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -30,6 +30,8 @@ pub enum Instruction {
     MoveRelative,
     /// `MC_MoveVelocity`.
     MoveVelocity,
+    /// `MC_MoveAdditive`.
+    MoveAdditive,
     /// `MC_MoveJog`.
     MoveJog,
     /// `MC_MoveSuperimposed`.
@@ -76,6 +78,7 @@ impl Instruction {
             Self::MoveAbsolute => "MC_MoveAbsolute",
             Self::MoveRelative => "MC_MoveRelative",
             Self::MoveVelocity => "MC_MoveVelocity",
+            Self::MoveAdditive => "MC_MoveAdditive",
             Self::MoveJog => "MC_MoveJog",
             Self::MoveSuperimposed => "MC_MoveSuperimposed",
             Self::SetOverride => "MC_SetOverride",
@@ -99,8 +102,11 @@ impl Instruction {
 /// What happened to a job.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum JobEventKind {
-    /// Accepted and running (`Busy`).
+    /// Accepted and running (`Busy`); a queued job (PLCopen `BufferMode`) is Busy while it
+    /// waits.
     Busy,
+    /// A queued job took over the axis (PLCopen `Active`).
+    Active,
     /// The target velocity is reached (`InVelocity`, velocity and jog jobs).
     InVelocity,
     /// The target velocity is left again (override change, stop of a jog).

@@ -70,6 +70,205 @@ impl VelocityDirection {
     }
 }
 
+/// `BufferMode` of the motion instructions (PLCopen Motion Control Part 1, 'BufferMode';
+/// `Mode` 0 override, 1 append, 2 overlay of S7-Technology V4.1 function manual, 6.2.6 'FB410
+/// MC_MoveAbsolute - Absolute positioning'). A tandem extension beyond the S7-1500T Motion
+/// Control V4.0 function manual, which has none (every job acts as [`BufferMode::Aborting`],
+/// the default).
+///
+/// The seam velocity of the blending modes is taken from the commanded velocities `v1` of the
+/// job before and `v2` of the queued job; it is 0 when the direction reverses at the seam.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Hash)]
+#[doc(alias = "MC_BUFFER_MODE")]
+pub enum BufferMode {
+    /// 0 `mcAborting` (S7-Technology Mode 0 "override"): starts at once, aborts the running job
+    /// and every queued one.
+    #[default]
+    #[doc(alias = "mcAborting")]
+    Aborting,
+    /// 1 `mcBuffered` (S7-Technology Mode 1 "append"): starts when the job before it is Done
+    /// (at rest at its target; a MoveVelocity before it: when InVelocity).
+    #[doc(alias = "mcBuffered")]
+    Buffered,
+    /// 2 `mcBlendingLow` (S7-Technology Mode 2 "blend"): passes the seam at `min(v1, v2)`.
+    #[doc(alias = "mcBlendingLow")]
+    BlendingLow,
+    /// 3 `mcBlendingPrevious`: passes the seam at `v1`.
+    #[doc(alias = "mcBlendingPrevious")]
+    BlendingPrevious,
+    /// 4 `mcBlendingNext`: passes the seam at `v2`.
+    #[doc(alias = "mcBlendingNext")]
+    BlendingNext,
+    /// 5 `mcBlendingHigh`: passes the seam at `max(v1, v2)`.
+    #[doc(alias = "mcBlendingHigh")]
+    BlendingHigh,
+}
+
+impl BufferMode {
+    /// Every mode, in PLCopen order (the index is [`BufferMode::code`]).
+    pub const ALL: [BufferMode; 6] = [
+        Self::Aborting,
+        Self::Buffered,
+        Self::BlendingLow,
+        Self::BlendingPrevious,
+        Self::BlendingNext,
+        Self::BlendingHigh,
+    ];
+
+    /// The PLCopen number (0 Aborting .. 5 BlendingHigh).
+    pub const fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// From the PLCopen number (0..=5).
+    pub fn from_code(c: i32) -> Option<Self> {
+        usize::try_from(c)
+            .ok()
+            .and_then(|i| Self::ALL.get(i).copied())
+    }
+
+    /// The PLCopen name without `mc` (`"BlendingLow"`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Aborting => "Aborting",
+            Self::Buffered => "Buffered",
+            Self::BlendingLow => "BlendingLow",
+            Self::BlendingPrevious => "BlendingPrevious",
+            Self::BlendingNext => "BlendingNext",
+            Self::BlendingHigh => "BlendingHigh",
+        }
+    }
+
+    /// From a name: the PLCopen one with or without `mc` in any case (`BlendingLow`,
+    /// `mcBlendingLow`, `blending_low`), or S7-Technology's `override`, `append`, `blend`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        let n: String = name
+            .chars()
+            .filter(|c| *c != '_' && *c != '-')
+            .flat_map(char::to_lowercase)
+            .collect();
+        let n = n.strip_prefix("mc").unwrap_or(&n);
+        match n {
+            "override" => return Some(Self::Aborting),
+            "append" => return Some(Self::Buffered),
+            "blend" => return Some(Self::BlendingLow),
+            _ => {}
+        }
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name().eq_ignore_ascii_case(n))
+    }
+
+    /// One of the four blending modes.
+    pub const fn is_blending(self) -> bool {
+        matches!(
+            self,
+            Self::BlendingLow | Self::BlendingPrevious | Self::BlendingNext | Self::BlendingHigh
+        )
+    }
+
+    /// The seam speed of a blending mode from the commanded speeds `v1` (the job before) and
+    /// `v2` (this job), both >= 0; 0 for the other modes.
+    pub fn seam_speed(self, v1: f64, v2: f64) -> f64 {
+        match self {
+            Self::BlendingLow => v1.min(v2),
+            Self::BlendingPrevious => v1,
+            Self::BlendingNext => v2,
+            Self::BlendingHigh => v1.max(v2),
+            Self::Aborting | Self::Buffered => 0.0,
+        }
+    }
+}
+
+/// A motion job that can be queued behind the running one ([`Command::Buffered`]).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum BufferedMotion {
+    /// `MC_MoveAbsolute`: `Position`, dynamics, `Direction` (modulo axes).
+    #[doc(alias = "MC_MoveAbsolute")]
+    MoveAbsolute {
+        /// `Position`.
+        position: f64,
+        /// Dynamics.
+        dynamics: Dynamics,
+        /// `Direction` (modulo axes only).
+        direction: Direction,
+    },
+    /// `MC_MoveRelative`: `Distance` from the target of the job before (from the position at
+    /// its start when the job before has no target).
+    #[doc(alias = "MC_MoveRelative")]
+    MoveRelative {
+        /// `Distance`.
+        distance: f64,
+        /// Dynamics.
+        dynamics: Dynamics,
+    },
+    /// `MC_MoveAdditive`: `Distance` added to the last commanded target.
+    #[doc(alias = "MC_MoveAdditive")]
+    MoveAdditive {
+        /// `Distance`.
+        distance: f64,
+        /// Dynamics.
+        dynamics: Dynamics,
+    },
+    /// `MC_MoveVelocity`.
+    #[doc(alias = "MC_MoveVelocity")]
+    MoveVelocity {
+        /// Dynamics (`Velocity` may be 0; its sign counts with `Direction` 0).
+        dynamics: Dynamics,
+        /// `Direction`.
+        direction: VelocityDirection,
+        /// `Current`: keep the velocity at job start.
+        current: bool,
+        /// `PositionControlled`.
+        position_controlled: bool,
+    },
+}
+
+impl BufferedMotion {
+    /// The same job as an aborting command.
+    pub fn aborting(self) -> Command {
+        match self {
+            Self::MoveAbsolute {
+                position,
+                dynamics,
+                direction,
+            } => Command::MoveAbsolute {
+                position,
+                dynamics,
+                direction,
+            },
+            Self::MoveRelative { distance, dynamics } => {
+                Command::MoveRelative { distance, dynamics }
+            }
+            Self::MoveAdditive { distance, dynamics } => {
+                Command::MoveAdditive { distance, dynamics }
+            }
+            Self::MoveVelocity {
+                dynamics,
+                direction,
+                current,
+                position_controlled,
+            } => Command::MoveVelocity {
+                dynamics,
+                direction,
+                current,
+                position_controlled,
+            },
+        }
+    }
+
+    /// The job's dynamics.
+    pub fn dynamics(&self) -> &Dynamics {
+        match self {
+            Self::MoveAbsolute { dynamics, .. }
+            | Self::MoveRelative { dynamics, .. }
+            | Self::MoveAdditive { dynamics, .. }
+            | Self::MoveVelocity { dynamics, .. } => dynamics,
+        }
+    }
+}
+
 /// `SyncProfileReference` of MC_GearInPos.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum SyncProfileReference {
@@ -174,6 +373,25 @@ pub enum Command {
         distance: f64,
         /// Dynamics.
         dynamics: Dynamics,
+    },
+    /// `MC_MoveAdditive` (S7-Technology V4.1 function manual, 6.2.8 'FB412 MC_MoveAdditive -
+    /// Relative positioning to current target position'; PLCopen Motion Control Part 1): the new target
+    /// is the target of the running positioning job plus `distance`; with no positioning job
+    /// running (standstill, a velocity job) it acts as MC_MoveRelative.
+    #[doc(alias = "MC_MoveAdditive")]
+    MoveAdditive {
+        /// `Distance`.
+        distance: f64,
+        /// Dynamics.
+        dynamics: Dynamics,
+    },
+    /// A motion job with a `BufferMode` ([`BufferMode::Aborting`] is the plain command).
+    #[doc(alias = "BufferMode")]
+    Buffered {
+        /// The job.
+        motion: BufferedMotion,
+        /// `BufferMode`.
+        buffer_mode: BufferMode,
     },
     /// `MC_MoveVelocity`.
     #[doc(alias = "MC_MoveVelocity")]

@@ -7,15 +7,17 @@
 //! Positions are kept continuous (unwrapped) inside; modulo positions are what the status shows.
 
 mod adjustment;
+mod buffer;
 mod command;
 mod config;
 mod step;
 mod sync;
 
 pub use adjustment::{AbsoluteOffset, RestoreOffsetError};
+pub use buffer::JOB_QUEUE_CAPACITY;
 pub use command::{
-    ApplicationMode, CamId, Command, Direction, StartMode, StopMode, SyncDirection,
-    SyncProfileReference, VelocityDirection,
+    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, StartMode, StopMode,
+    SyncDirection, SyncProfileReference, VelocityDirection,
 };
 pub use config::{
     AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
@@ -29,7 +31,9 @@ use crate::catalog::override_table::{table1, NewJob, RunningMotion};
 use crate::kinematics::dynamics::{Clamped, Dynamics};
 use crate::kinematics::extrapolation::{Extrapolated, Extrapolator};
 use crate::kinematics::modulo::Modulo;
-use crate::kinematics::profile::{plan_position, plan_velocity, Limits, Profile, State};
+use crate::kinematics::profile::{
+    plan_position, plan_position_velocity, plan_velocity, Limits, Profile, State,
+};
 use crate::objects::job::{EventQueue, Instruction, JobEvent, JobEventKind, JobId};
 use crate::objects::leading::LeadingValue;
 use crate::plant::link::{AxisSignals, DriveInputs, DriveLink, DriveOutputs, SimPlant};
@@ -120,6 +124,9 @@ pub struct AxisStatus {
     pub sync_status_word: u8,
     /// `StatusSynchronizedMotion.PhaseShift`.
     pub phase_shift: f64,
+    /// Jobs queued behind the running one (PLCopen `BufferMode`), at most
+    /// [`JOB_QUEUE_CAPACITY`].
+    pub queue_depth: u32,
 }
 
 /// The values of [`AxisStatus::sync_function`] (`StatusSynchronizedMotion.FunctionState`), as
@@ -160,8 +167,13 @@ impl AxisStatus {
 enum Goal {
     /// Hold the current position.
     Hold,
-    /// To rest at `target` (continuous coordinates); velocity scaled by the override.
-    Position { target: f64, lim: Limits },
+    /// To `target` (continuous coordinates), at rest or, blending into a queued job, passing it
+    /// at `end_v` (signed); velocities scaled by the override.
+    Position {
+        target: f64,
+        lim: Limits,
+        end_v: f64,
+    },
     /// To the velocity `v` (scaled by the override).
     Velocity { v: f64, lim: Limits },
     /// To standstill, not scaled by the override.
@@ -345,6 +357,8 @@ pub struct Axis {
     next_id: JobId,
     /// The absolute encoder adjustment (MC_Home 6/7), retained by the runtime.
     absolute: AbsoluteOffset,
+    /// Jobs queued behind `main` (PLCopen BufferMode); read only when a job ends.
+    queue: buffer::JobQueue,
 }
 
 fn sign(x: f64) -> f64 {
@@ -428,6 +442,7 @@ impl Axis {
             prev_phys: p0,
             events: EventQueue::default(),
             next_id: 1,
+            queue: buffer::JobQueue::default(),
             now: 0,
             status: OnceCell::new(),
             status_kept: Cell::new(false),
@@ -647,8 +662,18 @@ impl Axis {
                 self.basic = State { a: 0.0, ..s };
                 Ok(Profile::hold(self.basic))
             }
-            Goal::Position { target, lim } => {
-                if ovr > 0.0 {
+            Goal::Position { target, lim, end_v } => {
+                if ovr > 0.0 && end_v != 0.0 {
+                    plan_position_velocity(
+                        s,
+                        target,
+                        end_v * ovr,
+                        &Limits {
+                            vel: lim.vel * ovr,
+                            ..lim
+                        },
+                    )
+                } else if ovr > 0.0 {
                     plan_position(
                         s,
                         target,
@@ -744,6 +769,11 @@ impl Axis {
             // function manual, 6.2.3 'FB404 MC_Stop - Stopping an axis and preventing new motion
             // commands': "even across disable/re-enable"); only releasing it unlocks the axis.
             self.emit(m.id, m.instr, how);
+        }
+        // The jobs queued behind it end with it (PLCopen BufferMode: an aborting job aborts
+        // the queue).
+        if !self.queue.is_empty() {
+            self.abort_queued(how);
         }
     }
 
@@ -967,6 +997,17 @@ impl Axis {
                     ax.basic.p + distance
                 })
             }
+            Command::MoveAdditive { distance, dynamics } => {
+                // The target of the running positioning job, taken before it is aborted.
+                let base = self.running_target();
+                self.cmd_positioning(Instruction::MoveAdditive, distance, &dynamics, |ax, _| {
+                    base.unwrap_or(ax.basic.p) + distance
+                })
+            }
+            Command::Buffered {
+                motion,
+                buffer_mode,
+            } => self.cmd_buffered(&motion, buffer_mode),
             Command::MoveVelocity {
                 dynamics,
                 direction,
@@ -1174,7 +1215,15 @@ impl Axis {
         self.force_position_control();
         let target = target(self, &r.limits);
         let lim = r.limits;
-        Ok(self.start_main(instr, lim, Goal::Position { target, lim }))
+        Ok(self.start_main(
+            instr,
+            lim,
+            Goal::Position {
+                target,
+                lim,
+                end_v: 0.0,
+            },
+        ))
     }
 
     fn force_position_control(&mut self) {
@@ -1684,6 +1733,7 @@ impl Axis {
             } => *p += delta,
             _ => {}
         }
+        self.queue.shift(delta);
         if let Some(m) = self.main.as_mut() {
             if let Some(pm) = m.monitoring.as_mut() {
                 pm.target += delta;

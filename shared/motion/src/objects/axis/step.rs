@@ -371,7 +371,11 @@ impl Axis {
                 vel: self.cfg.homing.approach_velocity,
                 ..job.lim
             };
-            new_goal = Some(Goal::Position { target, lim });
+            new_goal = Some(Goal::Position {
+                target,
+                lim,
+                end_v: 0.0,
+            });
         }
         if let Some(m) = self.main.as_mut() {
             m.homing = Some(h);
@@ -537,6 +541,10 @@ impl Axis {
             return;
         };
         let ovr_stopped = self.override_pct == 0.0 && matches!(self.goal, Goal::Position { .. });
+        if !self.queue.is_empty() && self.queue_takes_over(&m, ovr_stopped) {
+            self.hand_over(m);
+            return;
+        }
         match (m.instr, self.goal) {
             (Instruction::MoveVelocity | Instruction::MoveJog, Goal::Velocity { .. })
                 if finished && !m.in_velocity =>
@@ -555,6 +563,7 @@ impl Axis {
             (
                 Instruction::MoveAbsolute
                 | Instruction::MoveRelative
+                | Instruction::MoveAdditive
                 | Instruction::Halt
                 | Instruction::Home,
                 Goal::Position { target: _, .. } | Goal::Stop { .. },
@@ -602,7 +611,10 @@ impl Axis {
     fn finish_main(&mut self, id: crate::objects::job::JobId, instr: Instruction) {
         self.main = None;
         self.emit(id, instr, JobEventKind::Done);
-        self.set_goal(Goal::Hold);
+        // A Buffered job waiting behind it starts now (PLCopen BufferMode).
+        if self.queue.is_empty() || !self.start_queued() {
+            self.set_goal(Goal::Hold);
+        }
     }
 
     fn pm_inside(&self, target: f64) -> bool {
@@ -725,6 +737,7 @@ impl Axis {
                 0
             },
             phase_shift: self.phase.p,
+            queue_depth: self.queue.len() as u32,
         }
     }
 
@@ -759,7 +772,11 @@ impl Axis {
                 status_bit::POSITIONING_COMMAND,
                 matches!(
                     main,
-                    Some(Instruction::MoveAbsolute | Instruction::MoveRelative)
+                    Some(
+                        Instruction::MoveAbsolute
+                            | Instruction::MoveRelative
+                            | Instruction::MoveAdditive
+                    )
                 ),
             )
             | bit(status_bit::JOG_COMMAND, main == Some(Instruction::MoveJog))
