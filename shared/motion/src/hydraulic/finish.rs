@@ -38,6 +38,7 @@
 //!
 //! Pure: no IO, no clock, no allocation.
 
+use crate::catalog::hyd_error::HydErrorCode;
 use crate::hydraulic::valve_table::ValveTable;
 
 /// Full scale of the valve output in volts (the normalised output ±1.0).
@@ -130,6 +131,20 @@ pub enum FinishError {
         /// `fValve_BendPointOutput`.
         output: f64,
     },
+}
+
+impl FinishError {
+    /// The library's error code: `dwTcHydErrCdRefVelo` for `fRefVelo`, else
+    /// `dwTcHydAdsErrIllegalValue`.
+    pub fn code(&self) -> HydErrorCode {
+        match self {
+            Self::NotAbove {
+                parameter: "fRefVelo",
+                ..
+            } => HydErrorCode::REF_VELO,
+            _ => HydErrorCode::ILLEGAL_VALUE,
+        }
+    }
 }
 
 impl core::fmt::Display for FinishError {
@@ -478,6 +493,10 @@ mod tests {
                 value: 0.0,
                 bound: 0.0
             }
+        );
+        assert_eq!(
+            bad(FinishParams { ref_velo: 0.0, ..d }).code().name(),
+            "dwTcHydErrCdRefVelo"
         );
         assert!(matches!(
             bad(FinishParams {

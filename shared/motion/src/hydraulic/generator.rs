@@ -40,6 +40,7 @@
 //!
 //! Pure: no IO, no clock (the cycle time is an input), no allocation.
 
+use crate::catalog::hyd_error::HydErrorCode;
 /// The generator's state, as the library names it (`E_TcHydAxState`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum HydState {
@@ -165,6 +166,22 @@ pub enum GeneratorError {
         /// Its value.
         value: f64,
     },
+}
+
+impl GeneratorError {
+    /// The library's error code: `dwTcHydErrCdRefVelo`, `dwTcHydErrCdSetVelo` (a command's
+    /// velocity, `fMaxVelo`), `dwTcHydErrCdAcc`, `dwTcHydErrCdDec`, else
+    /// `dwTcHydAdsErrIllegalValue`.
+    pub fn code(&self) -> HydErrorCode {
+        let Self::Invalid { name, .. } = *self;
+        match name {
+            "fRefVelo" => HydErrorCode::REF_VELO,
+            "Velocity" | "fMaxVelo" => HydErrorCode::SET_VELO,
+            "Acceleration" | "fAcc" | "fMaxAcc" => HydErrorCode::ACC,
+            "Deceleration" | "fDec" | "fMaxDec" => HydErrorCode::DEC,
+            _ => HydErrorCode::ILLEGAL_VALUE,
+        }
+    }
 }
 
 impl core::fmt::Display for GeneratorError {
@@ -743,13 +760,18 @@ mod tests {
                 value: 0.0
             }
         );
+        assert_eq!(
+            CtrlBasedGenerator::new(p, 0.0).unwrap_err().code().name(),
+            "dwTcHydErrCdDec"
+        );
         let mut p = params();
         p.approach_m.brake_distance = -1.0;
         assert!(CtrlBasedGenerator::new(p, 0.0).is_err());
         let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
         let before = g;
         assert!(g.move_absolute(f64::NAN, 100.0, 0.0, 0.0, 0.0).is_err());
-        assert!(g.move_absolute(10.0, 0.0, 0.0, 0.0, 0.0).is_err());
+        let e = g.move_absolute(10.0, 0.0, 0.0, 0.0, 0.0).unwrap_err();
+        assert_eq!(e.code().to_string(), "16#4359 dwTcHydErrCdSetVelo");
         assert!(g.move_absolute(10.0, 10.0, -1.0, 0.0, 0.0).is_err());
         assert_eq!(g, before);
         // A cycle with a NaN actual changes nothing either.

@@ -10,6 +10,7 @@
 //! MoveAbsolute / MoveRelative / Stop report Done once the axis is in target). A new target
 //! restarts the filter time. Pure: no IO, no clock (the cycle time is an input), no allocation.
 
+use crate::catalog::hyd_error::HydErrorCode;
 /// The parameters of the monitoring (defaults as the library's: 1.0 mm, 1.0 mm, 1.0 s).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct MonitorParams {
@@ -38,6 +39,13 @@ pub struct MonitorError {
     pub name: &'static str,
     /// Its value.
     pub value: f64,
+}
+
+impl MonitorError {
+    /// The library's error code: `dwTcHydAdsErrIllegalValue`.
+    pub fn code(&self) -> HydErrorCode {
+        HydErrorCode::ILLEGAL_VALUE
+    }
 }
 
 impl core::fmt::Display for MonitorError {

@@ -21,6 +21,7 @@
 //!
 //! Pure: no IO, no allocation (the points are held inline, at most [`MAX_POINTS`]).
 
+use crate::catalog::hyd_error::HydErrorCode;
 /// The most points a table holds (the library's automatic identification measures 3 to 99).
 pub const MAX_POINTS: usize = 256;
 
@@ -77,6 +78,22 @@ pub enum TableError {
         /// The value.
         value: f64,
     },
+}
+
+impl TableError {
+    /// The library's error code: `dwTcHydAdsErrSyntax` for a line of a file,
+    /// `dwTcHydErrCdTblEntryCount` / `dwTcHydErrCdTblLineCount` for too few / too many points,
+    /// `dwTcHydErrCdTblInvalidMasterStep` for velocities not increasing, else
+    /// `dwTcHydAdsErrIllegalValue`.
+    pub fn code(&self) -> HydErrorCode {
+        match self {
+            Self::Syntax { .. } => HydErrorCode::SYNTAX,
+            Self::TooFewPoints { .. } => HydErrorCode::TBL_ENTRY_COUNT,
+            Self::TooManyPoints { .. } => HydErrorCode::TBL_LINE_COUNT,
+            Self::VelocityNotIncreasing { .. } => HydErrorCode::TBL_INVALID_MASTER_STEP,
+            _ => HydErrorCode::ILLEGAL_VALUE,
+        }
+    }
 }
 
 impl core::fmt::Display for TableError {
@@ -378,6 +395,13 @@ pub(crate) mod tests {
         assert_eq!(
             parse("-1 -1\n0 0\n1 x\n", &mut buf),
             Err(TableError::Syntax { line: 3 })
+        );
+        assert_eq!(
+            parse("-1 -1\n0 0\n1 x\n", &mut buf)
+                .unwrap_err()
+                .code()
+                .name(),
+            "dwTcHydAdsErrSyntax"
         );
         assert_eq!(
             parse("-1 -1\n0 0 0\n", &mut buf),

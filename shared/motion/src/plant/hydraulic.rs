@@ -30,6 +30,7 @@
 //! mm³/s inside. Integrated with [`SUBSTEPS`] semi-implicit Euler steps per call (the oil spring
 //! is stiff). Pure: no IO, no clock (the cycle time is an input), no allocation.
 
+use crate::catalog::hyd_error::HydErrorCode;
 /// Integration steps per [`SimCylinder::step`] call, at least (more when the call is long: no
 /// sub-step exceeds [`MAX_SUBSTEP`]).
 pub const SUBSTEPS: u32 = 20;
@@ -203,6 +204,17 @@ pub struct CylinderError {
     pub name: &'static str,
     /// Its value.
     pub value: f64,
+}
+
+impl CylinderError {
+    /// The library's error code: `dwTcHydErrIllegalAreas` for the areas, else
+    /// `dwTcHydAdsErrIllegalValue`.
+    pub fn code(&self) -> HydErrorCode {
+        match self.name {
+            "area_a" | "area_b" => HydErrorCode::ILLEGAL_AREAS,
+            _ => HydErrorCode::ILLEGAL_VALUE,
+        }
+    }
 }
 
 impl core::fmt::Display for CylinderError {
@@ -543,6 +555,10 @@ mod tests {
                 name: "area_b",
                 value: 0.0
             }
+        );
+        assert_eq!(
+            bad(CylinderParams { area_b: 0.0, ..e }).code().name(),
+            "dwTcHydErrIllegalAreas"
         );
         assert_eq!(bad(CylinderParams { overlap: 0.95, ..e }).name, "overlap");
         assert_eq!(
