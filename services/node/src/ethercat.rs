@@ -1,0 +1,816 @@
+//! The node's EtherCAT segment (`[[ethercat]]`, docs/ethercat.md): an adapter at the edge
+//! between unmodified `ethercrab` 0.7.1 and the executive's external drives.
+//!
+//! At start, [`open`] runs the MainDevice on a thread of its own ("ethercat", with ethercrab's
+//! TX/RX loop on "ethercat-io"): it finds the SubDevices, compares them position by position
+//! with the cell file (the first mismatch refuses the start), reads each CiA 402 drive's
+//! assigned PDO mapping over CoE (0x1C12/0x1C13, then 0x16xx/0x1Axx), brings the segment to
+//! OP and waits for exchanges.
+//!
+//! Each cycle at `t`, before the step, the cyclic thread calls [`Link::exchange`]: it takes
+//! the process image back from the exchange it started at `t - cycle` (a whole cycle to
+//! complete), puts each drive's TxPDO into the executive, writes the RxPDO the step at
+//! `t - cycle` computed and hands the image to the "ethercat" thread, which runs one LRW
+//! (`SubDeviceGroup::tx_rx`) at once. The image moves between the two threads through two
+//! bounded channels (no lock, no allocation, no wait on the cyclic thread). An image not back
+//! by the next cycle, a failed exchange or a working counter below the expected one is a miss;
+//! after [`MISSES_TO_ALARM`] misses in a row each drive on the segment shows a fault with
+//! error code [`LOST_CODE`], which its axis takes as alarm 421 with the reaction the drive
+//! fault has; the node's other axes carry on.
+
+use ethercrab::std::{ethercat_now, tx_rx_task};
+use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, SubDeviceRef, Timeouts};
+use std::fmt;
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::time::{Duration, Instant};
+use tandem_config::{Cell, EthercatIdentity, EthercatRole};
+use tandem_motion::plant::cia402::{DriveCommand, DriveFeedback};
+use tandem_runtime::exec::Executive;
+use tracing::{info, warn};
+
+/// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 3 cycles, the
+/// bound the EtherCAT issue sets for a lost SubDevice's alarm (inferred: one late exchange on a
+/// loaded host is not a lost segment; three in a row are).
+pub const MISSES_TO_ALARM: u32 = 3;
+
+/// The error code 0x603F a drive on a segment that stopped exchanging shows: 0x8130, "life
+/// guard error or heartbeat error" of CiA 301's emergency error codes (inferred: the code of a
+/// lost cyclic communication closest to a lost EtherCAT exchange).
+#[doc(alias = "0x603F")]
+pub const LOST_CODE: u16 = 0x8130;
+
+/// Statusword 0x6041 of *fault* (IEC 61800-7-201 (CiA 402) drive profile, 0x6041: xxxx xxxx
+/// x0xx 1000).
+const FAULT_STATUSWORD: u16 = 0x0008;
+
+/// ethercrab's PDU timeout. Not below the cycle: in ethercrab 0.7.1 a reply arriving after its
+/// PDU timed out ends the receive task (and with it the segment), and on a loaded host a reply
+/// can take tens of ms (docs/ethercat.md, the emulator's measurements). The cyclic thread never
+/// waits for it: an exchange not back by the next cycle is a miss.
+const PDU_TIMEOUT: Duration = Duration::from_millis(100);
+
+/// Time allowed from opening the interface to OP.
+const START_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// The most SubDevices and bytes of process image the node drives on one segment.
+const MAX_SUBDEVICES: usize = 64;
+const MAX_PDI: usize = 4096;
+/// Frames in flight and their size.
+const MAX_FRAMES: usize = 16;
+static PDU_STORAGE: PduStorage<MAX_FRAMES, { PduStorage::element_size(1100) }> = PduStorage::new();
+
+/// Why the segment could not be started.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum EthercatError {
+    /// The interface could not be opened, a thread not started, or ethercrab failed.
+    Start {
+        /// The interface.
+        interface: String,
+        /// What failed.
+        reason: String,
+    },
+    /// The bus does not match the cell file at `position`.
+    Mismatch {
+        /// The interface.
+        interface: String,
+        /// Bus position (0: the first SubDevice after the MainDevice).
+        position: usize,
+        /// The SubDevice the cell file expects there (name, identity), if any.
+        expected: Option<(String, EthercatIdentity)>,
+        /// What the bus has there (its SII name, identity), if anything.
+        found: Option<(String, EthercatIdentity)>,
+    },
+    /// A drive's PDO mapping lacks an object the drive connection needs.
+    Mapping {
+        /// The SubDevice.
+        name: String,
+        /// The missing object.
+        object: u16,
+    },
+}
+
+impl fmt::Display for EthercatError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Start { interface, reason } => {
+                write!(f, "EtherCAT segment on `{interface}`: {reason}")
+            }
+            Self::Mismatch {
+                interface,
+                position,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "EtherCAT segment on `{interface}` does not match the cell file at position {position}: expected "
+                )?;
+                match expected {
+                    Some((n, id)) => write!(f, "`{n}` ({id})")?,
+                    None => f.write_str("no SubDevice")?,
+                }
+                f.write_str(", found ")?;
+                match found {
+                    Some((n, id)) => write!(f, "`{n}` ({id})"),
+                    None => f.write_str("no SubDevice"),
+                }
+            }
+            Self::Mapping { name, object } => write!(
+                f,
+                "EtherCAT SubDevice `{name}`: its PDO mapping has no object 0x{object:04X}, which a CiA 402 drive connection needs"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for EthercatError {}
+
+/// One mapped object of a PDO: index, byte offset in the SubDevice's image, length in bytes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+struct Mapped {
+    index: u16,
+    offset: usize,
+    len: usize,
+}
+
+/// A PDO mapping entry (CiA 301: index << 16 | subindex << 8 | bit length) as [`Mapped`] at
+/// `bit` bits into the image; `None` for an entry that is not whole bytes.
+fn mapped(entry: u32, bit: usize) -> Option<Mapped> {
+    let bits = (entry & 0xFF) as usize;
+    (bits % 8 == 0 && bit % 8 == 0).then_some(Mapped {
+        index: (entry >> 16) as u16,
+        offset: bit / 8,
+        len: bits / 8,
+    })
+}
+
+/// The PDO mapping of a CiA 402 drive, as read from the drive.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+struct DriveMap {
+    rx: Vec<Mapped>,
+    tx: Vec<Mapped>,
+}
+
+/// The little-endian bytes of `v`'s `len` low bytes into `buf` at `at` (as far as they fit).
+fn put(buf: &mut [u8], at: usize, len: usize, v: i64) {
+    for (i, b) in v.to_le_bytes().iter().take(len).enumerate() {
+        if let Some(x) = buf.get_mut(at + i) {
+            *x = *b;
+        }
+    }
+}
+
+/// `len` little-endian bytes of `buf` at `at`, sign-extended when `signed`.
+fn get(buf: &[u8], at: usize, len: usize, signed: bool) -> i64 {
+    let mut b = [0u8; 8];
+    for (i, x) in b.iter_mut().take(len.min(8)).enumerate() {
+        *x = buf.get(at + i).copied().unwrap_or(0);
+    }
+    let v = i64::from_le_bytes(b);
+    let shift = 64 - 8 * len.clamp(1, 8) as u32;
+    if signed {
+        (v << shift) >> shift
+    } else {
+        v
+    }
+}
+
+/// The RxPDO of `c` into the drive's output image by its mapping (objects it does not map
+/// are not sent; objects it maps that tandem does not write stay 0).
+fn encode(map: &DriveMap, c: &DriveCommand, out: &mut [u8]) {
+    for m in &map.rx {
+        let v = match m.index {
+            0x6040 => i64::from(c.controlword),
+            0x6060 => i64::from(c.mode),
+            0x607A => i64::from(c.target_position),
+            0x60FF => i64::from(c.target_velocity),
+            0x6071 => i64::from(c.target_torque),
+            0x60B1 => i64::from(c.velocity_offset),
+            0x60B2 => i64::from(c.torque_offset),
+            0x6072 => i64::from(c.max_torque),
+            0x60B8 => i64::from(c.touch_probe_function),
+            _ => 0,
+        };
+        put(out, m.offset, m.len, v);
+    }
+}
+
+/// The TxPDO from the drive's input image by its mapping (objects it does not map read 0).
+fn decode(map: &DriveMap, input: &[u8]) -> DriveFeedback {
+    let mut f = DriveFeedback::default();
+    for m in &map.tx {
+        let u = get(input, m.offset, m.len, false);
+        let s = get(input, m.offset, m.len, true);
+        // Truncation to the object's own width is the PDO's encoding.
+        match m.index {
+            0x6041 => f.statusword = u as u16,
+            0x6061 => f.mode_display = s as i8,
+            0x6064 => f.position_actual = s as i32,
+            0x606C => f.velocity_actual = s as i32,
+            0x6077 => f.torque_actual = s as i16,
+            0x60F4 => f.following_error = s as i32,
+            0x603F => f.error_code = u as u16,
+            0x60FD => f.digital_inputs = u as u32,
+            0x60B9 => f.touch_probe_status = u as u16,
+            0x60BA => f.touch_probe_1_positive = s as i32,
+            0x60BB => f.touch_probe_1_negative = s as i32,
+            0x60BC => f.touch_probe_2_positive = s as i32,
+            0x60BD => f.touch_probe_2_negative = s as i32,
+            _ => {}
+        }
+    }
+    f
+}
+
+/// One SubDevice's part of the process image the two threads hand over.
+#[derive(Debug)]
+struct Part {
+    /// Its device (index in the cell).
+    device: usize,
+    /// A drive's mapping; `None` for a digital terminal.
+    map: Option<DriveMap>,
+    /// The command to send (drives).
+    command: DriveCommand,
+    /// The feedback received (drives).
+    feedback: DriveFeedback,
+    /// The outputs byte (digital terminals).
+    outputs: u8,
+    /// The inputs byte received (digital terminals).
+    inputs: u8,
+}
+
+/// The process image between the cyclic thread and the "ethercat" thread.
+#[derive(Debug)]
+struct Image {
+    parts: Vec<Part>,
+    /// The exchange completed with the expected working counter.
+    ok: bool,
+    /// Its round trip (ns).
+    round_trip_ns: u64,
+}
+
+/// Counters of the segment, reported at the end.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentCounts {
+    /// Exchanges that came back complete.
+    pub exchanges: u64,
+    /// Cycles without a complete exchange (late, failed or a working counter error).
+    pub misses: u64,
+    /// Times the segment went into alarm.
+    pub alarms: u64,
+    /// Round trips of the exchanges, in buckets of 10 µs (the last one: 10 ms and more).
+    pub round_trip_10us: [u32; 1001],
+}
+
+impl Default for SegmentCounts {
+    fn default() -> Self {
+        Self {
+            exchanges: 0,
+            misses: 0,
+            alarms: 0,
+            round_trip_10us: [0; 1001],
+        }
+    }
+}
+
+impl SegmentCounts {
+    /// The round trip (µs, the bucket's upper edge) below which `share` of the exchanges are.
+    pub fn round_trip_quantile_us(&self, share: f64) -> u64 {
+        let total: u64 = self.round_trip_10us.iter().map(|&c| u64::from(c)).sum();
+        let want = (total as f64 * share).ceil() as u64;
+        let mut seen = 0u64;
+        for (i, c) in self.round_trip_10us.iter().enumerate() {
+            seen += u64::from(*c);
+            if seen >= want && seen > 0 {
+                return (i as u64 + 1) * 10;
+            }
+        }
+        0
+    }
+}
+
+/// The cyclic thread's end of the segment.
+#[derive(Debug)]
+pub struct Link {
+    interface: String,
+    to_bus: SyncSender<Box<Image>>,
+    from_bus: Receiver<Box<Image>>,
+    /// The image while the cyclic thread holds it.
+    image: Option<Box<Image>>,
+    /// Misses in a row.
+    in_a_row: u32,
+    /// The devices of the drives on the segment.
+    drives: Vec<usize>,
+    /// The counters.
+    pub counts: Box<SegmentCounts>,
+}
+
+impl Link {
+    /// The exchange at boundary `t` (see the module): the previous exchange's inputs into
+    /// `exec`, this cycle's outputs out. Never waits.
+    pub fn exchange(&mut self, exec: &mut Executive<'_>) {
+        if let Ok(image) = self.from_bus.try_recv() {
+            self.image = Some(image);
+        }
+        let Some(mut image) = self.image.take() else {
+            // The exchange started a cycle ago is not back.
+            self.miss(exec);
+            return;
+        };
+        if image.ok {
+            self.in_a_row = 0;
+            self.counts.exchanges += 1;
+            let bucket = usize::try_from(image.round_trip_ns / 10_000).unwrap_or(usize::MAX);
+            if let Some(c) = self.counts.round_trip_10us.get_mut(bucket.min(1000)) {
+                *c = c.saturating_add(1);
+            }
+            for p in image.parts.iter().filter(|p| p.map.is_some()) {
+                exec.set_drive_feedback(p.device, &p.feedback);
+            }
+        } else {
+            self.miss(exec);
+        }
+        for p in &mut image.parts {
+            if p.map.is_some() {
+                p.command = exec.drive_command(p.device).copied().unwrap_or_default();
+            }
+        }
+        image.ok = false;
+        match self.to_bus.try_send(image) {
+            Ok(()) => {}
+            Err(TrySendError::Full(i) | TrySendError::Disconnected(i)) => self.image = Some(i),
+        }
+    }
+
+    /// One cycle without a complete exchange; the alarm at [`MISSES_TO_ALARM`] in a row.
+    fn miss(&mut self, exec: &mut Executive<'_>) {
+        self.counts.misses += 1;
+        self.in_a_row = self.in_a_row.saturating_add(1);
+        if self.in_a_row < MISSES_TO_ALARM {
+            return;
+        }
+        if self.in_a_row == MISSES_TO_ALARM {
+            self.counts.alarms += 1;
+        }
+        let lost = DriveFeedback {
+            statusword: FAULT_STATUSWORD,
+            error_code: LOST_CODE,
+            ..DriveFeedback::default()
+        };
+        for &device in &self.drives {
+            exec.set_drive_feedback(device, &lost);
+        }
+    }
+
+    /// The segment's counters, logged at the node's end.
+    pub fn report(&self) {
+        let c = &self.counts;
+        info!(
+            interface = %self.interface,
+            exchanges = c.exchanges,
+            misses = c.misses,
+            alarms = c.alarms,
+            "EtherCAT segment: {} exchanges, {} missed cycles, {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us",
+            c.exchanges,
+            c.misses,
+            c.alarms,
+            c.round_trip_quantile_us(0.5),
+            c.round_trip_quantile_us(0.99),
+            c.round_trip_quantile_us(1.0),
+        );
+    }
+}
+
+/// What the "ethercat" thread needs to start.
+struct Plan {
+    interface: String,
+    /// Per expected SubDevice in bus order: name, identity, role, device.
+    expected: Vec<(String, EthercatIdentity, EthercatRole, usize)>,
+}
+
+/// Opens node `n`'s segment if it has one: the bus checked against the cell file, the drives'
+/// mappings read, OP reached (within [`START_TIMEOUT`]). `Ok(None)` for a node without
+/// `[[ethercat]]`.
+pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
+    let Some(seg) = cell.ethercat.iter().find(|s| s.node == n) else {
+        return Ok(None);
+    };
+    let plan = Plan {
+        interface: seg.interface.clone(),
+        expected: seg
+            .subdevices
+            .iter()
+            .map(|s| (s.name.clone(), s.identity, s.role, s.device.0))
+            .collect(),
+    };
+    let interface = seg.interface.clone();
+    let start_error = |reason: String| EthercatError::Start {
+        interface: interface.clone(),
+        reason,
+    };
+    let (ready_tx, ready_rx) = sync_channel::<Result<Box<Image>, EthercatError>>(1);
+    let (to_bus, bus_in) = sync_channel::<Box<Image>>(1);
+    let (bus_out, from_bus) = sync_channel::<Box<Image>>(1);
+    std::thread::Builder::new()
+        .name("ethercat".into())
+        .stack_size(8 << 20)
+        .spawn(move || bus_thread(&plan, &ready_tx, &bus_in, &bus_out))
+        .map_err(|e| start_error(format!("cannot start the ethercat thread: {e}")))?;
+    let image = match ready_rx.recv_timeout(START_TIMEOUT) {
+        Ok(r) => r?,
+        Err(_) => {
+            return Err(start_error(format!(
+                "not in OP within {} s",
+                START_TIMEOUT.as_secs()
+            )))
+        }
+    };
+    let drives = image
+        .parts
+        .iter()
+        .filter(|p| p.map.is_some())
+        .map(|p| p.device)
+        .collect();
+    info!(interface = %seg.interface, subdevices = seg.subdevices.len(), "EtherCAT segment in OP");
+    Ok(Some(Link {
+        interface: seg.interface.clone(),
+        to_bus,
+        from_bus,
+        image: Some(image),
+        in_a_row: 0,
+        drives,
+        counts: Box::default(),
+    }))
+}
+
+/// The "ethercat" thread: starts the segment, reports it ready (or why not), then runs one
+/// exchange per image handed over until the cyclic thread's end of the channel goes.
+fn bus_thread(
+    plan: &Plan,
+    ready: &SyncSender<Result<Box<Image>, EthercatError>>,
+    bus_in: &Receiver<Box<Image>>,
+    bus_out: &SyncSender<Box<Image>>,
+) {
+    let fail = |reason: String| EthercatError::Start {
+        interface: plan.interface.clone(),
+        reason,
+    };
+    let Ok((tx, rx, pdu_loop)) = PDU_STORAGE.try_split() else {
+        // The receiver waits with a timeout; if it gave up nobody needs the answer.
+        let _ = ready.send(Err(fail("the PDU storage is in use already".into())));
+        return;
+    };
+    let task = match tx_rx_task(&plan.interface, tx, rx) {
+        Ok(t) => t,
+        Err(e) => {
+            // As above: a receiver that gave up needs no answer.
+            let _ = ready.send(Err(fail(format!("cannot open the interface: {e}"))));
+            return;
+        }
+    };
+    let io = std::thread::Builder::new()
+        .name("ethercat-io".into())
+        .spawn(move || {
+            if let Err(e) = async_io::block_on(task) {
+                warn!("EtherCAT TX/RX ended: {e}");
+            }
+        });
+    if let Err(e) = io {
+        // As above.
+        let _ = ready.send(Err(fail(format!(
+            "cannot start the ethercat-io thread: {e}"
+        ))));
+        return;
+    }
+    let md = MainDevice::new(
+        pdu_loop,
+        Timeouts {
+            pdu: PDU_TIMEOUT,
+            ..Timeouts::default()
+        },
+        MainDeviceConfig {
+            dc_static_sync_iterations: 1000,
+            ..MainDeviceConfig::default()
+        },
+    );
+    async_io::block_on(run_bus(plan, &md, ready, bus_in, bus_out));
+}
+
+/// The MainDevice's work: start (see [`open`]), then the exchanges.
+async fn run_bus(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    ready: &SyncSender<Result<Box<Image>, EthercatError>>,
+    bus_in: &Receiver<Box<Image>>,
+    bus_out: &SyncSender<Box<Image>>,
+) {
+    let fail = |what: &str, e: ethercrab::error::Error| EthercatError::Start {
+        interface: plan.interface.clone(),
+        reason: format!("{what}: {e}"),
+    };
+    let group = match md
+        .init_single_group::<MAX_SUBDEVICES, MAX_PDI>(ethercat_now)
+        .await
+    {
+        Ok(g) => g,
+        Err(e) => {
+            // The receiver waits with a timeout; if it gave up nobody needs the answer.
+            let _ = ready.send(Err(fail("no segment found", e)));
+            return;
+        }
+    };
+    let mut parts = Vec::new();
+    let found: Vec<SubDeviceRef<'_, _>> = group.iter(md).collect();
+    for position in 0..plan.expected.len().max(found.len()) {
+        let expected = plan.expected.get(position);
+        let sd = found.get(position);
+        let id = sd.map(|sd| {
+            let i = sd.identity();
+            EthercatIdentity {
+                vendor: i.vendor_id,
+                product: i.product_id,
+                revision: i.revision,
+            }
+        });
+        let matches = matches!((expected, id), (Some(e), Some(id)) if e.1 == id);
+        if !matches {
+            // As above.
+            let _ = ready.send(Err(EthercatError::Mismatch {
+                interface: plan.interface.clone(),
+                position,
+                expected: expected.map(|e| (e.0.clone(), e.1)),
+                found: sd.zip(id).map(|(sd, id)| (sd.name().to_string(), id)),
+            }));
+            return;
+        }
+        let (Some((name, _, role, device)), Some(sd)) = (expected, sd) else {
+            return;
+        };
+        let map = match role {
+            EthercatRole::Cia402 => match read_mapping(name, sd).await {
+                Ok(m) => Some(m),
+                Err(e) => {
+                    // As above.
+                    let _ = ready.send(Err(e));
+                    return;
+                }
+            },
+            EthercatRole::Dio => None,
+        };
+        parts.push(Part {
+            device: *device,
+            map,
+            command: DriveCommand::default(),
+            feedback: DriveFeedback::default(),
+            outputs: 0,
+            inputs: 0,
+        });
+    }
+    let group = match group.into_safe_op(md).await {
+        Ok(g) => g,
+        Err(e) => {
+            // As above.
+            let _ = ready.send(Err(fail("SAFE-OP refused", e)));
+            return;
+        }
+    };
+    let group = match group.request_into_op(md).await {
+        Ok(g) => g,
+        Err(e) => {
+            // As above.
+            let _ = ready.send(Err(fail("OP refused", e)));
+            return;
+        }
+    };
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        match group.tx_rx(md).await {
+            Ok(r) if r.all_op() => break,
+            Ok(_) if Instant::now() < deadline => {}
+            Ok(_) => {
+                // As above.
+                let _ = ready.send(Err(EthercatError::Start {
+                    interface: plan.interface.clone(),
+                    reason: "not all SubDevices in OP within 10 s".into(),
+                }));
+                return;
+            }
+            Err(e) => {
+                // As above.
+                let _ = ready.send(Err(fail("exchange on the way to OP", e)));
+                return;
+            }
+        }
+        async_io::Timer::after(Duration::from_millis(1)).await;
+    }
+    // The working counter of a complete exchange: +1 per SubDevice with inputs, +2 per one
+    // with outputs (an LRW through its read and its write FMMU).
+    let expected_wkc: u16 = group
+        .iter(md)
+        .map(|sd| {
+            let io = sd.io_raw();
+            u16::from(!io.inputs().is_empty()) + 2 * u16::from(!io.outputs().is_empty())
+        })
+        .sum();
+    let image = Box::new(Image {
+        parts,
+        ok: false,
+        round_trip_ns: 0,
+    });
+    if ready.send(Ok(image)).is_err() {
+        return;
+    }
+    loop {
+        let mut image = match bus_in.recv_timeout(Duration::from_secs(1)) {
+            Ok(i) => i,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => return,
+        };
+        for (p, sd) in image.parts.iter().zip(group.iter(md)) {
+            let mut out = sd.outputs_raw_mut();
+            match &p.map {
+                Some(map) => encode(map, &p.command, &mut out),
+                None => put(&mut out, 0, 1, i64::from(p.outputs)),
+            }
+        }
+        let sent = Instant::now();
+        let result = group.tx_rx(md).await;
+        image.round_trip_ns = u64::try_from(sent.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        image.ok = matches!(&result, Ok(r) if r.working_counter >= expected_wkc);
+        if image.ok {
+            for (p, sd) in image.parts.iter_mut().zip(group.iter(md)) {
+                let input = sd.inputs_raw();
+                match &p.map {
+                    Some(map) => p.feedback = decode(map, &input),
+                    None => p.inputs = input.first().copied().unwrap_or(0),
+                }
+            }
+        }
+        if bus_out.send(image).is_err() {
+            return;
+        }
+    }
+}
+
+/// The assigned RxPDO and TxPDO mapping of drive `sd` over CoE (CiA 301: 0x1C12:01 and
+/// 0x1C13:01 name the PDO, its subindex 0 counts the entries), checked for the objects the
+/// CiA 402 drive connection needs.
+async fn read_mapping<S>(name: &str, sd: &SubDeviceRef<'_, S>) -> Result<DriveMap, EthercatError>
+where
+    S: core::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let sdo = |e: ethercrab::error::Error| EthercatError::Start {
+        interface: String::new(),
+        reason: format!("`{name}`: reading its PDO mapping over CoE: {e}"),
+    };
+    let mut map = DriveMap::default();
+    for (assign, rx) in [(0x1C12u16, true), (0x1C13u16, false)] {
+        let pdo: u16 = sd.sdo_read(assign, 1).await.map_err(sdo)?;
+        let n: u8 = sd.sdo_read(pdo, 0).await.map_err(sdo)?;
+        let mut bit = 0usize;
+        for sub in 1..=n {
+            let entry: u32 = sd.sdo_read(pdo, sub).await.map_err(sdo)?;
+            if let Some(m) = mapped(entry, bit) {
+                if rx {
+                    map.rx.push(m);
+                } else {
+                    map.tx.push(m);
+                }
+            }
+            bit += (entry & 0xFF) as usize;
+        }
+    }
+    for (list, object) in [
+        (&map.rx, 0x6040u16),
+        (&map.rx, 0x607A),
+        (&map.tx, 0x6041),
+        (&map.tx, 0x6064),
+    ] {
+        if !list.iter().any(|m| m.index == object) {
+            return Err(EthercatError::Mapping {
+                name: name.to_string(),
+                object,
+            });
+        }
+    }
+    Ok(map)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+
+    /// The emulated drive's mappings (docs/ethercat.md): RxPDO 0x1600 and TxPDO 0x1A00.
+    fn emulated() -> DriveMap {
+        let mut map = DriveMap::default();
+        let mut bit = 0;
+        for e in [0x6040_0010u32, 0x6060_0008, 0x607A_0020, 0x60B8_0010] {
+            map.rx.push(mapped(e, bit).unwrap());
+            bit += (e & 0xFF) as usize;
+        }
+        bit = 0;
+        for e in [
+            0x6041_0010u32,
+            0x6061_0008,
+            0x6064_0020,
+            0x606C_0020,
+            0x60B9_0010,
+            0x60BA_0020,
+            0x60BB_0020,
+        ] {
+            map.tx.push(mapped(e, bit).unwrap());
+            bit += (e & 0xFF) as usize;
+        }
+        map
+    }
+
+    #[test]
+    fn the_rxpdo_goes_out_at_the_mapped_offsets() {
+        let c = DriveCommand {
+            controlword: 0x000F,
+            mode: 8,
+            target_position: -2,
+            touch_probe_function: 0x0013,
+            target_velocity: 77,
+            ..DriveCommand::default()
+        };
+        let mut out = [0xAAu8; 9];
+        encode(&emulated(), &c, &mut out);
+        assert_eq!(out, [0x0F, 0x00, 8, 0xFE, 0xFF, 0xFF, 0xFF, 0x13, 0x00]);
+    }
+
+    #[test]
+    fn the_txpdo_comes_in_from_the_mapped_offsets() {
+        let mut input = [0u8; 21];
+        input[0..2].copy_from_slice(&0x1237u16.to_le_bytes());
+        input[2] = 0xF7; // -9
+        input[3..7].copy_from_slice(&(-123_456i32).to_le_bytes());
+        input[7..11].copy_from_slice(&(1_000_000i32).to_le_bytes());
+        input[11..13].copy_from_slice(&0x0202u16.to_le_bytes());
+        input[13..17].copy_from_slice(&(i32::MIN).to_le_bytes());
+        input[17..21].copy_from_slice(&(i32::MAX).to_le_bytes());
+        let f = decode(&emulated(), &input);
+        assert_eq!(
+            f,
+            DriveFeedback {
+                statusword: 0x1237,
+                mode_display: -9,
+                position_actual: -123_456,
+                velocity_actual: 1_000_000,
+                touch_probe_status: 0x0202,
+                touch_probe_1_positive: i32::MIN,
+                touch_probe_1_negative: i32::MAX,
+                ..DriveFeedback::default()
+            }
+        );
+    }
+
+    #[test]
+    fn a_short_image_reads_zeros_and_writes_nothing_beyond_it() {
+        let f = decode(&emulated(), &[0x27, 0x02]);
+        assert_eq!(f.statusword, 0x0227);
+        assert_eq!(f.position_actual, 0);
+        let mut out = [0u8; 2];
+        encode(
+            &emulated(),
+            &DriveCommand {
+                controlword: 6,
+                mode: 8,
+                ..DriveCommand::default()
+            },
+            &mut out,
+        );
+        assert_eq!(out, [6, 0]);
+    }
+
+    #[test]
+    fn a_mismatch_names_position_and_both_identities() {
+        let e = EthercatError::Mismatch {
+            interface: "ecm".into(),
+            position: 1,
+            expected: Some((
+                "io".into(),
+                EthercatIdentity {
+                    vendor: 2,
+                    product: 0x0743_3052,
+                    revision: 0x0010_0000,
+                },
+            )),
+            found: Some((
+                "EL1859".into(),
+                EthercatIdentity {
+                    vendor: 2,
+                    product: 0x0743_3052,
+                    revision: 0x0011_0000,
+                },
+            )),
+        };
+        assert_eq!(
+            e.to_string(),
+            "EtherCAT segment on `ecm` does not match the cell file at position 1: expected `io` \
+             (vendor 0x00000002, product 0x07433052, revision 0x00100000), found `EL1859` \
+             (vendor 0x00000002, product 0x07433052, revision 0x00110000)"
+        );
+    }
+}
