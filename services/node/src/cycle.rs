@@ -220,7 +220,7 @@ impl<'c> NodeCycle<'c> {
             if let Some(segment) = self.ethercat.as_mut() {
                 // The PDI at the boundary `t`: inputs of the exchange started at `t - cycle`
                 // in, the outputs of the last step out (crate::ethercat).
-                segment.exchange(&mut self.exec);
+                segment.exchange(t, &mut self.exec, &mut self.log);
             }
             marks[2] = rt::now_ns();
             self.step(t);

@@ -21,11 +21,12 @@
 use ethercrab::std::{ethercat_now, tx_rx_task};
 use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, SubDeviceRef, Timeouts};
 use std::fmt;
+use std::io::Write;
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
 use std::time::{Duration, Instant};
 use tandem_config::{Cell, EthercatIdentity, EthercatRole};
 use tandem_motion::plant::cia402::{DriveCommand, DriveFeedback};
-use tandem_runtime::exec::Executive;
+use tandem_runtime::exec::{Executive, Secs};
 use tracing::{info, warn};
 
 /// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 10 cycles. Not
@@ -250,6 +251,10 @@ struct Part {
     outputs: u8,
     /// The inputs byte received (digital terminals).
     inputs: u8,
+    /// The inputs byte last logged.
+    inputs_logged: u8,
+    /// Its name in the cell (for the log).
+    name: String,
 }
 
 /// The process image between the cyclic thread and the "ethercat" thread.
@@ -315,8 +320,10 @@ pub struct Link {
     image: Option<Box<Image>>,
     /// Misses in a row.
     in_a_row: u32,
-    /// The devices of the drives on the segment.
-    drives: Vec<usize>,
+    /// The drives on the segment: device and last feedback (extrapolated over misses).
+    drives: Vec<(usize, DriveFeedback)>,
+    /// The node's cycle (ns).
+    cycle_ns: i64,
     /// The first exchange has been started.
     started: bool,
     /// The counters.
@@ -326,7 +333,7 @@ pub struct Link {
 impl Link {
     /// The exchange at boundary `t` (see the module): the previous exchange's inputs into
     /// `exec`, this cycle's outputs out. Never waits.
-    pub fn exchange(&mut self, exec: &mut Executive<'_>) {
+    pub fn exchange(&mut self, t: i64, exec: &mut Executive<'_>, log: &mut impl Write) {
         if !self.started {
             // The first boundary: nothing was exchanged before it; the first outputs go out.
             self.started = true;
@@ -338,7 +345,7 @@ impl Link {
         if let Ok(image) = self.from_bus.try_recv() {
             self.image = Some(image);
         }
-        let Some(image) = self.image.take() else {
+        let Some(mut image) = self.image.take() else {
             // The exchange started a cycle ago is not back.
             self.miss(exec);
             return;
@@ -350,8 +357,23 @@ impl Link {
             if let Some(c) = self.counts.round_trip_10us.get_mut(bucket.min(1000)) {
                 *c = c.saturating_add(1);
             }
-            for p in image.parts.iter().filter(|p| p.map.is_some()) {
-                exec.set_drive_feedback(p.device, &p.feedback);
+            for p in &mut image.parts {
+                if p.map.is_some() {
+                    exec.set_drive_feedback(p.device, &p.feedback);
+                    if let Some(d) = self.drives.iter_mut().find(|d| d.0 == p.device) {
+                        d.1 = p.feedback;
+                    }
+                } else if p.inputs != p.inputs_logged {
+                    p.inputs_logged = p.inputs;
+                    // The log ring keeps what fits; a full ring counts its losses itself.
+                    let _ = writeln!(
+                        log,
+                        "t={} {} inputs 0x{:02X} (EtherCAT)",
+                        Secs(t),
+                        p.name,
+                        p.inputs
+                    );
+                }
             }
         } else {
             self.miss(exec);
@@ -365,6 +387,11 @@ impl Link {
         for p in &mut image.parts {
             if p.map.is_some() {
                 p.command = exec.drive_command(p.device).copied().unwrap_or_default();
+            } else {
+                // The levels the last step left on its output channels (bit c - 1: channel c).
+                p.outputs = exec
+                    .output_device(p.device)
+                    .map_or(0, |s| (s.levels & 0xFF) as u8);
             }
         }
         image.ok = false;
@@ -380,6 +407,15 @@ impl Link {
         self.in_a_row = self.in_a_row.saturating_add(1);
         self.counts.most_in_a_row = self.counts.most_in_a_row.max(self.in_a_row);
         if self.in_a_row < MISSES_TO_ALARM {
+            // Until the alarm the drives' positions go on at their last velocity, so a late
+            // exchange makes no jump in the following error (inferred: a drive in CSP keeps
+            // following its last setpoints' motion; the real sample replaces this one).
+            let dt = self.cycle_ns as f64 * 1e-9;
+            for (device, last) in &mut self.drives {
+                let step = (f64::from(last.velocity_actual) * dt).round() as i64;
+                last.position_actual = last.position_actual.wrapping_add(step as i32);
+                exec.set_drive_feedback(*device, last);
+            }
             return;
         }
         if self.in_a_row == MISSES_TO_ALARM {
@@ -390,8 +426,8 @@ impl Link {
             error_code: LOST_CODE,
             ..DriveFeedback::default()
         };
-        for &device in &self.drives {
-            exec.set_drive_feedback(device, &lost);
+        for (device, _) in &self.drives {
+            exec.set_drive_feedback(*device, &lost);
         }
     }
 
@@ -466,7 +502,7 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
         .parts
         .iter()
         .filter(|p| p.map.is_some())
-        .map(|p| p.device)
+        .map(|p| (p.device, DriveFeedback::default()))
         .collect();
     info!(interface = %seg.interface, subdevices = seg.subdevices.len(), "EtherCAT segment in OP");
     Ok(Some(Link {
@@ -476,6 +512,7 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
         image: Some(image),
         in_a_row: 0,
         drives,
+        cycle_ns: cell.nodes.get(n).map_or(1, |x| x.cycle_ns),
         started: false,
         counts: Box::default(),
     }))
@@ -615,6 +652,8 @@ async fn run_bus(
             feedback: DriveFeedback::default(),
             outputs: 0,
             inputs: 0,
+            inputs_logged: 0,
+            name: name.clone(),
         });
     }
     let group = match group.into_safe_op(md).await {

@@ -166,6 +166,9 @@ pub enum DeviceKind {
 pub struct EthercatDriveParams {
     /// Position actual value 0x6064 increments per motor revolution.
     pub increments_per_revolution: u32,
+    /// Cycles from a setpoint to the actual value that shows it, through the node's exchange
+    /// (2 to 8): the following error is formed against the setpoint this many cycles old.
+    pub transport_cycles: u8,
 }
 
 /// The identity of a SubDevice (CiA 301 identity object 0x1018, as in its SII).
@@ -245,8 +248,9 @@ impl DeviceKind {
         match self {
             DeviceKind::SimServo(_)
             | DeviceKind::SimAnalogDrive(_)
-            | DeviceKind::EthercatCia402(_)
-            | DeviceKind::EthercatDio => None,
+            | DeviceKind::EthercatCia402(_) => None,
+            // Its 8 outputs; its inputs come back in the node's log (docs/ethercat.md).
+            DeviceKind::EthercatDio => Some((8, false, SignalDirection::Output)),
             DeviceKind::SimDigitalOutput(p) => {
                 Some((p.channels, p.timestamped, SignalDirection::Output))
             }
@@ -264,8 +268,8 @@ impl DeviceKind {
         match self {
             DeviceKind::SimServo(_)
             | DeviceKind::SimAnalogDrive(_)
-            | DeviceKind::EthercatCia402(_)
-            | DeviceKind::EthercatDio => None,
+            | DeviceKind::EthercatCia402(_) => None,
+            DeviceKind::EthercatDio => Some(SignalType::Bool),
             DeviceKind::SimDigitalOutput(DigitalOutputParams { timestamped, .. })
             | DeviceKind::SimDigitalInput(DigitalInputParams { timestamped, .. }) => {
                 Some(if *timestamped {

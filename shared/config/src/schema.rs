@@ -1217,6 +1217,8 @@ pub struct SubDeviceSection {
     pub role: String,
     /// `cia402`: position actual value 0x6064 per motor revolution (default 2^20).
     pub increments_per_revolution: Option<u32>,
+    /// `cia402`: cycles from a setpoint to the actual value that shows it (default 4).
+    pub transport_cycles: Option<u8>,
 }
 
 /// `identity = { vendor, product, revision }`: CiA 301 identity object 0x1018:01..03.

@@ -63,7 +63,8 @@ fn the_example_segment_gives_the_node_its_devices_and_the_axis_its_drive() {
     assert_eq!(
         cell.devices[seg.subdevices[0].device.0].kind,
         DeviceKind::EthercatCia402(EthercatDriveParams {
-            increments_per_revolution: 1 << 20
+            increments_per_revolution: 1 << 20,
+            transport_cycles: 4,
         })
     );
     assert_eq!(
@@ -216,6 +217,32 @@ fn increments_per_revolution_only_on_a_drive_and_not_zero() {
     assert_eq!(key, "ethercat[0].subdevices[0].increments_per_revolution");
     assert_eq!(line, Some(line_of(&src, "increments_per_revolution = 0")));
     assert_eq!(p, Problem::Invalid("must be at least 1"));
+}
+
+#[test]
+fn transport_cycles_from_2_to_8_on_a_drive_only() {
+    for (v, ok) in [(1, false), (2, true), (8, true), (9, false)] {
+        let src = with("transport_cycles = 4", &format!("transport_cycles = {v}"));
+        match parse("c.toml", &src) {
+            Ok(cell) => {
+                assert!(ok, "{v} accepted");
+                let d = cell.ethercat[0].subdevices[0].device.0;
+                assert!(matches!(
+                    cell.devices[d].kind,
+                    DeviceKind::EthercatCia402(EthercatDriveParams { transport_cycles, .. })
+                        if transport_cycles == v
+                ));
+            }
+            Err(e) => {
+                assert!(!ok, "{v} refused: {e}");
+                assert_eq!(e.key, "ethercat[0].subdevices[0].transport_cycles");
+                assert_eq!(*e.problem, Problem::Invalid("must be from 2 to 8 cycles"));
+            }
+        }
+    }
+    let src = with("role = \"dio\"", "role = \"dio\"\ntransport_cycles = 3");
+    let (_, key, _) = refused(&src);
+    assert_eq!(key, "ethercat[0].subdevices[1].transport_cycles");
 }
 
 #[test]

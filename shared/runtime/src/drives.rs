@@ -35,6 +35,10 @@ pub mod analog;
 /// Cycles between a setpoint and the actual value that shows it (see the module's order).
 const TRANSPORT_CYCLES: usize = 2;
 
+/// The most cycles between a setpoint and its actual value a drive may take (the exchange of
+/// an external drive adds to [`TRANSPORT_CYCLES`]).
+pub const MAX_TRANSPORT_CYCLES: usize = 8;
+
 /// A device of the process image.
 #[derive(Debug)]
 enum Device {
@@ -79,8 +83,11 @@ pub struct Cia402Link {
     request: PowerRequest,
     /// The position setpoints of the last [`TRANSPORT_CYCLES`] cycles (physical), newest at
     /// `head`: at the next cycle the oldest is the one the actual value shows.
-    setpoints: [f64; TRANSPORT_CYCLES],
+    setpoints: [f64; MAX_TRANSPORT_CYCLES],
     head: usize,
+    /// Cycles from a setpoint to the actual value that shows it: [`TRANSPORT_CYCLES`] on a
+    /// simulated drive, the device's on an external one (1 to [`MAX_TRANSPORT_CYCLES`]).
+    transport: usize,
     /// The simulated plant around the drive (limit switches, reference cam), physical.
     plant: Plant,
     /// The measuring input on the drive's touch probe 1 (index in the cell), if any.
@@ -249,6 +256,9 @@ impl Drives {
                 });
             }
             let mut link = Cia402Link::new(i, c, a.config.plant, a.config.initial_position)?;
+            if let DeviceKind::EthercatCia402(p) = &dev.kind {
+                link.transport = usize::from(p.transport_cycles).clamp(1, MAX_TRANSPORT_CYCLES);
+            }
             link.probe_input = cell
                 .measuring_inputs
                 .iter()
@@ -442,8 +452,9 @@ impl Cia402Link {
             counter: None,
             controlword: 0,
             request: PowerRequest::default(),
-            setpoints: [p0; TRANSPORT_CYCLES],
+            setpoints: [p0; MAX_TRANSPORT_CYCLES],
             head: 0,
+            transport: TRANSPORT_CYCLES,
             plant,
             probe_input: None,
             probe_armed: false,
@@ -554,7 +565,11 @@ impl Cia402Link {
                 DriveState::Disabled
             }
         };
-        let oldest = self.setpoints[(self.head + 1) % self.setpoints.len()];
+        let oldest = self
+            .setpoints
+            .get((self.head + 1) % self.transport.max(1))
+            .copied()
+            .unwrap_or_default();
         let di = fb.digital_inputs;
         let (zero_mark, reference_cam_left) = self.homing_marks(fb);
         DriveInputs {
@@ -729,7 +744,7 @@ impl Cia402Link {
             // follows the setpoint that tracks the actual value.
             self.controlword = DeviceCommand::QuickStop.controlword();
         }
-        self.head = (self.head + 1) % self.setpoints.len();
+        self.head = (self.head + 1) % self.transport.max(1);
         if let Some(s) = self.setpoints.get_mut(self.head) {
             *s = out.position;
         }

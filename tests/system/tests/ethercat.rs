@@ -6,7 +6,8 @@
 //! Proves: the node finds the expected SubDevices, brings the segment to OP and exchanges the
 //! PDI every cycle; MC_Power enables the emulated drive through its CiA 402 enable sequence
 //! over EtherCAT and MC_MoveAbsolute brings the axis to its target with its following error
-//! below its limit in every cycle; a bus that differs from the cell file (a revision, a missing
+//! below its limit in every cycle; an output cam's switching on the terminal's output comes
+//! back on its looped-back input within 5 cycles; a bus that differs from the cell file (a revision, a missing
 //! SubDevice) refuses to start with exit code 3, naming the position and both identities.
 //!
 //! Every wait has a timeout.
@@ -158,6 +159,27 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
     assert!(log.contains("slide MC_Power job 1: Status TRUE"), "{log}");
     assert!(log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
     assert!(!log.contains("alarm"), "{log}");
+    // The output cam switches the terminal's output 1 at 50 mm; the emulator's loop brings it
+    // back on input 1, which the node logs a few cycles later.
+    let time_of = |what: &str| -> f64 {
+        let line = log
+            .lines()
+            .find(|l| l.contains(what))
+            .unwrap_or_else(|| panic!("no `{what}` in\n{log}"));
+        line.trim_start_matches("t=")
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let on = time_of("lamp_cam output ON");
+    let back = time_of("io inputs 0x01 (EtherCAT)");
+    assert!(
+        back > on && back - on <= 0.010,
+        "output ON at {on} s, back on the input at {back} s"
+    );
+    assert!(!log.contains("lamp_cam output OFF"), "{log}");
     let fe: Vec<f64> = column(&rec.join("drives.csv"), "slide.following_error")
         .iter()
         .map(|v| v.parse().unwrap())

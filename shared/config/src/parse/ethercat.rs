@@ -19,6 +19,13 @@ const ROLES: [(&str, EthercatRole); 2] =
 /// of `tandem-ecat-sim`'s drive (a 20-bit motor encoder).
 const DEFAULT_INCREMENTS: u32 = 1 << 20;
 
+/// Cycles from a setpoint to its actual value on an EtherCAT drive without `transport_cycles`:
+/// the setpoint of the step at `t` goes out with the exchange at `t + cycle`, the drive acts on
+/// it until its next exchange, which samples it, and the node reads that sample a cycle later
+/// (measured on `tandem-ecat-sim`'s drive, whose inputs are one exchange behind; inferred the
+/// same for a drive that samples at SYNC0 before the frame).
+const DEFAULT_TRANSPORT_CYCLES: u8 = 4;
+
 /// The longest interface name Linux takes (IFNAMSIZ 16 with the terminating NUL).
 const MAX_INTERFACE: usize = 15;
 
@@ -202,16 +209,33 @@ fn subdevice(
                     Problem::Invalid("must be at least 1"),
                 ));
             }
-            DeviceKind::EthercatCia402(EthercatDriveParams {
-                increments_per_revolution: steps,
-            })
-        }
-        EthercatRole::Dio => {
-            if s.increments_per_revolution.is_some() {
+            let transport_cycles = s.transport_cycles.unwrap_or(DEFAULT_TRANSPORT_CYCLES);
+            if !(2..=8).contains(&transport_cycles) {
                 return Err(cx.in_subdevice(
                     i,
                     j,
-                    "increments_per_revolution",
+                    "transport_cycles",
+                    Problem::Invalid("must be from 2 to 8 cycles"),
+                ));
+            }
+            DeviceKind::EthercatCia402(EthercatDriveParams {
+                increments_per_revolution: steps,
+                transport_cycles,
+            })
+        }
+        EthercatRole::Dio => {
+            let drive_key = if s.increments_per_revolution.is_some() {
+                Some("increments_per_revolution")
+            } else if s.transport_cycles.is_some() {
+                Some("transport_cycles")
+            } else {
+                None
+            };
+            if let Some(key) = drive_key {
+                return Err(cx.in_subdevice(
+                    i,
+                    j,
+                    key,
                     Problem::Invalid("only for `role = \"cia402\"`"),
                 ));
             }
