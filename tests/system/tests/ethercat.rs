@@ -148,7 +148,7 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
     let up = Spawned::start(
         tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
             .arg("--script")
-            .arg(root().join("config/ethercat-script.toml")),
+            .arg(root().join("config/ethercat.script.toml")),
     );
     let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
     assert!(status.success(), "tandem up failed: {status}\n{up_log}");
@@ -243,5 +243,156 @@ fn a_bus_that_differs_from_the_cell_file_refuses_to_start_naming_the_first_misma
             "{out}"
         );
     }
+    remove_dir(&dir);
+}
+
+/// A second axis of the node, on the simulated drive inside the axis (not on the segment).
+const OTHER_AXIS: &str = r#"
+[axes.other]
+node = "drives"
+kind = "positioning"
+motion_type = "linear"
+
+[axes.other.dynamics]
+max_velocity = 300.0
+max_acceleration = 3000.0
+max_deceleration = 3000.0
+max_jerk = 60000.0
+velocity = 100.0
+acceleration = 1000.0
+deceleration = 1000.0
+jerk = 20000.0
+emergency_deceleration = 3000.0
+
+[axes.slide]"#;
+
+/// Both axes move for about 4 s; the test kills the emulator while they do.
+const LONG_SCRIPT: &str = r#"
+[sim]
+duration = 6.0
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Home"
+mode = 0
+position = 0.0
+
+[[at]]
+t = 0.0
+axis = "other"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "other"
+instruction = "MC_Home"
+mode = 0
+position = 0.0
+
+[[at]]
+t = 0.1
+axis = "slide"
+instruction = "MC_MoveAbsolute"
+position = 400.0
+
+[[at]]
+t = 0.1
+axis = "other"
+instruction = "MC_MoveAbsolute"
+position = 450.0
+"#;
+
+#[test]
+fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
+    let ns = Netns::create("k");
+    let sim = start_sim(&ns, "drive,dio", 2);
+    let dir = fresh_dir(&format!("tandem-ethercat-k-{}", std::process::id()));
+    let cell = cell(&dir, "\n[axes.slide]", OTHER_AXIS);
+    let script = dir.join("script.toml");
+    std::fs::write(&script, LONG_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let mut up = tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+        .arg("--script")
+        .arg(&script)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn tandem up");
+    let (tx, rx) = mpsc::channel::<String>();
+    for pipe in [
+        Box::new(up.stdout.take().unwrap()) as Box<dyn std::io::Read + Send>,
+        Box::new(up.stderr.take().unwrap()),
+    ] {
+        let tx = tx.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+                // The test may have stopped reading; the line is then of no use.
+                let _ = tx.send(line);
+            }
+        });
+    }
+    drop(tx);
+    let mut said = String::new();
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    while !said.contains("EtherCAT segment in OP") {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let line = rx
+            .recv_timeout(left)
+            .unwrap_or_else(|_| panic!("no OP within 60 s:\n{said}"));
+        said.push_str(&line);
+        said.push('\n');
+    }
+    // The node's clock starts at the next whole second; both axes move from 0.1 s to 4 s.
+    std::thread::sleep(Duration::from_millis(2500));
+    drop(sim);
+    let status = tandem_testkit::process::wait_for(&mut up, Duration::from_secs(60), "tandem up");
+    while let Ok(line) = rx.recv_timeout(Duration::from_secs(5)) {
+        said.push_str(&line);
+        said.push('\n');
+    }
+    assert!(status.success(), "tandem up failed: {status}\n{said}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // The axis on the segment: alarm 421 with 0x8130, its move aborted.
+    assert!(
+        log.contains("slide alarm 421 DriveFault (supplement 33072"),
+        "{log}"
+    );
+    assert!(!log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
+    // The other axis carries on to its target, without an alarm.
+    assert!(log.contains("other MC_MoveAbsolute job 3: Done"), "{log}");
+    assert!(!log.contains("other alarm"), "{log}");
+    let end = said
+        .lines()
+        .find(|l| l.contains("EtherCAT segment:"))
+        .unwrap_or_else(|| panic!("no end line:\n{said}"));
+    assert!(end.contains(", 1 alarms;"), "{end}");
+    // The alarm comes 10 missed cycles (MISSES_TO_ALARM) after the last complete exchange: the
+    // cycles before it are the complete exchanges, the first cycle (nothing to take back yet)
+    // and the few misses of a loaded host before the kill.
+    let exchanges: i64 = end
+        .split("EtherCAT segment: ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{end}"));
+    let alarm_at: f64 = log
+        .lines()
+        .find(|l| l.contains("slide alarm 421"))
+        .and_then(|l| l.trim_start_matches("t=").split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    let alarm_cycle = (alarm_at / 0.002).round() as i64;
+    let after = alarm_cycle - exchanges;
+    assert!(
+        (10..=40).contains(&after),
+        "alarm at cycle {alarm_cycle}, {exchanges} exchanges before: {after} cycles after"
+    );
+    eprintln!("{end}\nalarm at cycle {alarm_cycle}, {after} cycles after {exchanges} exchanges");
     remove_dir(&dir);
 }
