@@ -29,12 +29,13 @@ use tandem_motion::plant::cia402::{DriveCommand, DriveFeedback};
 use tandem_runtime::exec::{Executive, Secs};
 use tracing::{info, warn};
 
-/// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 10 cycles. Not
-/// the 3 the EtherCAT issue aims at: on the shared 2-core test host, without real-time
-/// priority, the "ethercat" thread was measured late 3 cycles in a row (2 ms cycle, two such
-/// nodes side by side) while the segment was fine. With the node's `realtime.priority` (which
-/// the EtherCAT threads take too) on an isolated CPU, 3 is the aim.
-pub const MISSES_TO_ALARM: u32 = 10;
+/// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 3 cycles, the
+/// bound the EtherCAT issue sets for a lost SubDevice's alarm (inferred: one or two late
+/// exchanges are jitter, three in a row a lost segment). It presumes the node runs with its
+/// `realtime.priority`, which its EtherCAT threads take too: without it, with a load of 5 on
+/// the shared 2-core test host, the "ethercat" thread was measured late up to 10 cycles in a row
+/// (2 ms cycle) while the segment was fine; with SCHED_FIFO 40 it missed none in 1,500 cycles.
+pub const MISSES_TO_ALARM: u32 = 3;
 
 /// The error code 0x603F a drive on a segment that stopped exchanging shows: 0x8130, "life
 /// guard error or heartbeat error" of CiA 301's emergency error codes (inferred: the code of a
@@ -253,6 +254,8 @@ struct Part {
     inputs: u8,
     /// The inputs byte last logged.
     inputs_logged: u8,
+    /// The device of its inputs, if they are bound to input signals.
+    inputs_device: Option<usize>,
     /// Its name in the cell (for the log).
     name: String,
 }
@@ -363,7 +366,12 @@ impl Link {
                     if let Some(d) = self.drives.iter_mut().find(|d| d.0 == p.device) {
                         d.1 = p.feedback;
                     }
-                } else if p.inputs != p.inputs_logged {
+                    continue;
+                }
+                if let Some(d) = p.inputs_device {
+                    exec.set_input_levels(d, t, u32::from(p.inputs));
+                }
+                if p.inputs != p.inputs_logged {
                     p.inputs_logged = p.inputs;
                     // The log ring keeps what fits; a full ring counts its losses itself.
                     let _ = writeln!(
@@ -456,8 +464,8 @@ struct Plan {
     interface: String,
     /// The node's SCHED_FIFO priority, which the EtherCAT threads take too.
     priority: Option<u8>,
-    /// Per expected SubDevice in bus order: name, identity, role, device.
-    expected: Vec<(String, EthercatIdentity, EthercatRole, usize)>,
+    /// Per expected SubDevice in bus order: name, identity, role, device, inputs device.
+    expected: Vec<(String, EthercatIdentity, EthercatRole, usize, Option<usize>)>,
 }
 
 /// Opens node `n`'s segment if it has one: the bus checked against the cell file, the drives'
@@ -473,7 +481,15 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
         expected: seg
             .subdevices
             .iter()
-            .map(|s| (s.name.clone(), s.identity, s.role, s.device.0))
+            .map(|s| {
+                (
+                    s.name.clone(),
+                    s.identity,
+                    s.role,
+                    s.device.0,
+                    s.inputs.map(|d| d.0),
+                )
+            })
             .collect(),
     };
     let interface = seg.interface.clone();
@@ -631,7 +647,7 @@ async fn run_bus(
             }));
             return;
         }
-        let (Some((name, _, role, device)), Some(sd)) = (expected, sd) else {
+        let (Some((name, _, role, device, inputs_device)), Some(sd)) = (expected, sd) else {
             return;
         };
         let map = match role {
@@ -653,6 +669,7 @@ async fn run_bus(
             outputs: 0,
             inputs: 0,
             inputs_logged: 0,
+            inputs_device: *inputs_device,
             name: name.clone(),
         });
     }

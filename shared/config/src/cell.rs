@@ -157,8 +157,12 @@ pub enum DeviceKind {
     /// A CiA 402 drive on the node's EtherCAT segment (`[[ethercat.subdevices]] role =
     /// "cia402"`): its process data are exchanged by the node.
     EthercatCia402(EthercatDriveParams),
-    /// A digital input/output terminal on the node's EtherCAT segment (`role = "dio"`).
+    /// A digital input/output terminal on the node's EtherCAT segment (`role = "dio"`): its
+    /// 8 outputs.
     EthercatDio,
+    /// The 8 inputs of such a terminal (`inputs = "<name>"` of its SubDevice), a device of
+    /// their own.
+    EthercatDioInputs,
 }
 
 /// What the configuration knows of a CiA 402 drive on an EtherCAT segment.
@@ -209,6 +213,8 @@ pub struct EthercatSubDevice {
     pub name: String,
     /// Its device.
     pub device: DeviceIndex,
+    /// A `dio`'s inputs device, if its inputs are bound (`inputs = "<name>"`).
+    pub inputs: Option<DeviceIndex>,
     /// The identity it must report.
     pub identity: EthercatIdentity,
     /// What it is.
@@ -239,6 +245,7 @@ impl DeviceKind {
             DeviceKind::SimCounter(_) => "sim_counter",
             DeviceKind::EthercatCia402(_) => "ethercat_cia402",
             DeviceKind::EthercatDio => "ethercat_dio",
+            DeviceKind::EthercatDioInputs => "ethercat_dio_inputs",
         }
     }
 
@@ -249,8 +256,8 @@ impl DeviceKind {
             DeviceKind::SimServo(_)
             | DeviceKind::SimAnalogDrive(_)
             | DeviceKind::EthercatCia402(_) => None,
-            // Its 8 outputs; its inputs come back in the node's log (docs/ethercat.md).
             DeviceKind::EthercatDio => Some((8, false, SignalDirection::Output)),
+            DeviceKind::EthercatDioInputs => Some((8, false, SignalDirection::Input)),
             DeviceKind::SimDigitalOutput(p) => {
                 Some((p.channels, p.timestamped, SignalDirection::Output))
             }
@@ -269,7 +276,7 @@ impl DeviceKind {
             DeviceKind::SimServo(_)
             | DeviceKind::SimAnalogDrive(_)
             | DeviceKind::EthercatCia402(_) => None,
-            DeviceKind::EthercatDio => Some(SignalType::Bool),
+            DeviceKind::EthercatDio | DeviceKind::EthercatDioInputs => Some(SignalType::Bool),
             DeviceKind::SimDigitalOutput(DigitalOutputParams { timestamped, .. })
             | DeviceKind::SimDigitalInput(DigitalInputParams { timestamped, .. }) => {
                 Some(if *timestamped {

@@ -1219,6 +1219,8 @@ pub struct SubDeviceSection {
     pub increments_per_revolution: Option<u32>,
     /// `cia402`: cycles from a setpoint to the actual value that shows it (default 4).
     pub transport_cycles: Option<u8>,
+    /// `dio`: the name of a device of its own for the terminal's 8 inputs.
+    pub inputs: Option<String>,
 }
 
 /// `identity = { vendor, product, revision }`: CiA 301 identity object 0x1018:01..03.

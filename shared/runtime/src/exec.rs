@@ -1115,6 +1115,14 @@ impl<'c> Executive<'c> {
         self.drives.set_external_feedback(device, feedback)
     }
 
+    /// The levels of input device `device` (index in [`Cell::devices`]: the inputs of a digital
+    /// terminal on the node's EtherCAT segment) an edge read at the boundary `t`, bit `c - 1`
+    /// for channel `c`: sampled by the step at `t` as a `sim_digital_input` is. `false` when
+    /// this executive runs no such device.
+    pub fn set_input_levels(&mut self, device: usize, t: i64, levels: u32) -> bool {
+        self.inputs.set_levels(device, t, levels)
+    }
+
     /// The RxPDO the last step wrote for external drive `device`, which the edge sends at the
     /// next boundary; `None` when this executive runs no such drive.
     pub fn drive_command(

@@ -7,7 +7,8 @@
 //! PDI every cycle; MC_Power enables the emulated drive through its CiA 402 enable sequence
 //! over EtherCAT and MC_MoveAbsolute brings the axis to its target with its following error
 //! below its limit in every cycle; an output cam's switching on the terminal's output comes
-//! back on its looped-back input within 5 cycles; a bus that differs from the cell file (a revision, a missing
+//! back on its looped-back input within 5 cycles, where it is an input signal: the positive
+//! limit switch of a second axis, which stops with alarm 531 in that step; a bus that differs from the cell file (a revision, a missing
 //! SubDevice) refuses to start with exit code 3, naming the position and both identities.
 //!
 //! Every wait has a timeout.
@@ -80,8 +81,12 @@ impl Drop for Sim {
 /// Starts `tandem-ecat-sim --devices <devices> --loopback` on `ecs` with a 2 ms cycle and waits
 /// (10 s at most) for it to say it runs `n` SubDevices.
 fn start_sim(ns: &Netns, devices: &str, n: usize) -> Sim {
+    // SCHED_FIFO as the node's threads (see `cell`): on this shared host a starved emulator
+    // answers late as much as a starved node asks late.
     let mut child = ns
-        .exec(&bin("tandem-ecat-sim"))
+        .exec(Path::new("chrt"))
+        .args(["-f", "40"])
+        .arg(bin("tandem-ecat-sim"))
         .args(["--interface", "ecs", "--devices", devices])
         .args(["--cycle-us", "2000", "--loopback"])
         .stderr(Stdio::piped())
@@ -108,9 +113,18 @@ fn start_sim(ns: &Netns, devices: &str, n: usize) -> Sim {
     sim
 }
 
-/// `config/ethercat.toml` under a name of its own in `dir`, with `from` replaced by `to`.
+/// `config/ethercat.toml` under a name of its own in `dir`, with `from` replaced by `to`, and
+/// the node on SCHED_FIFO 40 (its cyclic and EtherCAT threads), as docs/ethercat.md asks of a
+/// node with a segment: without it, with a load of 5 on this shared 2-core host, the EtherCAT
+/// thread was once late 10 cycles in a row (20 ms) and the segment's alarm came in a healthy run.
 fn cell(dir: &Path, from: &str, to: &str) -> PathBuf {
-    let src = std::fs::read_to_string(root().join("config/ethercat.toml")).unwrap();
+    let src = std::fs::read_to_string(root().join("config/ethercat.toml"))
+        .unwrap()
+        .replacen(
+            "[[ethercat]]",
+            "[nodes.realtime]\npriority = 40\n\n[[ethercat]]",
+            1,
+        );
     assert!(src.contains(from), "{from}");
     let name = format!("ethercat{}", std::process::id());
     let cell = dir.join("ethercat.toml");
@@ -138,27 +152,59 @@ fn column(p: &Path, col: &str) -> Vec<String> {
         .collect()
 }
 
+/// The example's script, and a second axis (on the simulated drive) moving towards its
+/// positive limit switch, which is the terminal's looped-back input 1.
+const LIMIT_SCRIPT: &str = r#"
+[[at]]
+t = 0.0
+axis = "other"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "other"
+instruction = "MC_Home"
+mode = 0
+position = 0.0
+
+[[at]]
+t = 0.1
+axis = "other"
+instruction = "MC_MoveVelocity"
+velocity = 20.0
+"#;
+
 #[test]
 fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_limit() {
     let ns = Netns::create("m");
     let _sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-{}", std::process::id()));
-    let cell = cell(&dir, "[cell]", "[cell]");
+    let other = format!("{OTHER_AXIS}").replace(
+        "\n[axes.slide]",
+        "\n[axes.other.inputs]\nlimit_positive = \"lamp_back\"\n\n[axes.slide]",
+    );
+    let cell = cell(&dir, "\n[axes.slide]", &other);
+    let script = dir.join("script.toml");
+    let example = std::fs::read_to_string(root().join("config/ethercat.script.toml")).unwrap();
+    std::fs::write(&script, format!("{example}\n{LIMIT_SCRIPT}")).unwrap();
     let rec = dir.join("rec");
     let up = Spawned::start(
         tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
             .arg("--script")
-            .arg(root().join("config/ethercat.script.toml")),
+            .arg(&script),
     );
     let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
     assert!(status.success(), "tandem up failed: {status}\n{up_log}");
     assert!(!up_log.contains("panicked"), "{up_log}");
     assert!(up_log.contains("EtherCAT segment in OP"), "{up_log}");
+    for line in up_log.lines().filter(|l| l.contains("EtherCAT segment:")) {
+        eprintln!("{line}");
+    }
     let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
     // The enable sequence over the segment, then the move, without any alarm.
     assert!(log.contains("slide MC_Power job 1: Status TRUE"), "{log}");
     assert!(log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
-    assert!(!log.contains("alarm"), "{log}");
+    assert!(!log.contains("slide alarm"), "{log}");
     // The output cam switches the terminal's output 1 at 50 mm; the emulator's loop brings it
     // back on input 1, which the node logs a few cycles later.
     let time_of = |what: &str| -> f64 {
@@ -180,6 +226,13 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
         "output ON at {on} s, back on the input at {back} s"
     );
     assert!(!log.contains("lamp_cam output OFF"), "{log}");
+    // ... and that input, the other axis's positive limit switch, stops it (alarm 531) in the
+    // step that sampled it, while the axis on the drive carries on.
+    let limit = time_of("other alarm 531");
+    assert!(
+        (limit - back).abs() < 1e-9,
+        "limit at {limit} s, input at {back} s\n{log}"
+    );
     let fe: Vec<f64> = column(&rec.join("drives.csv"), "slide.following_error")
         .iter()
         .map(|v| v.parse().unwrap())
@@ -196,9 +249,6 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
         .unwrap();
     assert!((actual - 100.0).abs() < 0.01, "actual position {actual}");
     eprintln!("max |following error| {worst:.4} mm");
-    for line in up_log.lines().filter(|l| l.contains("EtherCAT segment:")) {
-        eprintln!("{line}");
-    }
     remove_dir(&dir);
 }
 
@@ -372,9 +422,9 @@ fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
         .find(|l| l.contains("EtherCAT segment:"))
         .unwrap_or_else(|| panic!("no end line:\n{said}"));
     assert!(end.contains(", 1 alarms;"), "{end}");
-    // The alarm comes 10 missed cycles (MISSES_TO_ALARM) after the last complete exchange: the
+    // The alarm comes 3 missed cycles (MISSES_TO_ALARM) after the last complete exchange: the
     // cycles before it are the complete exchanges, the first cycle (nothing to take back yet)
-    // and the few misses of a loaded host before the kill.
+    // and any late exchange before the kill.
     let exchanges: i64 = end
         .split("EtherCAT segment: ")
         .nth(1)
@@ -390,7 +440,7 @@ fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
     let alarm_cycle = (alarm_at / 0.002).round() as i64;
     let after = alarm_cycle - exchanges;
     assert!(
-        (10..=40).contains(&after),
+        (3..=5).contains(&after),
         "alarm at cycle {alarm_cycle}, {exchanges} exchanges before: {after} cycles after"
     );
     eprintln!("{end}\nalarm at cycle {alarm_cycle}, {after} cycles after {exchanges} exchanges");

@@ -488,6 +488,7 @@ pub(super) fn drives(
             }
             // Refused by `Bound::device` (not a drive).
             DeviceKind::EthercatDio
+            | DeviceKind::EthercatDioInputs
             | DeviceKind::SimDigitalOutput(_)
             | DeviceKind::SimDigitalInput(_)
             | DeviceKind::SimAnalogInput(_)

@@ -33,8 +33,11 @@ const MAX_INTERFACE: usize = 15;
 /// bounds the PDI the node allocates).
 const MAX_SUBDEVICES: usize = 64;
 
-/// A segment as read so far: its node, its interface, its SubDevices (name, identity, role).
-type Expected = (usize, String, Vec<(String, EthercatIdentity, EthercatRole)>);
+/// A SubDevice as read: name, identity, role, the name of its inputs device.
+type Sub = (String, EthercatIdentity, EthercatRole, Option<String>);
+
+/// A segment as read so far: its node, its interface, its SubDevices.
+type Expected = (usize, String, Vec<Sub>);
 
 impl Ctx<'_> {
     /// An error at `key` of `[[ethercat]]` `i`'s SubDevice `j` (the SubDevice's table when
@@ -86,21 +89,38 @@ pub(super) fn segments(
     let mut expected: Vec<Expected> = Vec::new();
     for (i, e) in raw.ethercat.iter().enumerate() {
         let node = segment_node(cx, i, e, nodes, &expected)?;
-        let mut subs = Vec::new();
+        let mut subs: Vec<Sub> = Vec::new();
         for (j, s) in e.subdevices.iter().enumerate() {
-            let taken = devices.iter().any(|d| d.name == s.name)
-                || expected
-                    .iter()
-                    .flat_map(|x| x.2.iter())
-                    .chain(subs.iter())
-                    .any(|x| x.0 == s.name);
+            let taken = name_taken(&devices, &expected, &subs, &s.name);
             let (kind, role, identity) = subdevice(cx, i, j, s, taken)?;
             devices.push(DeviceEntry {
                 name: s.name.clone(),
                 node,
                 kind,
             });
-            subs.push((s.name.clone(), identity, role));
+            if let Some(inputs) = &s.inputs {
+                let problem = if role != EthercatRole::Dio {
+                    Some(Problem::Invalid("only for `role = \"dio\"`"))
+                } else if !plain_name(inputs) {
+                    Some(Problem::BadName {
+                        what: "device",
+                        name: inputs.clone(),
+                    })
+                } else if name_taken(&devices, &expected, &subs, inputs) {
+                    Some(Problem::NameTaken(inputs.clone()))
+                } else {
+                    None
+                };
+                if let Some(p) = problem {
+                    return Err(cx.in_subdevice(i, j, "inputs", p));
+                }
+                devices.push(DeviceEntry {
+                    name: inputs.clone(),
+                    node,
+                    kind: DeviceKind::EthercatDioInputs,
+                });
+            }
+            subs.push((s.name.clone(), identity, role, s.inputs.clone()));
         }
         expected.push((node, e.interface.clone(), subs));
     }
@@ -113,8 +133,9 @@ pub(super) fn segments(
             interface,
             subdevices: subs
                 .into_iter()
-                .map(|(name, identity, role)| EthercatSubDevice {
+                .map(|(name, identity, role, inputs)| EthercatSubDevice {
                     device: index(&name),
+                    inputs: inputs.as_deref().map(index),
                     name,
                     identity,
                     role,
@@ -123,6 +144,16 @@ pub(super) fn segments(
         })
         .collect();
     Ok((devices, segments))
+}
+
+/// Whether `name` is a device's already, or a SubDevice's or its inputs' read so far.
+fn name_taken(devices: &[DeviceEntry], expected: &[Expected], subs: &[Sub], name: &str) -> bool {
+    devices.iter().any(|d| d.name == name)
+        || expected
+            .iter()
+            .flat_map(|x| x.2.iter())
+            .chain(subs.iter())
+            .any(|x| x.0 == name || x.3.as_deref() == Some(name))
 }
 
 /// Segment `i`'s node (known, without another segment) after checking its interface and that
