@@ -55,7 +55,23 @@ fn the_example_segment_gives_the_node_its_devices_and_the_axis_its_drive() {
     );
     // Devices stay in name order; each SubDevice's index points at its own device.
     let dev_names: Vec<&str> = cell.devices.iter().map(|d| d.name.as_str()).collect();
-    assert_eq!(dev_names, ["io", "slide_servo"]);
+    assert_eq!(dev_names, ["io", "io_in", "slide_servo"]);
+    let inputs = seg.subdevices[1].inputs.expect("the dio's inputs device");
+    assert_eq!(cell.devices[inputs.0].name, "io_in");
+    assert_eq!(cell.devices[inputs.0].kind, DeviceKind::EthercatDioInputs);
+    assert_eq!(seg.subdevices[0].inputs, None);
+    // Its channels are inputs, the terminal's are outputs.
+    let lamp_back = cell.signal("lamp_back").unwrap();
+    assert_eq!(cell.signals[lamp_back.0].device, inputs);
+    assert_eq!(
+        cell.signals[lamp_back.0].direction,
+        tandem_config::SignalDirection::Input
+    );
+    let lamp = cell.signal("lamp").unwrap();
+    assert_eq!(
+        cell.signals[lamp.0].direction,
+        tandem_config::SignalDirection::Output
+    );
     for s in &seg.subdevices {
         assert_eq!(cell.devices[s.device.0].name, s.name);
         assert_eq!(cell.devices[s.device.0].node, seg.node);
@@ -243,6 +259,34 @@ fn transport_cycles_from_2_to_8_on_a_drive_only() {
     let src = with("role = \"dio\"", "role = \"dio\"\ntransport_cycles = 3");
     let (_, key, _) = refused(&src);
     assert_eq!(key, "ethercat[0].subdevices[1].transport_cycles");
+}
+
+#[test]
+fn a_dio_inputs_device_is_refused_on_a_drive_taken_or_not_plain() {
+    let src = with(
+        "role = \"cia402\"",
+        "role = \"cia402\"\ninputs = \"servo_in\"",
+    );
+    let (line, key, p) = refused(&src);
+    assert_eq!(key, "ethercat[0].subdevices[0].inputs");
+    assert_eq!(line, Some(line_of(&src, "inputs = \"servo_in\"")));
+    assert_eq!(p, Problem::Invalid("only for `role = \"dio\"`"));
+    for (name, want) in [
+        ("slide_servo", Problem::NameTaken("slide_servo".into())),
+        ("io", Problem::NameTaken("io".into())),
+        (
+            "in put",
+            Problem::BadName {
+                what: "device",
+                name: "in put".into(),
+            },
+        ),
+    ] {
+        let src = with("inputs = \"io_in\"", &format!("inputs = \"{name}\""));
+        let (_, key, p) = refused(&src);
+        assert_eq!(key, "ethercat[0].subdevices[1].inputs", "{name}");
+        assert_eq!(p, want);
+    }
 }
 
 #[test]

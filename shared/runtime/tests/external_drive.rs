@@ -28,7 +28,8 @@ fn external_cell() -> Cell {
     tandem_config::parse("ethercat.toml", &src).unwrap()
 }
 
-/// The same cell with the segment replaced by a `sim_servo` and a `sim_digital_output`.
+/// The same cell with the segment replaced by a `sim_servo`, a `sim_digital_output` and a
+/// `sim_digital_input`.
 fn simulated_cell() -> Cell {
     let src = example();
     let start = src.find("[[ethercat]]").unwrap();
@@ -37,7 +38,8 @@ fn simulated_cell() -> Cell {
     s.replace_range(
         start..end,
         "[devices.slide_servo]\nnode = \"drives\"\nkind = \"sim_servo\"\n\n\
-         [devices.io]\nnode = \"drives\"\nkind = \"sim_digital_output\"\nchannels = 8\n\n",
+         [devices.io]\nnode = \"drives\"\nkind = \"sim_digital_output\"\nchannels = 8\n\n\
+         [devices.io_in]\nnode = \"drives\"\nkind = \"sim_digital_input\"\nchannels = 8\n\n",
     );
     tandem_config::parse("sim.toml", &s).unwrap()
 }

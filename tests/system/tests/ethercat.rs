@@ -179,7 +179,7 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
     let ns = Netns::create("m");
     let _sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-{}", std::process::id()));
-    let other = format!("{OTHER_AXIS}").replace(
+    let other = OTHER_AXIS.replace(
         "\n[axes.slide]",
         "\n[axes.other.inputs]\nlimit_positive = \"lamp_back\"\n\n[axes.slide]",
     );
