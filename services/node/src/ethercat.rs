@@ -18,8 +18,12 @@
 //! error code [`LOST_CODE`], which its axis takes as alarm 421 with the reaction the drive
 //! fault has; the node's other axes carry on.
 
-use ethercrab::std::{ethercat_now, tx_rx_task};
-use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, SubDeviceRef, Timeouts};
+use ethercrab::std::tx_rx_task;
+use ethercrab::subdevice_group::{self, DcConfiguration};
+use ethercrab::{
+    DcSync, MainDevice, MainDeviceConfig, PduStorage, RegisterAddress, SubDeviceGroup,
+    SubDeviceRef, Timeouts,
+};
 use std::fmt;
 use std::io::Write;
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
@@ -464,6 +468,8 @@ struct Plan {
     interface: String,
     /// The node's SCHED_FIFO priority, which the EtherCAT threads take too.
     priority: Option<u8>,
+    /// The node's cycle (ns): SYNC0's period.
+    cycle_ns: u64,
     /// Per expected SubDevice in bus order: name, identity, role, device, inputs device.
     expected: Vec<(String, EthercatIdentity, EthercatRole, usize, Option<usize>)>,
 }
@@ -478,6 +484,9 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
     let plan = Plan {
         interface: seg.interface.clone(),
         priority: cell.nodes.get(n).and_then(|x| x.realtime.priority),
+        cycle_ns: cell.nodes.get(n).map_or(1_000_000, |x| {
+            u64::try_from(x.cycle_ns).unwrap_or(1_000_000)
+        }),
         expected: seg
             .subdevices
             .iter()
@@ -600,6 +609,36 @@ fn realtime(priority: Option<u8>) {
     }
 }
 
+/// The DC epoch, 2000-01-01 00:00 UTC, on the cell clock (ns since the Unix epoch).
+const DC_EPOCH_NS: i64 = 946_684_800 * 1_000_000_000;
+
+/// The cell clock as DC system time (ns since 2000-01-01): the time base ethercrab sets the
+/// SubDevices' clocks to (their offsets 0x0920), so that the DC system time is cell time and
+/// SYNC0, at whole multiples of the node's cycle in DC time, falls on the node's grid (whose
+/// epoch is a whole second: exactly when the cycle divides one second).
+fn cell_dc_now() -> u64 {
+    u64::try_from(tandem_rt::now_ns().saturating_sub(DC_EPOCH_NS)).unwrap_or(0)
+}
+
+/// The "ethercat" thread's ends of the channels.
+struct Ends<'a> {
+    ready: &'a SyncSender<Result<Box<Image>, EthercatError>>,
+    bus_in: &'a Receiver<Box<Image>>,
+    bus_out: &'a SyncSender<Box<Image>>,
+}
+
+impl Ends<'_> {
+    /// Reports why the start failed.
+    fn refuse(&self, e: EthercatError) {
+        // The receiver waits with a timeout; if it gave up nobody needs the answer.
+        let _ = self.ready.send(Err(e));
+    }
+}
+
+/// The node's group of SubDevices in OP, with or without DC.
+type OpGroup<DC> =
+    SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, subdevice_group::Op, DC>;
+
 /// The MainDevice's work: start (see [`open`]), then the exchanges.
 async fn run_bus(
     plan: &Plan,
@@ -608,21 +647,112 @@ async fn run_bus(
     bus_in: &Receiver<Box<Image>>,
     bus_out: &SyncSender<Box<Image>>,
 ) {
+    let ends = Ends {
+        ready,
+        bus_in,
+        bus_out,
+    };
     let fail = |what: &str, e: ethercrab::error::Error| EthercatError::Start {
         interface: plan.interface.clone(),
         reason: format!("{what}: {e}"),
     };
-    let group = match md
-        .init_single_group::<MAX_SUBDEVICES, MAX_PDI>(ethercat_now)
+    let mut group = match md
+        .init_single_group::<MAX_SUBDEVICES, MAX_PDI>(cell_dc_now)
         .await
     {
         Ok(g) => g,
-        Err(e) => {
-            // The receiver waits with a timeout; if it gave up nobody needs the answer.
-            let _ = ready.send(Err(fail("no segment found", e)));
-            return;
-        }
+        Err(e) => return ends.refuse(fail("no segment found", e)),
     };
+    let parts = match check_and_map(plan, md, &group).await {
+        Ok(p) => p,
+        Err(e) => return ends.refuse(e),
+    };
+    // SYNC0 on every SubDevice with DC, every node cycle.
+    let mut dc = 0usize;
+    for mut sd in group.iter_mut(md) {
+        if sd.dc_support().any() {
+            sd.set_dc_sync(DcSync::Sync0);
+            dc += 1;
+        }
+    }
+    if dc == 0 {
+        let group = match group.into_safe_op(md).await {
+            Ok(g) => g,
+            Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+        };
+        match group.request_into_op(md).await {
+            Ok(g) => serve(plan, md, &g, parts, &ends).await,
+            Err(e) => ends.refuse(fail("OP refused", e)),
+        }
+        return;
+    }
+    let conf = DcConfiguration {
+        // Inferred: time for the SubDevices to take the configuration before the first pulse.
+        start_delay: Duration::from_millis(100),
+        sync0_period: Duration::from_nanos(plan.cycle_ns),
+        sync0_shift: Duration::ZERO,
+    };
+    let group = match group.into_pre_op_pdi(md).await {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("process data mapping", e)),
+    };
+    let group = match group.configure_dc_sync(md, conf).await {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("SYNC0 configuration", e)),
+    };
+    let group = match group.into_safe_op(md).await {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+    };
+    match group.request_into_op(md).await {
+        Ok(g) => {
+            log_dc(plan, md, &g, dc).await;
+            serve(plan, md, &g, parts, &ends).await;
+        }
+        Err(e) => ends.refuse(fail("OP refused", e)),
+    }
+}
+
+/// Logs the SYNC0 configuration the first DC SubDevice holds and how far its DC system time
+/// is from the cell clock.
+async fn log_dc<DC>(plan: &Plan, md: &MainDevice<'_>, group: &OpGroup<DC>, dc: usize) {
+    let Some(sd) = group.iter(md).find(|sd| sd.dc_support().any()) else {
+        return;
+    };
+    let cycle = sd
+        .register_read::<u32>(RegisterAddress::DcSync0CycleTime)
+        .await;
+    let start = sd
+        .register_read::<u64>(RegisterAddress::DcSyncStartTime)
+        .await;
+    let system = sd.register_read::<u64>(RegisterAddress::DcSystemTime).await;
+    let now = cell_dc_now();
+    match (cycle, start, system) {
+        (Ok(cycle), Ok(start), Ok(system)) => info!(
+            interface = %plan.interface,
+            sync0_ns = cycle,
+            "EtherCAT SYNC0 every {cycle} ns on {dc} SubDevice(s), first pulse at DC time {start} ns \
+             (on the node's grid: {} ns past a cycle boundary); DC system time {} us from the cell clock",
+            (i128::from(start) + i128::from(DC_EPOCH_NS)).rem_euclid(i128::from(plan.cycle_ns.max(1))),
+            (i128::from(system) - i128::from(now)) / 1000,
+        ),
+        _ => warn!(interface = %plan.interface, "EtherCAT SYNC0 registers not readable"),
+    }
+}
+
+/// Compares the bus with the cell file position by position and reads each drive's mapping:
+/// the parts of the process image in bus order.
+async fn check_and_map<DC>(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    group: &SubDeviceGroup<
+        MAX_SUBDEVICES,
+        MAX_PDI,
+        ethercrab::DefaultLock,
+        subdevice_group::PreOp,
+        DC,
+    >,
+) -> Result<Vec<Part>, EthercatError> {
     let mut parts = Vec::new();
     let found: Vec<SubDeviceRef<'_, _>> = group.iter(md).collect();
     for position in 0..plan.expected.len().max(found.len()) {
@@ -636,29 +766,16 @@ async fn run_bus(
                 revision: i.revision,
             }
         });
-        let matches = matches!((expected, id), (Some(e), Some(id)) if e.1 == id);
-        if !matches {
-            // As above.
-            let _ = ready.send(Err(EthercatError::Mismatch {
-                interface: plan.interface.clone(),
-                position,
-                expected: expected.map(|e| (e.0.clone(), e.1)),
-                found: sd.zip(id).map(|(sd, id)| (sd.name().to_string(), id)),
-            }));
-            return;
-        }
-        let (Some((name, _, role, device, inputs_device)), Some(sd)) = (expected, sd) else {
-            return;
+        let (Some((name, want, role, device, inputs_device)), Some(sd), Some(id)) =
+            (expected, sd, id)
+        else {
+            return Err(mismatch(plan, position, expected, sd.zip(id)));
         };
+        if *want != id {
+            return Err(mismatch(plan, position, expected, Some((sd, id))));
+        }
         let map = match role {
-            EthercatRole::Cia402 => match read_mapping(name, sd, &plan.interface).await {
-                Ok(m) => Some(m),
-                Err(e) => {
-                    // As above.
-                    let _ = ready.send(Err(e));
-                    return;
-                }
-            },
+            EthercatRole::Cia402 => Some(read_mapping(name, sd, &plan.interface).await?),
             EthercatRole::Dio => None,
         };
         parts.push(Part {
@@ -670,42 +787,55 @@ async fn run_bus(
             inputs: 0,
             inputs_logged: 0,
             inputs_device: *inputs_device,
-            name: name.clone(),
+            name: name.to_string(),
         });
     }
-    let group = match group.into_safe_op(md).await {
-        Ok(g) => g,
-        Err(e) => {
-            // As above.
-            let _ = ready.send(Err(fail("SAFE-OP refused", e)));
-            return;
-        }
-    };
-    let group = match group.request_into_op(md).await {
-        Ok(g) => g,
-        Err(e) => {
-            // As above.
-            let _ = ready.send(Err(fail("OP refused", e)));
-            return;
-        }
-    };
+    Ok(parts)
+}
+
+/// The mismatch at `position`: what the cell file expects there, what the bus has.
+fn mismatch<S>(
+    plan: &Plan,
+    position: usize,
+    expected: Option<&(String, EthercatIdentity, EthercatRole, usize, Option<usize>)>,
+    found: Option<(&SubDeviceRef<'_, S>, EthercatIdentity)>,
+) -> EthercatError
+where
+    S: core::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    EthercatError::Mismatch {
+        interface: plan.interface.clone(),
+        position,
+        expected: expected.map(|e| (e.0.clone(), e.1)),
+        found: found.map(|(sd, id)| (sd.name().to_string(), id)),
+    }
+}
+
+/// In OP: reports the segment ready, then one exchange per image handed over until the
+/// cyclic thread's end of the channel goes.
+async fn serve<DC>(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    group: &OpGroup<DC>,
+    parts: Vec<Part>,
+    ends: &Ends<'_>,
+) {
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         match group.tx_rx(md).await {
             Ok(r) if r.all_op() => break,
             Ok(_) if Instant::now() < deadline => {}
             Ok(_) => {
-                // As above.
-                let _ = ready.send(Err(EthercatError::Start {
+                return ends.refuse(EthercatError::Start {
                     interface: plan.interface.clone(),
                     reason: "not all SubDevices in OP within 10 s".into(),
-                }));
-                return;
+                })
             }
             Err(e) => {
-                // As above.
-                let _ = ready.send(Err(fail("exchange on the way to OP", e)));
-                return;
+                return ends.refuse(EthercatError::Start {
+                    interface: plan.interface.clone(),
+                    reason: format!("exchange on the way to OP: {e}"),
+                })
             }
         }
         async_io::Timer::after(Duration::from_millis(1)).await;
@@ -724,11 +854,11 @@ async fn run_bus(
         ok: false,
         round_trip_ns: 0,
     });
-    if ready.send(Ok(image)).is_err() {
+    if ends.ready.send(Ok(image)).is_err() {
         return;
     }
     loop {
-        let mut image = match bus_in.recv_timeout(Duration::from_secs(1)) {
+        let mut image = match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
             Ok(i) => i,
             Err(RecvTimeoutError::Timeout) => continue,
             Err(RecvTimeoutError::Disconnected) => return,
@@ -753,7 +883,7 @@ async fn run_bus(
                 }
             }
         }
-        if bus_out.send(image).is_err() {
+        if ends.bus_out.send(image).is_err() {
             return;
         }
     }

@@ -4,7 +4,8 @@
 //! `tandem up` runs `config/ethercat.toml` on the other end.
 //!
 //! Proves: the node finds the expected SubDevices, brings the segment to OP and exchanges the
-//! PDI every cycle; MC_Power enables the emulated drive through its CiA 402 enable sequence
+//! PDI every cycle, with SYNC0 configured on the drive every node cycle on the node's grid and
+//! the DC system time on the cell clock; MC_Power enables the emulated drive through its CiA 402 enable sequence
 //! over EtherCAT and MC_MoveAbsolute brings the axis to its target with its following error
 //! below its limit in every cycle; an output cam's switching on the terminal's output comes
 //! back on its looped-back input within 5 cycles, where it is an input signal: the positive
@@ -197,9 +198,31 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
     assert!(status.success(), "tandem up failed: {status}\n{up_log}");
     assert!(!up_log.contains("panicked"), "{up_log}");
     assert!(up_log.contains("EtherCAT segment in OP"), "{up_log}");
-    for line in up_log.lines().filter(|l| l.contains("EtherCAT segment:")) {
+    for line in up_log
+        .lines()
+        .filter(|l| l.contains("EtherCAT s") || l.contains("SYNC0"))
+    {
         eprintln!("{line}");
     }
+    // DC: SYNC0 on the drive every node cycle (its 0x09A0 read back), the first pulse on the
+    // node's grid, and the reference's DC system time on the cell clock (within 50 ms: the
+    // register is read in flight, the clock after the reply).
+    let dc = up_log
+        .lines()
+        .find(|l| l.contains("EtherCAT SYNC0"))
+        .unwrap_or_else(|| panic!("no SYNC0 line:\n{up_log}"));
+    assert!(
+        dc.contains("SYNC0 every 2000000 ns on 1 SubDevice(s)")
+            && dc.contains("(on the node's grid: 0 ns past a cycle boundary)"),
+        "{dc}"
+    );
+    let off_us: i64 = dc
+        .split("DC system time ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{dc}"));
+    assert!(off_us.abs() < 50_000, "{dc}");
     let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
     // The enable sequence over the segment, then the move, without any alarm.
     assert!(log.contains("slide MC_Power job 1: Status TRUE"), "{log}");
