@@ -1035,6 +1035,118 @@ mod tests {
         assert_eq!(out, [6, 0]);
     }
 
+    /// Runs `f` with a link on `config/ethercat.toml`'s drive whose bus end is the test: the
+    /// link, the node's executive, the images the link sends, the sender of the bus's answers,
+    /// and the drive's device.
+    fn with_link(
+        f: impl FnOnce(
+            &mut Link,
+            &mut Executive<'_>,
+            &Receiver<Box<Image>>,
+            &SyncSender<Box<Image>>,
+            usize,
+        ),
+    ) {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/ethercat.toml");
+        let cell = tandem_config::load(&path).unwrap();
+        let drive = cell.ethercat[0].subdevices[0].device.0;
+        let mut exec = Executive::new(&cell, Some(0)).unwrap();
+        let (to_bus, bus_in) = sync_channel(1);
+        let (bus_out, from_bus) = sync_channel(1);
+        let part = Part {
+            device: drive,
+            map: Some(emulated()),
+            command: DriveCommand::default(),
+            feedback: DriveFeedback::default(),
+            outputs: 0,
+            inputs: 0,
+            inputs_logged: 0,
+            inputs_device: None,
+            name: "slide_servo".into(),
+        };
+        let mut link = Link {
+            interface: "ecm".into(),
+            to_bus,
+            from_bus,
+            image: Some(Box::new(Image {
+                parts: vec![part],
+                ok: false,
+                round_trip_ns: 0,
+            })),
+            in_a_row: 0,
+            drives: vec![(drive, DriveFeedback::default())],
+            cycle_ns: 2_000_000,
+            started: false,
+            counts: Box::default(),
+        };
+        f(&mut link, &mut exec, &bus_in, &bus_out, drive);
+    }
+
+    #[test]
+    fn a_late_exchange_extrapolates_and_the_third_miss_in_a_row_is_the_alarm() {
+        with_link(|link, exec, bus_in, bus_out, drive| {
+            let mut log = Vec::new();
+            // Cycle 0: the first image goes out at once.
+            link.exchange(0, exec, &mut log);
+            let mut image = bus_in.try_recv().expect("sent at the first boundary");
+            // The bus answers: the drive at 1000 increments, 500 000 increments/s.
+            image.ok = true;
+            image.round_trip_ns = 120_000;
+            image.parts[0].feedback = DriveFeedback {
+                statusword: 0x0237,
+                position_actual: 1000,
+                velocity_actual: 500_000,
+                ..DriveFeedback::default()
+            };
+            bus_out.send(image).unwrap();
+            link.exchange(2_000_000, exec, &mut log);
+            assert_eq!(exec.drive_feedback(drive).unwrap().position_actual, 1000);
+            assert_eq!((link.counts.exchanges, link.counts.misses), (1, 0));
+            assert_eq!(link.counts.round_trip_10us[12], 1);
+            // The next image is out; nothing comes back for two cycles: the position goes on
+            // at the last velocity (1000 increments per 2 ms), no alarm.
+            let _held = bus_in.try_recv().expect("sent again");
+            for (k, want) in [(2i64, 2000), (3, 3000)] {
+                link.exchange(k * 2_000_000, exec, &mut log);
+                let f = exec.drive_feedback(drive).unwrap();
+                assert_eq!((f.position_actual, f.statusword), (want, 0x0237));
+            }
+            assert_eq!(link.counts.alarms, 0);
+            // The third miss in a row: fault with 0x8130.
+            link.exchange(8_000_000, exec, &mut log);
+            let f = exec.drive_feedback(drive).unwrap();
+            assert_eq!((f.statusword, f.error_code), (FAULT_STATUSWORD, LOST_CODE));
+            assert_eq!(
+                (
+                    link.counts.misses,
+                    link.counts.alarms,
+                    link.counts.most_in_a_row
+                ),
+                (3, 1, 3)
+            );
+            // Further misses are the same alarm, not new ones.
+            link.exchange(10_000_000, exec, &mut log);
+            assert_eq!(link.counts.alarms, 1);
+        });
+    }
+
+    #[test]
+    fn a_working_counter_error_is_a_miss_and_the_command_goes_out_anyway() {
+        with_link(|link, exec, bus_in, bus_out, _| {
+            let mut log = Vec::new();
+            link.exchange(0, exec, &mut log);
+            let image = bus_in.try_recv().unwrap();
+            // `ok` false: the exchange failed or its working counter was short.
+            bus_out.send(image).unwrap();
+            link.exchange(2_000_000, exec, &mut log);
+            assert_eq!((link.counts.exchanges, link.counts.misses), (0, 1));
+            let image = bus_in.try_recv().expect("the next command still goes out");
+            assert!(!image.ok);
+            assert!(image.parts[0].map.is_some());
+        });
+    }
+
     #[test]
     fn a_mismatch_names_position_and_both_identities() {
         let e = EthercatError::Mismatch {
