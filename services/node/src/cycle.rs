@@ -104,6 +104,8 @@ pub(crate) struct NodeCycle<'c> {
     /// Per signal of the cell: its device, channel and whether it is timestamped (to name an
     /// output switch's signal without searching the cell's names).
     signals: Vec<(usize, u8, bool)>,
+    /// The node's EtherCAT segment, if it has one.
+    ethercat: Option<crate::ethercat::Link>,
 }
 
 /// What [`NodeCycle::new`] takes.
@@ -124,6 +126,8 @@ pub(crate) struct CycleParts<'c> {
     pub(crate) links: Links,
     /// Cycles between two telemetry snapshots.
     pub(crate) telemetry_every: u64,
+    /// The node's EtherCAT segment, in OP, if it has one.
+    pub(crate) ethercat: Option<crate::ethercat::Link>,
 }
 
 impl<'c> NodeCycle<'c> {
@@ -167,6 +171,7 @@ impl<'c> NodeCycle<'c> {
                     (s.device.0, s.channel, ts)
                 })
                 .collect(),
+            ethercat: p.ethercat,
         }
     }
 
@@ -212,6 +217,11 @@ impl<'c> NodeCycle<'c> {
             self.receive(wake - clock.epoch);
             marks[1] = rt::now_ns();
             self.commands(t);
+            if let Some(segment) = self.ethercat.as_mut() {
+                // The PDI at the boundary `t`: inputs of the exchange started at `t - cycle`
+                // in, the outputs of the last step out (crate::ethercat).
+                segment.exchange(t, &mut self.exec, &mut self.log);
+            }
             marks[2] = rt::now_ns();
             self.step(t);
             marks[3] = rt::now_ns();
@@ -225,6 +235,9 @@ impl<'c> NodeCycle<'c> {
             self.telemetry();
         }
         self.hand_over_last_adjustments();
+        if let Some(segment) = &self.ethercat {
+            segment.report();
+        }
         self.report.wall_ns = rt::now_ns() - started;
         if let Some((process, thread)) = cpu0 {
             self.report.cpu_ns = cpu_time_ns() - process;

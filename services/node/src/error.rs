@@ -31,6 +31,8 @@ pub enum NodeError {
         /// What iceoryx2 said.
         source: IpcError,
     },
+    /// The node's EtherCAT segment could not be started or does not match the cell file.
+    Ethercat(crate::ethercat::EthercatError),
     /// A thread of the node could not be started.
     Thread {
         /// The thread's name.
@@ -42,9 +44,11 @@ pub enum NodeError {
 
 impl NodeError {
     /// The exit code of `tandem-node`: 2 when the input (cell, node, script) is wrong, 1 when
-    /// the node could not run (iceoryx2 resources, threads).
+    /// the node could not run (iceoryx2 resources, threads), 3 when its EtherCAT segment
+    /// cannot be opened, does not reach OP or does not match the cell file.
     pub fn exit_code(&self) -> u8 {
         match self {
+            Self::Ethercat(_) => 3,
             Self::Cell(_) | Self::UnknownNode { .. } | Self::Script(_) | Self::Engine(_) => 2,
             Self::Port { .. } | Self::Thread { .. } => 1,
         }
@@ -70,6 +74,7 @@ impl fmt::Display for NodeError {
                 nodes.join(", ")
             ),
             Self::Engine(e) => write!(f, "the engine refused the cell: {e}"),
+            Self::Ethercat(e) => write!(f, "{e}"),
             Self::Port { port, source } => write!(f, "{port}: {source}"),
             Self::Thread { thread, source } => {
                 write!(f, "cannot start the {thread} thread: {source}")
@@ -84,6 +89,7 @@ impl Error for NodeError {
             Self::Cell(e) | Self::Script(e) => Some(e),
             Self::UnknownNode { .. } => None,
             Self::Engine(e) => Some(e.as_ref()),
+            Self::Ethercat(e) => Some(e),
             Self::Port { source, .. } => Some(source),
             Self::Thread { source, .. } => Some(source),
         }

@@ -31,6 +31,7 @@ mod audit;
 mod commands;
 mod cycle;
 mod error;
+pub mod ethercat;
 mod logring;
 mod lvhealth;
 mod ports;
@@ -288,6 +289,8 @@ fn cyclic(
         .map(|d| (d * 1e9) as i64)
         .or(start.script.map(|s| s.duration_ns));
     let script = start.script.map_or(&[][..], |s| s.entries.as_slice());
+    // The segment in OP before the clock starts (opening it takes seconds).
+    let ethercat = ethercat::open(cell, n).map_err(NodeError::Ethercat)?;
     let mut exec = Executive::new(cell, Some(n)).map_err(|e| NodeError::Engine(e.into()))?;
     retain::restore(&mut exec, cell, start.retained);
     let remote: Vec<(Leader, Coupling)> = exec.remote_leaders().collect();
@@ -313,6 +316,7 @@ fn cyclic(
         script,
         links,
         telemetry_every: telemetry_every(cell, n),
+        ethercat,
     };
     let node = NodeCycle::new(parts, &clock);
     let t0 = Secs(clock.first * clock.cycle);

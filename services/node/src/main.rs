@@ -1,7 +1,8 @@
 //! `tandem-node`: thin main over [`tandem_node::run`].
 //!
 //! Exit codes: 0 stopped cleanly (signal or end of duration); 2 the cell, node or script is
-//! wrong; 1 the node could not run (iceoryx2 resources, threads). Diagnostics go to stderr
+//! wrong; 1 the node could not run (iceoryx2 resources, threads); 3 its EtherCAT segment cannot
+//! be opened, does not reach OP or does not match the cell file. Diagnostics go to stderr
 //! through `tracing` (`--log-format text|json`, filtered by `TANDEM_LOG` or `RUST_LOG`,
 //! default `info`).
 

@@ -154,6 +154,82 @@ pub enum DeviceKind {
     /// A simulated counter terminal (`kind = "sim_counter"`): `integer` channels, each a
     /// counter value register.
     SimCounter(CounterParams),
+    /// A CiA 402 drive on the node's EtherCAT segment (`[[ethercat.subdevices]] role =
+    /// "cia402"`): its process data are exchanged by the node.
+    EthercatCia402(EthercatDriveParams),
+    /// A digital input/output terminal on the node's EtherCAT segment (`role = "dio"`): its
+    /// 8 outputs.
+    EthercatDio,
+    /// The 8 inputs of such a terminal (`inputs = "<name>"` of its SubDevice), a device of
+    /// their own.
+    EthercatDioInputs,
+}
+
+/// What the configuration knows of a CiA 402 drive on an EtherCAT segment.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct EthercatDriveParams {
+    /// Position actual value 0x6064 increments per motor revolution.
+    pub increments_per_revolution: u32,
+    /// Cycles from a setpoint to the actual value that shows it, through the node's exchange
+    /// (2 to 8): the following error is formed against the setpoint this many cycles old.
+    pub transport_cycles: u8,
+}
+
+/// The identity of a SubDevice (CiA 301 identity object 0x1018, as in its SII).
+#[doc(alias = "0x1018")]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct EthercatIdentity {
+    /// Vendor ID 0x1018:01.
+    pub vendor: u32,
+    /// Product code 0x1018:02.
+    pub product: u32,
+    /// Revision number 0x1018:03.
+    pub revision: u32,
+}
+
+impl core::fmt::Display for EthercatIdentity {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "vendor 0x{:08X}, product 0x{:08X}, revision 0x{:08X}",
+            self.vendor, self.product, self.revision
+        )
+    }
+}
+
+/// The role of a SubDevice on a node's segment.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum EthercatRole {
+    /// A CiA 402 drive, the drive of an axis (`[axes.<name>.drive] type = "cia402"`).
+    Cia402,
+    /// A digital input/output terminal (8 inputs, 8 outputs, one bit each).
+    Dio,
+}
+
+/// One expected SubDevice of a segment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EthercatSubDevice {
+    /// Its name, that of its device in [`Cell::devices`].
+    pub name: String,
+    /// Its device.
+    pub device: DeviceIndex,
+    /// A `dio`'s inputs device, if its inputs are bound (`inputs = "<name>"`).
+    pub inputs: Option<DeviceIndex>,
+    /// The identity it must report.
+    pub identity: EthercatIdentity,
+    /// What it is.
+    pub role: EthercatRole,
+}
+
+/// `[[ethercat]]`: the segment one node drives.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EthercatSegment {
+    /// Index into [`Cell::nodes`].
+    pub node: usize,
+    /// The network interface.
+    pub interface: String,
+    /// The expected SubDevices in bus order.
+    pub subdevices: Vec<EthercatSubDevice>,
 }
 
 impl DeviceKind {
@@ -167,6 +243,9 @@ impl DeviceKind {
             DeviceKind::SimAnalogInput(_) => "sim_analog_input",
             DeviceKind::SimAnalogOutput(_) => "sim_analog_output",
             DeviceKind::SimCounter(_) => "sim_counter",
+            DeviceKind::EthercatCia402(_) => "ethercat_cia402",
+            DeviceKind::EthercatDio => "ethercat_dio",
+            DeviceKind::EthercatDioInputs => "ethercat_dio_inputs",
         }
     }
 
@@ -174,7 +253,11 @@ impl DeviceKind {
     /// whether they are timestamped, and whether they are inputs.
     pub fn channels(&self) -> Option<(u8, bool, SignalDirection)> {
         match self {
-            DeviceKind::SimServo(_) | DeviceKind::SimAnalogDrive(_) => None,
+            DeviceKind::SimServo(_)
+            | DeviceKind::SimAnalogDrive(_)
+            | DeviceKind::EthercatCia402(_) => None,
+            DeviceKind::EthercatDio => Some((8, false, SignalDirection::Output)),
+            DeviceKind::EthercatDioInputs => Some((8, false, SignalDirection::Input)),
             DeviceKind::SimDigitalOutput(p) => {
                 Some((p.channels, p.timestamped, SignalDirection::Output))
             }
@@ -190,7 +273,10 @@ impl DeviceKind {
     /// The type of the signals on the device's channels, for a device with channels.
     pub fn channel_type(&self) -> Option<SignalType> {
         match self {
-            DeviceKind::SimServo(_) | DeviceKind::SimAnalogDrive(_) => None,
+            DeviceKind::SimServo(_)
+            | DeviceKind::SimAnalogDrive(_)
+            | DeviceKind::EthercatCia402(_) => None,
+            DeviceKind::EthercatDio | DeviceKind::EthercatDioInputs => Some(SignalType::Bool),
             DeviceKind::SimDigitalOutput(DigitalOutputParams { timestamped, .. })
             | DeviceKind::SimDigitalInput(DigitalInputParams { timestamped, .. }) => {
                 Some(if *timestamped {
@@ -664,6 +750,8 @@ pub struct Cell {
     pub inputs: InputBindings,
     /// `[security]`: how the cell's Zenoh links are authenticated, who may do what.
     pub security: crate::security::Security,
+    /// `[[ethercat]]`: the EtherCAT segments, at most one per node.
+    pub ethercat: Vec<EthercatSegment>,
 }
 
 impl Cell {

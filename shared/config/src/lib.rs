@@ -58,9 +58,10 @@ pub use cell::{
     AnalogChannelParams, AnalogDriveConnection, AxisEntry, AxisIndex, AxisInputs, CamEntry,
     CamTrackEntry, Cell, Cia402Connection, CounterParams, Coupling, DeviceEntry, DeviceIndex,
     DeviceKind, DigitalInputParams, DigitalOutputParams, DriveConnection, EncoderEntry,
-    EncoderIndex, EncoderSource, InputBindings, Leader, LeadingValueConfig, MeasuringInputEntry,
-    Node, OutputCamEntry, Realtime, Registration, SensorEntry, SignalDirection, SignalEntry,
-    SignalIndex, SignalType, LEADING_BUFFER, MAX_CHANNELS,
+    EncoderIndex, EncoderSource, EthercatDriveParams, EthercatIdentity, EthercatRole,
+    EthercatSegment, EthercatSubDevice, InputBindings, Leader, LeadingValueConfig,
+    MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration, SensorEntry,
+    SignalDirection, SignalEntry, SignalIndex, SignalType, LEADING_BUFFER, MAX_CHANNELS,
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};

@@ -42,6 +42,9 @@ pub struct CellFile {
     pub signals: BTreeMap<String, SignalSection>,
     /// `[security]`: how the Zenoh links are authenticated (docs/security.md).
     pub security: Option<SecuritySection>,
+    /// `[[ethercat]]`: the EtherCAT segment a node drives (docs/ethercat.md).
+    #[serde(default)]
+    pub ethercat: Vec<EthercatSection>,
 }
 
 /// `[security]`: mTLS with the cell's certificates (default), or plain Zenoh written out.
@@ -1187,4 +1190,47 @@ pub struct PlantSection {
     /// Position of one zero mark.
     #[serde(default)]
     pub zero_mark_offset: f64,
+}
+
+/// `[[ethercat]]`: the EtherCAT segment one node drives as its MainDevice.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EthercatSection {
+    /// The node that drives the segment.
+    pub node: String,
+    /// The network interface the segment hangs on (e.g. `enp2s0`).
+    pub interface: String,
+    /// The expected SubDevices, in bus order.
+    #[serde(default)]
+    pub subdevices: Vec<SubDeviceSection>,
+}
+
+/// `[[ethercat.subdevices]]`: one expected SubDevice.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SubDeviceSection {
+    /// Its name: a device of the node's process image.
+    pub name: String,
+    /// The identity it must report (SII / 0x1018).
+    pub identity: IdentitySection,
+    /// `cia402` (a drive) or `dio` (a digital input/output terminal).
+    pub role: String,
+    /// `cia402`: position actual value 0x6064 per motor revolution (default 2^20).
+    pub increments_per_revolution: Option<u32>,
+    /// `cia402`: cycles from a setpoint to the actual value that shows it (default 4).
+    pub transport_cycles: Option<u8>,
+    /// `dio`: the name of a device of its own for the terminal's 8 inputs.
+    pub inputs: Option<String>,
+}
+
+/// `identity = { vendor, product, revision }`: CiA 301 identity object 0x1018:01..03.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IdentitySection {
+    /// Vendor ID 0x1018:01.
+    pub vendor: u32,
+    /// Product code 0x1018:02.
+    pub product: u32,
+    /// Revision number 0x1018:03.
+    pub revision: u32,
 }

@@ -35,11 +35,20 @@ pub mod analog;
 /// Cycles between a setpoint and the actual value that shows it (see the module's order).
 const TRANSPORT_CYCLES: usize = 2;
 
+/// The most cycles between a setpoint and its actual value a drive may take (the exchange of
+/// an external drive adds to [`TRANSPORT_CYCLES`]).
+pub const MAX_TRANSPORT_CYCLES: usize = 8;
+
 /// A device of the process image.
 #[derive(Debug)]
 enum Device {
     /// A simulated CiA 402 servo drive.
     SimServo(Box<SimServo>),
+    /// A drive whose process data the edge exchanges (a CiA 402 drive on the node's EtherCAT
+    /// segment): the edge puts the TxPDO of `t` in with [`Drives::set_external_feedback`]
+    /// before the step at `t` and takes the RxPDO the step wrote with
+    /// [`Drives::external_command`] after it.
+    External,
 }
 
 /// One device with its process data.
@@ -74,8 +83,11 @@ pub struct Cia402Link {
     request: PowerRequest,
     /// The position setpoints of the last [`TRANSPORT_CYCLES`] cycles (physical), newest at
     /// `head`: at the next cycle the oldest is the one the actual value shows.
-    setpoints: [f64; TRANSPORT_CYCLES],
+    setpoints: [f64; MAX_TRANSPORT_CYCLES],
     head: usize,
+    /// Cycles from a setpoint to the actual value that shows it: [`TRANSPORT_CYCLES`] on a
+    /// simulated drive, the device's on an external one (1 to [`MAX_TRANSPORT_CYCLES`]).
+    transport: usize,
     /// The simulated plant around the drive (limit switches, reference cam), physical.
     plant: Plant,
     /// The measuring input on the drive's touch probe 1 (index in the cell), if any.
@@ -216,23 +228,27 @@ impl Drives {
             let Some(dev) = cell.devices.get(c.device.0) else {
                 continue;
             };
-            let DeviceKind::SimServo(params) = &dev.kind else {
+            let (device, params) = match &dev.kind {
+                DeviceKind::SimServo(params) => {
+                    // The motor starts where the axis's initial position puts it.
+                    let start = f64::from(c.scaling.drive_increments(a.config.initial_position));
+                    let servo = SimServo::new(ServoParams {
+                        initial_position: start,
+                        ..*params
+                    })
+                    .map_err(|reason| ExecError::Device {
+                        name: dev.name.clone(),
+                        reason,
+                    })?;
+                    (Device::SimServo(Box::new(servo)), Some(*params))
+                }
+                DeviceKind::EthercatCia402(_) => (Device::External, None),
                 // Refused by the configuration: an axis's drive is a servo.
-                continue;
+                _ => continue,
             };
-            // The motor starts where the axis's initial position puts it.
-            let start = f64::from(c.scaling.drive_increments(a.config.initial_position));
-            let servo = SimServo::new(ServoParams {
-                initial_position: start,
-                ..*params
-            })
-            .map_err(|reason| ExecError::Device {
-                name: dev.name.clone(),
-                reason,
-            })?;
             if let Some(slot) = slots.get_mut(c.device.0) {
                 *slot = Some(Slot {
-                    device: Device::SimServo(Box::new(servo)),
+                    device,
                     cycle_ns: cell.nodes[dev.node].cycle_ns,
                     command: DriveCommand::default(),
                     feedback: DriveFeedback::default(),
@@ -240,6 +256,9 @@ impl Drives {
                 });
             }
             let mut link = Cia402Link::new(i, c, a.config.plant, a.config.initial_position)?;
+            if let DeviceKind::EthercatCia402(p) = &dev.kind {
+                link.transport = usize::from(p.transport_cycles).clamp(1, MAX_TRANSPORT_CYCLES);
+            }
             link.probe_input = cell
                 .measuring_inputs
                 .iter()
@@ -248,16 +267,20 @@ impl Drives {
             link.homing_probe = if link.probe_input.is_some() { 2 } else { 1 };
             // 0x60B2 per increment/s²: J · 2π / (increments per revolution) N·m, in per mille
             // of the rated torque 0x6076.
-            link.torque_per_acceleration = c.torque_precontrol_inertia.map(|j| {
-                j * core::f64::consts::TAU
-                    / f64::from(params.increments_per_revolution)
-                    / params.rated_torque
-                    * 1e3
-            });
+            link.torque_per_acceleration =
+                c.torque_precontrol_inertia.zip(params).map(|(j, params)| {
+                    j * core::f64::consts::TAU
+                        / f64::from(params.increments_per_revolution)
+                        / params.rated_torque
+                        * 1e3
+                });
             if let (Some((lo, hi)), Some(Some(slot))) =
                 (a.config.plant.reference_cam, slots.get_mut(c.device.0))
             {
-                let Device::SimServo(servo) = &mut slot.device;
+                let Device::SimServo(servo) = &mut slot.device else {
+                    links.push(link);
+                    continue;
+                };
                 // The home switch is wired to the homing probe's input as well (the simulated
                 // plant's reference cam, at its physical position).
                 let at = |x: f64| f64::from(c.scaling.drive_increments(x));
@@ -302,7 +325,10 @@ impl Drives {
             if t % slot.cycle_ns != 0 {
                 continue;
             }
-            let Device::SimServo(servo) = &mut slot.device;
+            let Device::SimServo(servo) = &mut slot.device else {
+                // An external drive's sample of `t` is what the edge put in.
+                continue;
+            };
             if slot.started {
                 servo.advance(slot.cycle_ns);
             }
@@ -364,12 +390,41 @@ impl Drives {
         let Some(Some(slot)) = self.slots.get_mut(device) else {
             return Ok(());
         };
-        let Device::SimServo(servo) = &mut slot.device;
+        let Device::SimServo(servo) = &mut slot.device else {
+            // A drive on a fieldbus faults on its own, not on command.
+            return Ok(());
+        };
         if code == 0 {
             servo.clear_fault_cause();
             Ok(())
         } else {
             servo.inject_fault(code)
+        }
+    }
+
+    /// Puts the TxPDO the edge exchanged at boundary `t` into external drive `device`: the
+    /// sample of `t` its axis reads in the next step. `false` when this executive does not run
+    /// an external drive `device`.
+    pub(crate) fn set_external_feedback(
+        &mut self,
+        device: usize,
+        feedback: &DriveFeedback,
+    ) -> bool {
+        match self.slots.get_mut(device) {
+            Some(Some(slot)) if matches!(slot.device, Device::External) => {
+                slot.feedback = *feedback;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// The RxPDO the last step wrote for external drive `device`: what the edge sends at the
+    /// next boundary.
+    pub(crate) fn external_command(&self, device: usize) -> Option<&DriveCommand> {
+        match self.slots.get(device) {
+            Some(Some(slot)) if matches!(slot.device, Device::External) => Some(&slot.command),
+            _ => None,
         }
     }
 
@@ -397,8 +452,9 @@ impl Cia402Link {
             counter: None,
             controlword: 0,
             request: PowerRequest::default(),
-            setpoints: [p0; TRANSPORT_CYCLES],
+            setpoints: [p0; MAX_TRANSPORT_CYCLES],
             head: 0,
+            transport: TRANSPORT_CYCLES,
             plant,
             probe_input: None,
             probe_armed: false,
@@ -509,7 +565,11 @@ impl Cia402Link {
                 DriveState::Disabled
             }
         };
-        let oldest = self.setpoints[(self.head + 1) % self.setpoints.len()];
+        let oldest = self
+            .setpoints
+            .get((self.head + 1) % self.transport.max(1))
+            .copied()
+            .unwrap_or_default();
         let di = fb.digital_inputs;
         let (zero_mark, reference_cam_left) = self.homing_marks(fb);
         DriveInputs {
@@ -684,7 +744,7 @@ impl Cia402Link {
             // follows the setpoint that tracks the actual value.
             self.controlword = DeviceCommand::QuickStop.controlword();
         }
-        self.head = (self.head + 1) % self.setpoints.len();
+        self.head = (self.head + 1) % self.transport.max(1);
         if let Some(s) = self.setpoints.get_mut(self.head) {
             *s = out.position;
         }

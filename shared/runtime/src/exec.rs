@@ -1136,6 +1136,34 @@ impl<'c> Executive<'c> {
         self.drives.analog.status(device)
     }
 
+    /// Puts the TxPDO of external drive `device` (index in [`Cell::devices`]: a CiA 402 drive
+    /// on the node's EtherCAT segment) exchanged by the edge at the boundary of the next step;
+    /// `false` when this executive runs no such drive.
+    pub fn set_drive_feedback(
+        &mut self,
+        device: usize,
+        feedback: &tandem_motion::plant::cia402::DriveFeedback,
+    ) -> bool {
+        self.drives.set_external_feedback(device, feedback)
+    }
+
+    /// The levels of input device `device` (index in [`Cell::devices`]: the inputs of a digital
+    /// terminal on the node's EtherCAT segment) an edge read at the boundary `t`, bit `c - 1`
+    /// for channel `c`: sampled by the step at `t` as a `sim_digital_input` is. `false` when
+    /// this executive runs no such device.
+    pub fn set_input_levels(&mut self, device: usize, t: i64, levels: u32) -> bool {
+        self.inputs.set_levels(device, t, levels)
+    }
+
+    /// The RxPDO the last step wrote for external drive `device`, which the edge sends at the
+    /// next boundary; `None` when this executive runs no such drive.
+    pub fn drive_command(
+        &self,
+        device: usize,
+    ) -> Option<&tandem_motion::plant::cia402::DriveCommand> {
+        self.drives.external_command(device)
+    }
+
     /// The TxPDO that drive `device` gave at the last boundary, if this executive runs it.
     pub fn drive_feedback(
         &self,

@@ -144,8 +144,15 @@ impl Inputs {
         let mut terminals = Vec::new();
         let mut of_device = vec![None; cell.devices.len()];
         for (i, d) in cell.devices.iter().enumerate() {
-            let DeviceKind::SimDigitalInput(p) = &d.kind else {
-                continue;
+            let p = match &d.kind {
+                DeviceKind::SimDigitalInput(p) => *p,
+                // The inputs of a terminal on the node's EtherCAT segment: the edge sets their
+                // levels ([`Inputs::set_levels`]).
+                DeviceKind::EthercatDioInputs => tandem_config::DigitalInputParams {
+                    channels: 8,
+                    timestamped: false,
+                },
+                _ => continue,
             };
             if node.is_some_and(|n| n != d.node) {
                 continue;
@@ -252,6 +259,30 @@ impl Inputs {
             });
         }
         Ok(())
+    }
+
+    /// The levels `levels` (bit `c - 1`: channel `c`) an edge read from input device `device`
+    /// at the boundary `t`: each channel that differs from the device's last sample becomes a
+    /// stimulus at `t`, sampled by the step at `t`. `false` when the device is not an input
+    /// device here.
+    pub(crate) fn set_levels(&mut self, device: usize, t: i64, levels: u32) -> bool {
+        let Some(k) = self.terminals.iter().position(|d| d.device == device) else {
+            return false;
+        };
+        let Some(d) = self.terminals.get_mut(k) else {
+            return false;
+        };
+        let changed = levels ^ d.status.levels;
+        for c in 0..32u8 {
+            if changed & (1 << c) != 0 {
+                d.push(Stimulus {
+                    at_ns: t,
+                    channel: c + 1,
+                    on: levels & (1 << c) != 0,
+                });
+            }
+        }
+        true
     }
 
     /// Step 1 at `t`: samples the devices due at `t` with the stimuli at or before `t`, a new

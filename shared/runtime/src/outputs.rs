@@ -268,6 +268,14 @@ pub(crate) struct Outputs {
     switches: Vec<OutputSwitch>,
 }
 
+/// The outputs of an EtherCAT digital terminal (`role = "dio"`): 8 channels, switched with
+/// the cycle's exchange.
+const ETHERCAT_DIO_OUTPUTS: tandem_config::DigitalOutputParams =
+    tandem_config::DigitalOutputParams {
+        channels: 8,
+        timestamped: false,
+    };
+
 /// The look-ahead of an output cam or cam track on `position_type` that drives `output`: `Λ`
 /// of the node of the output's device (see the module documentation), or `None` when it
 /// drives no digital output (it then steps with the cycle just computed).
@@ -279,7 +287,10 @@ pub(crate) fn switching_ahead(
 ) -> Option<SwitchingAhead> {
     let signal = cell.signals.get(output?.0)?;
     let device = cell.devices.get(signal.device.0)?;
-    if !matches!(device.kind, DeviceKind::SimDigitalOutput(_)) {
+    if !matches!(
+        device.kind,
+        DeviceKind::SimDigitalOutput(_) | DeviceKind::EthercatDio
+    ) {
         return None;
     }
     let cycle = cell.nodes.get(device.node).map_or(1, |n| n.cycle_ns.max(1));
@@ -336,8 +347,12 @@ impl Outputs {
         let mut terminals = Vec::new();
         let mut of_device = vec![None; cell.devices.len()];
         for (i, d) in cell.devices.iter().enumerate() {
-            let DeviceKind::SimDigitalOutput(p) = &d.kind else {
-                continue;
+            let p = match &d.kind {
+                DeviceKind::SimDigitalOutput(p) => *p,
+                // The outputs of a digital terminal on the node's EtherCAT segment: their
+                // levels go out with the node's next exchange.
+                DeviceKind::EthercatDio => ETHERCAT_DIO_OUTPUTS,
+                _ => continue,
             };
             if node.is_some_and(|n| n != d.node) {
                 continue;

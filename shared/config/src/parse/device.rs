@@ -408,8 +408,8 @@ pub(super) fn drives(
                 kind_ok: |k| matches!(k, DeviceKind::SimAnalogDrive(_)),
             },
             _ => Wanted {
-                needs: "a drive (`sim_servo`)",
-                kind_ok: |k| matches!(k, DeviceKind::SimServo(_)),
+                needs: "a drive (`sim_servo` or an EtherCAT `cia402` SubDevice)",
+                kind_ok: |k| matches!(k, DeviceKind::SimServo(_) | DeviceKind::EthercatCia402(_)),
             },
         };
         let bound = Bound {
@@ -462,8 +462,34 @@ pub(super) fn drives(
                         .then_some(inertia),
                 }))
             }
+            DeviceKind::EthercatCia402(p) => {
+                if a.drive.torque_precontrol.is_some() || a.drive.inertia.is_some() {
+                    let key = if a.drive.torque_precontrol.is_some() {
+                        "torque_precontrol"
+                    } else {
+                        "inertia"
+                    };
+                    return Err(at(
+                        &["drive", key],
+                        Problem::Invalid(
+                            "not for a drive on an EtherCAT segment (its PDO has no torque offset 0x60B2)",
+                        ),
+                    ));
+                }
+                let steps = p.increments_per_revolution;
+                let scaling = scaling(a, steps, Some(steps))
+                    .map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+                DriveConnection::Cia402(Box::new(Cia402Connection {
+                    device: DeviceIndex(k),
+                    enable_timeout_ns,
+                    scaling,
+                    torque_precontrol_inertia: None,
+                }))
+            }
             // Refused by `Bound::device` (not a drive).
-            DeviceKind::SimDigitalOutput(_)
+            DeviceKind::EthercatDio
+            | DeviceKind::EthercatDioInputs
+            | DeviceKind::SimDigitalOutput(_)
             | DeviceKind::SimDigitalInput(_)
             | DeviceKind::SimAnalogInput(_)
             | DeviceKind::SimAnalogOutput(_)

@@ -6,6 +6,7 @@ mod axis;
 mod cam;
 mod device;
 mod encoder;
+mod ethercat;
 mod names;
 mod objects;
 mod security;
@@ -159,6 +160,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     let hosts = hosts(cx, &raw)?;
     let nodes = nodes(cx, &raw, &hosts)?;
     let devices = device::devices(cx, &raw, &nodes)?;
+    let (devices, ethercat) = ethercat::segments(cx, &raw, &nodes, devices)?;
     let mut axes = axes(cx, &raw, &nodes)?;
     device::drives(cx, &raw, &mut axes, &devices)?;
     leaders(cx, &raw, &mut axes)?;
@@ -222,6 +224,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         signals,
         inputs,
         security,
+        ethercat,
     })
 }
 

@@ -54,7 +54,7 @@ pub(super) fn signals(
                 device: dev.name.clone(),
                 kind: dev.kind.name(),
                 needs: "a device with channels (`sim_digital_output`, `sim_digital_input`, \
-                        `sim_analog_input`, `sim_analog_output`, `sim_counter`)",
+                        `sim_analog_input`, `sim_analog_output`, `sim_counter`, an EtherCAT `dio`)",
             };
             return Err(at("device", problem));
         };

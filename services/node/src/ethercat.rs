@@ -1,0 +1,1179 @@
+//! The node's EtherCAT segment (`[[ethercat]]`, docs/ethercat.md): an adapter at the edge
+//! between unmodified `ethercrab` 0.7.1 and the executive's external drives.
+//!
+//! At start, [`open`] runs the MainDevice on a thread of its own ("ethercat", with ethercrab's
+//! TX/RX loop on "ethercat-io"): it finds the SubDevices, compares them position by position
+//! with the cell file (the first mismatch refuses the start), reads each CiA 402 drive's
+//! assigned PDO mapping over CoE (0x1C12/0x1C13, then 0x16xx/0x1Axx), brings the segment to
+//! OP and waits for exchanges.
+//!
+//! Each cycle at `t`, before the step, the cyclic thread calls [`Link::exchange`]: it takes
+//! the process image back from the exchange it started at `t - cycle` (a whole cycle to
+//! complete), puts each drive's TxPDO into the executive, writes the RxPDO the step at
+//! `t - cycle` computed and hands the image to the "ethercat" thread, which runs one LRW
+//! (`SubDeviceGroup::tx_rx`) at once. The image moves between the two threads through two
+//! bounded channels (no lock, no allocation, no wait on the cyclic thread). An image not back
+//! by the next cycle, a failed exchange or a working counter below the expected one is a miss;
+//! after [`MISSES_TO_ALARM`] misses in a row each drive on the segment shows a fault with
+//! error code [`LOST_CODE`], which its axis takes as alarm 421 with the reaction the drive
+//! fault has; the node's other axes carry on.
+
+use ethercrab::std::tx_rx_task;
+use ethercrab::subdevice_group::{self, DcConfiguration};
+use ethercrab::{
+    DcSync, MainDevice, MainDeviceConfig, PduStorage, RegisterAddress, SubDeviceGroup,
+    SubDeviceRef, Timeouts,
+};
+use std::fmt;
+use std::io::Write;
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::time::{Duration, Instant};
+use tandem_config::{Cell, EthercatIdentity, EthercatRole};
+use tandem_motion::plant::cia402::{DriveCommand, DriveFeedback};
+use tandem_runtime::exec::{Executive, Secs};
+use tracing::{info, warn};
+
+/// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 3 cycles, the
+/// bound the EtherCAT issue sets for a lost SubDevice's alarm (inferred: one or two late
+/// exchanges are jitter, three in a row a lost segment). It presumes the node runs with its
+/// `realtime.priority`, which its EtherCAT threads take too: without it, with a load of 5 on
+/// the shared 2-core test host, the "ethercat" thread was measured late up to 10 cycles in a row
+/// (2 ms cycle) while the segment was fine; with SCHED_FIFO 40 it missed none in 1,500 cycles.
+pub const MISSES_TO_ALARM: u32 = 3;
+
+/// The error code 0x603F a drive on a segment that stopped exchanging shows: 0x8130, "life
+/// guard error or heartbeat error" of CiA 301's emergency error codes (inferred: the code of a
+/// lost cyclic communication closest to a lost EtherCAT exchange).
+#[doc(alias = "0x603F")]
+pub const LOST_CODE: u16 = 0x8130;
+
+/// Statusword 0x6041 of *fault* (IEC 61800-7-201 (CiA 402) drive profile, 0x6041: xxxx xxxx
+/// x0xx 1000).
+const FAULT_STATUSWORD: u16 = 0x0008;
+
+/// ethercrab's PDU timeout. Not below the cycle: in ethercrab 0.7.1 a reply arriving after its
+/// PDU timed out ends the receive task (and with it the segment), and on a loaded host a reply
+/// can take tens of ms (docs/ethercat.md, the emulator's measurements). The cyclic thread never
+/// waits for it: an exchange not back by the next cycle is a miss.
+const PDU_TIMEOUT: Duration = Duration::from_millis(100);
+
+/// The RxPDO mapping the node writes into a drive's assigned RxPDO (CiA 301 entries: index,
+/// subindex, bit length): controlword 0x6040, modes of operation 0x6060, target position
+/// 0x607A, velocity offset 0x60B1, touch probe function 0x60B8.
+const CSP_RXPDO: [u32; 5] = [
+    0x6040_0010,
+    0x6060_0008,
+    0x607A_0020,
+    0x60B1_0020,
+    0x60B8_0010,
+];
+
+/// Time allowed from opening the interface to OP.
+const START_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// The most SubDevices and bytes of process image the node drives on one segment.
+const MAX_SUBDEVICES: usize = 64;
+const MAX_PDI: usize = 4096;
+/// Frames in flight and their size.
+const MAX_FRAMES: usize = 16;
+static PDU_STORAGE: PduStorage<MAX_FRAMES, { PduStorage::element_size(1100) }> = PduStorage::new();
+
+/// Why the segment could not be started.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum EthercatError {
+    /// The interface could not be opened, a thread not started, or ethercrab failed.
+    Start {
+        /// The interface.
+        interface: String,
+        /// What failed.
+        reason: String,
+    },
+    /// The bus does not match the cell file at `position`.
+    Mismatch {
+        /// The interface.
+        interface: String,
+        /// Bus position (0: the first SubDevice after the MainDevice).
+        position: usize,
+        /// The SubDevice the cell file expects there (name, identity), if any.
+        expected: Option<(String, EthercatIdentity)>,
+        /// What the bus has there (its SII name, identity), if anything.
+        found: Option<(String, EthercatIdentity)>,
+    },
+    /// A drive's PDO mapping lacks an object the drive connection needs.
+    Mapping {
+        /// The SubDevice.
+        name: String,
+        /// The missing object.
+        object: u16,
+    },
+}
+
+impl fmt::Display for EthercatError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Start { interface, reason } => {
+                write!(f, "EtherCAT segment on `{interface}`: {reason}")
+            }
+            Self::Mismatch {
+                interface,
+                position,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "EtherCAT segment on `{interface}` does not match the cell file at position {position}: expected "
+                )?;
+                match expected {
+                    Some((n, id)) => write!(f, "`{n}` ({id})")?,
+                    None => f.write_str("no SubDevice")?,
+                }
+                f.write_str(", found ")?;
+                match found {
+                    Some((n, id)) => write!(f, "`{n}` ({id})"),
+                    None => f.write_str("no SubDevice"),
+                }
+            }
+            Self::Mapping { name, object } => write!(
+                f,
+                "EtherCAT SubDevice `{name}`: its PDO mapping has no object 0x{object:04X}, which a CiA 402 drive connection needs"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for EthercatError {}
+
+/// One mapped object of a PDO: index, byte offset in the SubDevice's image, length in bytes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+struct Mapped {
+    index: u16,
+    offset: usize,
+    len: usize,
+}
+
+/// A PDO mapping entry (CiA 301: index << 16 | subindex << 8 | bit length) as [`Mapped`] at
+/// `bit` bits into the image; `None` for an entry that is not whole bytes.
+fn mapped(entry: u32, bit: usize) -> Option<Mapped> {
+    let bits = (entry & 0xFF) as usize;
+    (bits % 8 == 0 && bit % 8 == 0).then_some(Mapped {
+        index: (entry >> 16) as u16,
+        offset: bit / 8,
+        len: bits / 8,
+    })
+}
+
+/// The PDO mapping of a CiA 402 drive, as read from the drive.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+struct DriveMap {
+    rx: Vec<Mapped>,
+    tx: Vec<Mapped>,
+}
+
+/// The little-endian bytes of `v`'s `len` low bytes into `buf` at `at` (as far as they fit).
+fn put(buf: &mut [u8], at: usize, len: usize, v: i64) {
+    for (i, b) in v.to_le_bytes().iter().take(len).enumerate() {
+        if let Some(x) = buf.get_mut(at + i) {
+            *x = *b;
+        }
+    }
+}
+
+/// `len` little-endian bytes of `buf` at `at`, sign-extended when `signed`.
+fn get(buf: &[u8], at: usize, len: usize, signed: bool) -> i64 {
+    let mut b = [0u8; 8];
+    for (i, x) in b.iter_mut().take(len.min(8)).enumerate() {
+        *x = buf.get(at + i).copied().unwrap_or(0);
+    }
+    let v = i64::from_le_bytes(b);
+    let shift = 64 - 8 * len.clamp(1, 8) as u32;
+    if signed {
+        (v << shift) >> shift
+    } else {
+        v
+    }
+}
+
+/// The RxPDO of `c` into the drive's output image by its mapping (objects it does not map
+/// are not sent; objects it maps that tandem does not write stay 0).
+fn encode(map: &DriveMap, c: &DriveCommand, out: &mut [u8]) {
+    for m in &map.rx {
+        let v = match m.index {
+            0x6040 => i64::from(c.controlword),
+            0x6060 => i64::from(c.mode),
+            0x607A => i64::from(c.target_position),
+            0x60FF => i64::from(c.target_velocity),
+            0x6071 => i64::from(c.target_torque),
+            0x60B1 => i64::from(c.velocity_offset),
+            0x60B2 => i64::from(c.torque_offset),
+            0x6072 => i64::from(c.max_torque),
+            0x60B8 => i64::from(c.touch_probe_function),
+            _ => 0,
+        };
+        put(out, m.offset, m.len, v);
+    }
+}
+
+/// The TxPDO from the drive's input image by its mapping (objects it does not map read 0).
+fn decode(map: &DriveMap, input: &[u8]) -> DriveFeedback {
+    let mut f = DriveFeedback::default();
+    for m in &map.tx {
+        let u = get(input, m.offset, m.len, false);
+        let s = get(input, m.offset, m.len, true);
+        // Truncation to the object's own width is the PDO's encoding.
+        match m.index {
+            0x6041 => f.statusword = u as u16,
+            0x6061 => f.mode_display = s as i8,
+            0x6064 => f.position_actual = s as i32,
+            0x606C => f.velocity_actual = s as i32,
+            0x6077 => f.torque_actual = s as i16,
+            0x60F4 => f.following_error = s as i32,
+            0x603F => f.error_code = u as u16,
+            0x60FD => f.digital_inputs = u as u32,
+            0x60B9 => f.touch_probe_status = u as u16,
+            0x60BA => f.touch_probe_1_positive = s as i32,
+            0x60BB => f.touch_probe_1_negative = s as i32,
+            0x60BC => f.touch_probe_2_positive = s as i32,
+            0x60BD => f.touch_probe_2_negative = s as i32,
+            _ => {}
+        }
+    }
+    f
+}
+
+/// One SubDevice's part of the process image the two threads hand over.
+#[derive(Debug)]
+struct Part {
+    /// Its device (index in the cell).
+    device: usize,
+    /// A drive's mapping; `None` for a digital terminal.
+    map: Option<DriveMap>,
+    /// The command to send (drives).
+    command: DriveCommand,
+    /// The feedback received (drives).
+    feedback: DriveFeedback,
+    /// The outputs byte (digital terminals).
+    outputs: u8,
+    /// The inputs byte received (digital terminals).
+    inputs: u8,
+    /// The inputs byte last logged.
+    inputs_logged: u8,
+    /// The device of its inputs, if they are bound to input signals.
+    inputs_device: Option<usize>,
+    /// Its name in the cell (for the log).
+    name: String,
+}
+
+/// The process image between the cyclic thread and the "ethercat" thread.
+#[derive(Debug)]
+struct Image {
+    parts: Vec<Part>,
+    /// The exchange completed with the expected working counter.
+    ok: bool,
+    /// Its round trip (ns).
+    round_trip_ns: u64,
+}
+
+/// Counters of the segment, reported at the end.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentCounts {
+    /// Exchanges that came back complete.
+    pub exchanges: u64,
+    /// Cycles without a complete exchange (late, failed or a working counter error).
+    pub misses: u64,
+    /// Times the segment went into alarm.
+    pub alarms: u64,
+    /// The most misses in a row.
+    pub most_in_a_row: u32,
+    /// Round trips of the exchanges, in buckets of 10 µs (the last one: 10 ms and more).
+    pub round_trip_10us: [u32; 1001],
+}
+
+impl Default for SegmentCounts {
+    fn default() -> Self {
+        Self {
+            exchanges: 0,
+            misses: 0,
+            alarms: 0,
+            most_in_a_row: 0,
+            round_trip_10us: [0; 1001],
+        }
+    }
+}
+
+impl SegmentCounts {
+    /// The round trip (µs, the bucket's upper edge) below which `share` of the exchanges are.
+    pub fn round_trip_quantile_us(&self, share: f64) -> u64 {
+        let total: u64 = self.round_trip_10us.iter().map(|&c| u64::from(c)).sum();
+        let want = (total as f64 * share).ceil() as u64;
+        let mut seen = 0u64;
+        for (i, c) in self.round_trip_10us.iter().enumerate() {
+            seen += u64::from(*c);
+            if seen >= want && seen > 0 {
+                return (i as u64 + 1) * 10;
+            }
+        }
+        0
+    }
+}
+
+/// The cyclic thread's end of the segment.
+#[derive(Debug)]
+pub struct Link {
+    interface: String,
+    to_bus: SyncSender<Box<Image>>,
+    from_bus: Receiver<Box<Image>>,
+    /// The image while the cyclic thread holds it.
+    image: Option<Box<Image>>,
+    /// Misses in a row.
+    in_a_row: u32,
+    /// The drives on the segment: device and last feedback (extrapolated over misses).
+    drives: Vec<(usize, DriveFeedback)>,
+    /// The node's cycle (ns).
+    cycle_ns: i64,
+    /// The first exchange has been started.
+    started: bool,
+    /// The counters.
+    pub counts: Box<SegmentCounts>,
+}
+
+impl Link {
+    /// The exchange at boundary `t` (see the module): the previous exchange's inputs into
+    /// `exec`, this cycle's outputs out. Never waits.
+    pub fn exchange(&mut self, t: i64, exec: &mut Executive<'_>, log: &mut impl Write) {
+        if !self.started {
+            // The first boundary: nothing was exchanged before it; the first outputs go out.
+            self.started = true;
+            if let Some(image) = self.image.take() {
+                self.send(image, exec);
+            }
+            return;
+        }
+        if let Ok(image) = self.from_bus.try_recv() {
+            self.image = Some(image);
+        }
+        let Some(mut image) = self.image.take() else {
+            // The exchange started a cycle ago is not back.
+            self.miss(exec);
+            return;
+        };
+        if image.ok {
+            self.in_a_row = 0;
+            self.counts.exchanges += 1;
+            let bucket = usize::try_from(image.round_trip_ns / 10_000).unwrap_or(usize::MAX);
+            if let Some(c) = self.counts.round_trip_10us.get_mut(bucket.min(1000)) {
+                *c = c.saturating_add(1);
+            }
+            for p in &mut image.parts {
+                if p.map.is_some() {
+                    exec.set_drive_feedback(p.device, &p.feedback);
+                    if let Some(d) = self.drives.iter_mut().find(|d| d.0 == p.device) {
+                        d.1 = p.feedback;
+                    }
+                    continue;
+                }
+                if let Some(d) = p.inputs_device {
+                    exec.set_input_levels(d, t, u32::from(p.inputs));
+                }
+                if p.inputs != p.inputs_logged {
+                    p.inputs_logged = p.inputs;
+                    // The log ring keeps what fits; a full ring counts its losses itself.
+                    let _ = writeln!(
+                        log,
+                        "t={} {} inputs 0x{:02X} (EtherCAT)",
+                        Secs(t),
+                        p.name,
+                        p.inputs
+                    );
+                }
+            }
+        } else {
+            self.miss(exec);
+        }
+        self.send(image, exec);
+    }
+
+    /// The RxPDO of the last step into `image`, handed to the "ethercat" thread (kept for the
+    /// next cycle if it still holds the previous one).
+    fn send(&mut self, mut image: Box<Image>, exec: &Executive<'_>) {
+        for p in &mut image.parts {
+            if p.map.is_some() {
+                p.command = exec.drive_command(p.device).copied().unwrap_or_default();
+            } else {
+                // The levels the last step left on its output channels (bit c - 1: channel c).
+                p.outputs = exec
+                    .output_device(p.device)
+                    .map_or(0, |s| (s.levels & 0xFF) as u8);
+            }
+        }
+        image.ok = false;
+        match self.to_bus.try_send(image) {
+            Ok(()) => {}
+            Err(TrySendError::Full(i) | TrySendError::Disconnected(i)) => self.image = Some(i),
+        }
+    }
+
+    /// One cycle without a complete exchange; the alarm at [`MISSES_TO_ALARM`] in a row.
+    fn miss(&mut self, exec: &mut Executive<'_>) {
+        self.counts.misses += 1;
+        self.in_a_row = self.in_a_row.saturating_add(1);
+        self.counts.most_in_a_row = self.counts.most_in_a_row.max(self.in_a_row);
+        if self.in_a_row < MISSES_TO_ALARM {
+            // Until the alarm the drives' positions go on at their last velocity, so a late
+            // exchange makes no jump in the following error (inferred: a drive in CSP keeps
+            // following its last setpoints' motion; the real sample replaces this one).
+            let dt = self.cycle_ns as f64 * 1e-9;
+            for (device, last) in &mut self.drives {
+                let step = (f64::from(last.velocity_actual) * dt).round() as i64;
+                last.position_actual = last.position_actual.wrapping_add(step as i32);
+                exec.set_drive_feedback(*device, last);
+            }
+            return;
+        }
+        if self.in_a_row == MISSES_TO_ALARM {
+            self.counts.alarms += 1;
+        }
+        let lost = DriveFeedback {
+            statusword: FAULT_STATUSWORD,
+            error_code: LOST_CODE,
+            ..DriveFeedback::default()
+        };
+        for (device, _) in &self.drives {
+            exec.set_drive_feedback(*device, &lost);
+        }
+    }
+
+    /// The segment's counters, logged at the node's end.
+    pub fn report(&self) {
+        let c = &self.counts;
+        info!(
+            interface = %self.interface,
+            exchanges = c.exchanges,
+            misses = c.misses,
+            alarms = c.alarms,
+            "EtherCAT segment: {} exchanges, {} missed cycles (at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us",
+            c.exchanges,
+            c.misses,
+            c.most_in_a_row,
+            c.alarms,
+            c.round_trip_quantile_us(0.5),
+            c.round_trip_quantile_us(0.99),
+            c.round_trip_quantile_us(1.0),
+        );
+    }
+}
+
+/// What the "ethercat" thread needs to start.
+struct Plan {
+    interface: String,
+    /// The node's SCHED_FIFO priority, which the EtherCAT threads take too.
+    priority: Option<u8>,
+    /// The node's cycle (ns): SYNC0's period.
+    cycle_ns: u64,
+    /// Per expected SubDevice in bus order: name, identity, role, device, inputs device.
+    expected: Vec<(String, EthercatIdentity, EthercatRole, usize, Option<usize>)>,
+}
+
+/// Opens node `n`'s segment if it has one: the bus checked against the cell file, the drives'
+/// mappings read, OP reached (within [`START_TIMEOUT`]). `Ok(None)` for a node without
+/// `[[ethercat]]`.
+pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
+    let Some(seg) = cell.ethercat.iter().find(|s| s.node == n) else {
+        return Ok(None);
+    };
+    let plan = Plan {
+        interface: seg.interface.clone(),
+        priority: cell.nodes.get(n).and_then(|x| x.realtime.priority),
+        cycle_ns: cell.nodes.get(n).map_or(1_000_000, |x| {
+            u64::try_from(x.cycle_ns).unwrap_or(1_000_000)
+        }),
+        expected: seg
+            .subdevices
+            .iter()
+            .map(|s| {
+                (
+                    s.name.clone(),
+                    s.identity,
+                    s.role,
+                    s.device.0,
+                    s.inputs.map(|d| d.0),
+                )
+            })
+            .collect(),
+    };
+    let interface = seg.interface.clone();
+    let start_error = |reason: String| EthercatError::Start {
+        interface: interface.clone(),
+        reason,
+    };
+    let (ready_tx, ready_rx) = sync_channel::<Result<Box<Image>, EthercatError>>(1);
+    let (to_bus, bus_in) = sync_channel::<Box<Image>>(1);
+    let (bus_out, from_bus) = sync_channel::<Box<Image>>(1);
+    std::thread::Builder::new()
+        .name("ethercat".into())
+        .stack_size(8 << 20)
+        .spawn(move || bus_thread(&plan, &ready_tx, &bus_in, &bus_out))
+        .map_err(|e| start_error(format!("cannot start the ethercat thread: {e}")))?;
+    let image = match ready_rx.recv_timeout(START_TIMEOUT) {
+        Ok(r) => r?,
+        Err(_) => {
+            return Err(start_error(format!(
+                "not in OP within {} s",
+                START_TIMEOUT.as_secs()
+            )))
+        }
+    };
+    let drives = image
+        .parts
+        .iter()
+        .filter(|p| p.map.is_some())
+        .map(|p| (p.device, DriveFeedback::default()))
+        .collect();
+    info!(interface = %seg.interface, subdevices = seg.subdevices.len(), "EtherCAT segment in OP");
+    Ok(Some(Link {
+        interface: seg.interface.clone(),
+        to_bus,
+        from_bus,
+        image: Some(image),
+        in_a_row: 0,
+        drives,
+        cycle_ns: cell.nodes.get(n).map_or(1, |x| x.cycle_ns),
+        started: false,
+        counts: Box::default(),
+    }))
+}
+
+/// The "ethercat" thread: starts the segment, reports it ready (or why not), then runs one
+/// exchange per image handed over until the cyclic thread's end of the channel goes.
+fn bus_thread(
+    plan: &Plan,
+    ready: &SyncSender<Result<Box<Image>, EthercatError>>,
+    bus_in: &Receiver<Box<Image>>,
+    bus_out: &SyncSender<Box<Image>>,
+) {
+    let fail = |reason: String| EthercatError::Start {
+        interface: plan.interface.clone(),
+        reason,
+    };
+    let Ok((tx, rx, pdu_loop)) = PDU_STORAGE.try_split() else {
+        // The receiver waits with a timeout; if it gave up nobody needs the answer.
+        let _ = ready.send(Err(fail("the PDU storage is in use already".into())));
+        return;
+    };
+    let task = match tx_rx_task(&plan.interface, tx, rx) {
+        Ok(t) => t,
+        Err(e) => {
+            // As above: a receiver that gave up needs no answer.
+            let _ = ready.send(Err(fail(format!("cannot open the interface: {e}"))));
+            return;
+        }
+    };
+    let priority = plan.priority;
+    realtime(priority);
+    let io = std::thread::Builder::new()
+        .name("ethercat-io".into())
+        .spawn(move || {
+            realtime(priority);
+            if let Err(e) = async_io::block_on(task) {
+                warn!("EtherCAT TX/RX ended: {e}");
+            }
+        });
+    if let Err(e) = io {
+        // As above.
+        let _ = ready.send(Err(fail(format!(
+            "cannot start the ethercat-io thread: {e}"
+        ))));
+        return;
+    }
+    let md = MainDevice::new(
+        pdu_loop,
+        Timeouts {
+            pdu: PDU_TIMEOUT,
+            ..Timeouts::default()
+        },
+        MainDeviceConfig {
+            dc_static_sync_iterations: 1000,
+            ..MainDeviceConfig::default()
+        },
+    );
+    async_io::block_on(run_bus(plan, &md, ready, bus_in, bus_out));
+}
+
+/// SCHED_FIFO at the node's priority, if it has one (a refusal is a warning).
+fn realtime(priority: Option<u8>) {
+    tandem_rt::no_timer_slack();
+    if let Some(p) = priority {
+        if let Err(w) = tandem_rt::set_fifo(p) {
+            warn!("{w}");
+        }
+    }
+}
+
+/// The DC epoch, 2000-01-01 00:00 UTC, on the cell clock (ns since the Unix epoch).
+const DC_EPOCH_NS: i64 = 946_684_800 * 1_000_000_000;
+
+/// The cell clock as DC system time (ns since 2000-01-01): the time base ethercrab sets the
+/// SubDevices' clocks to (their offsets 0x0920), so that the DC system time is cell time and
+/// SYNC0, at whole multiples of the node's cycle in DC time, falls on the node's grid (whose
+/// epoch is a whole second: exactly when the cycle divides one second).
+fn cell_dc_now() -> u64 {
+    u64::try_from(tandem_rt::now_ns().saturating_sub(DC_EPOCH_NS)).unwrap_or(0)
+}
+
+/// The "ethercat" thread's ends of the channels.
+struct Ends<'a> {
+    ready: &'a SyncSender<Result<Box<Image>, EthercatError>>,
+    bus_in: &'a Receiver<Box<Image>>,
+    bus_out: &'a SyncSender<Box<Image>>,
+}
+
+impl Ends<'_> {
+    /// Reports why the start failed.
+    fn refuse(&self, e: EthercatError) {
+        // The receiver waits with a timeout; if it gave up nobody needs the answer.
+        let _ = self.ready.send(Err(e));
+    }
+}
+
+/// The node's group of SubDevices in OP, with or without DC.
+type OpGroup<DC> =
+    SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, subdevice_group::Op, DC>;
+
+/// The MainDevice's work: start (see [`open`]), then the exchanges.
+async fn run_bus(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    ready: &SyncSender<Result<Box<Image>, EthercatError>>,
+    bus_in: &Receiver<Box<Image>>,
+    bus_out: &SyncSender<Box<Image>>,
+) {
+    let ends = Ends {
+        ready,
+        bus_in,
+        bus_out,
+    };
+    let fail = |what: &str, e: ethercrab::error::Error| EthercatError::Start {
+        interface: plan.interface.clone(),
+        reason: format!("{what}: {e}"),
+    };
+    let mut group = match md
+        .init_single_group::<MAX_SUBDEVICES, MAX_PDI>(cell_dc_now)
+        .await
+    {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("no segment found", e)),
+    };
+    let parts = match check_and_map(plan, md, &group).await {
+        Ok(p) => p,
+        Err(e) => return ends.refuse(e),
+    };
+    // SYNC0 on every SubDevice with DC, every node cycle.
+    let mut dc = 0usize;
+    for mut sd in group.iter_mut(md) {
+        if sd.dc_support().any() {
+            sd.set_dc_sync(DcSync::Sync0);
+            dc += 1;
+        }
+    }
+    if dc == 0 {
+        let group = match group.into_safe_op(md).await {
+            Ok(g) => g,
+            Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+        };
+        match group.request_into_op(md).await {
+            Ok(g) => serve(plan, md, &g, parts, &ends).await,
+            Err(e) => ends.refuse(fail("OP refused", e)),
+        }
+        return;
+    }
+    let conf = DcConfiguration {
+        // Inferred: time for the SubDevices to take the configuration before the first pulse.
+        start_delay: Duration::from_millis(100),
+        sync0_period: Duration::from_nanos(plan.cycle_ns),
+        sync0_shift: Duration::ZERO,
+    };
+    let group = match group.into_pre_op_pdi(md).await {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("process data mapping", e)),
+    };
+    let group = match group.configure_dc_sync(md, conf).await {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("SYNC0 configuration", e)),
+    };
+    let group = match group.into_safe_op(md).await {
+        Ok(g) => g,
+        Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+    };
+    match group.request_into_op(md).await {
+        Ok(g) => {
+            log_dc(plan, md, &g, dc).await;
+            serve(plan, md, &g, parts, &ends).await;
+        }
+        Err(e) => ends.refuse(fail("OP refused", e)),
+    }
+}
+
+/// Logs the SYNC0 configuration the first DC SubDevice holds and how far its DC system time
+/// is from the cell clock.
+async fn log_dc<DC>(plan: &Plan, md: &MainDevice<'_>, group: &OpGroup<DC>, dc: usize) {
+    let Some(sd) = group.iter(md).find(|sd| sd.dc_support().any()) else {
+        return;
+    };
+    let cycle = sd
+        .register_read::<u32>(RegisterAddress::DcSync0CycleTime)
+        .await;
+    let start = sd
+        .register_read::<u64>(RegisterAddress::DcSyncStartTime)
+        .await;
+    let system = sd.register_read::<u64>(RegisterAddress::DcSystemTime).await;
+    let now = cell_dc_now();
+    match (cycle, start, system) {
+        (Ok(cycle), Ok(start), Ok(system)) => info!(
+            interface = %plan.interface,
+            sync0_ns = cycle,
+            "EtherCAT SYNC0 every {cycle} ns on {dc} SubDevice(s), first pulse at DC time {start} ns \
+             (on the node's grid: {} ns past a cycle boundary); DC system time {} us from the cell clock",
+            (i128::from(start) + i128::from(DC_EPOCH_NS)).rem_euclid(i128::from(plan.cycle_ns.max(1))),
+            (i128::from(system) - i128::from(now)) / 1000,
+        ),
+        _ => warn!(interface = %plan.interface, "EtherCAT SYNC0 registers not readable"),
+    }
+}
+
+/// Compares the bus with the cell file position by position and reads each drive's mapping:
+/// the parts of the process image in bus order.
+async fn check_and_map<DC>(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    group: &SubDeviceGroup<
+        MAX_SUBDEVICES,
+        MAX_PDI,
+        ethercrab::DefaultLock,
+        subdevice_group::PreOp,
+        DC,
+    >,
+) -> Result<Vec<Part>, EthercatError> {
+    let mut parts = Vec::new();
+    let found: Vec<SubDeviceRef<'_, _>> = group.iter(md).collect();
+    for position in 0..plan.expected.len().max(found.len()) {
+        let expected = plan.expected.get(position);
+        let sd = found.get(position);
+        let id = sd.map(|sd| {
+            let i = sd.identity();
+            EthercatIdentity {
+                vendor: i.vendor_id,
+                product: i.product_id,
+                revision: i.revision,
+            }
+        });
+        let (Some((name, want, role, device, inputs_device)), Some(sd), Some(id)) =
+            (expected, sd, id)
+        else {
+            return Err(mismatch(plan, position, expected, sd.zip(id)));
+        };
+        if *want != id {
+            return Err(mismatch(plan, position, expected, Some((sd, id))));
+        }
+        let map = match role {
+            EthercatRole::Cia402 => Some(read_mapping(name, sd, &plan.interface).await?),
+            EthercatRole::Dio => None,
+        };
+        parts.push(Part {
+            device: *device,
+            map,
+            command: DriveCommand::default(),
+            feedback: DriveFeedback::default(),
+            outputs: 0,
+            inputs: 0,
+            inputs_logged: 0,
+            inputs_device: *inputs_device,
+            name: name.to_string(),
+        });
+    }
+    Ok(parts)
+}
+
+/// The mismatch at `position`: what the cell file expects there, what the bus has.
+fn mismatch<S>(
+    plan: &Plan,
+    position: usize,
+    expected: Option<&(String, EthercatIdentity, EthercatRole, usize, Option<usize>)>,
+    found: Option<(&SubDeviceRef<'_, S>, EthercatIdentity)>,
+) -> EthercatError
+where
+    S: core::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    EthercatError::Mismatch {
+        interface: plan.interface.clone(),
+        position,
+        expected: expected.map(|e| (e.0.clone(), e.1)),
+        found: found.map(|(sd, id)| (sd.name().to_string(), id)),
+    }
+}
+
+/// In OP: reports the segment ready, then one exchange per image handed over until the
+/// cyclic thread's end of the channel goes.
+async fn serve<DC>(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    group: &OpGroup<DC>,
+    parts: Vec<Part>,
+    ends: &Ends<'_>,
+) {
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        match group.tx_rx(md).await {
+            Ok(r) if r.all_op() => break,
+            Ok(_) if Instant::now() < deadline => {}
+            Ok(_) => {
+                return ends.refuse(EthercatError::Start {
+                    interface: plan.interface.clone(),
+                    reason: "not all SubDevices in OP within 10 s".into(),
+                })
+            }
+            Err(e) => {
+                return ends.refuse(EthercatError::Start {
+                    interface: plan.interface.clone(),
+                    reason: format!("exchange on the way to OP: {e}"),
+                })
+            }
+        }
+        async_io::Timer::after(Duration::from_millis(1)).await;
+    }
+    // The working counter of a complete exchange: +1 per SubDevice with inputs, +2 per one
+    // with outputs (an LRW through its read and its write FMMU).
+    let expected_wkc: u16 = group
+        .iter(md)
+        .map(|sd| {
+            let io = sd.io_raw();
+            u16::from(!io.inputs().is_empty()) + 2 * u16::from(!io.outputs().is_empty())
+        })
+        .sum();
+    let image = Box::new(Image {
+        parts,
+        ok: false,
+        round_trip_ns: 0,
+    });
+    if ends.ready.send(Ok(image)).is_err() {
+        return;
+    }
+    loop {
+        let mut image = match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
+            Ok(i) => i,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => return,
+        };
+        for (p, sd) in image.parts.iter().zip(group.iter(md)) {
+            let mut out = sd.outputs_raw_mut();
+            match &p.map {
+                Some(map) => encode(map, &p.command, &mut out),
+                None => put(&mut out, 0, 1, i64::from(p.outputs)),
+            }
+        }
+        let sent = Instant::now();
+        let result = group.tx_rx(md).await;
+        image.round_trip_ns = u64::try_from(sent.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        image.ok = matches!(&result, Ok(r) if r.working_counter >= expected_wkc);
+        if image.ok {
+            for (p, sd) in image.parts.iter_mut().zip(group.iter(md)) {
+                let input = sd.inputs_raw();
+                match &p.map {
+                    Some(map) => p.feedback = decode(map, &input),
+                    None => p.inputs = input.first().copied().unwrap_or(0),
+                }
+            }
+        }
+        if ends.bus_out.send(image).is_err() {
+            return;
+        }
+    }
+}
+
+/// The assigned RxPDO and TxPDO mapping of drive `sd` over CoE (CiA 301: 0x1C12:01 and
+/// 0x1C13:01 name the PDO, its subindex 0 counts the entries), checked for the objects the
+/// CiA 402 drive connection needs.
+async fn read_mapping<S>(
+    name: &str,
+    sd: &SubDeviceRef<'_, S>,
+    interface: &str,
+) -> Result<DriveMap, EthercatError>
+where
+    S: core::ops::Deref<Target = ethercrab::SubDevice>,
+{
+    let sdo = |e: ethercrab::error::Error| EthercatError::Start {
+        interface: interface.to_string(),
+        reason: format!("`{name}`: reading its PDO mapping over CoE: {e}"),
+    };
+    // The RxPDO tandem's CSP needs, with the velocity feedforward 0x60B1 (a drive's default
+    // mapping often lacks it: without it the drive's own position loop lags by v / Kv).
+    // Written into the assigned RxPDO in PRE-OP; a drive that refuses keeps its own mapping.
+    let rx_pdo: u16 = sd.sdo_read(0x1C12, 1).await.map_err(sdo)?;
+    if let Err(e) = sd.sdo_write_array(rx_pdo, &CSP_RXPDO).await {
+        warn!(
+            subdevice = name,
+            "RxPDO 0x{rx_pdo:04X} not remapped ({e}): the drive's own mapping is used"
+        );
+    }
+    let mut map = DriveMap::default();
+    for (assign, rx) in [(0x1C12u16, true), (0x1C13u16, false)] {
+        let pdo: u16 = sd.sdo_read(assign, 1).await.map_err(sdo)?;
+        let n: u8 = sd.sdo_read(pdo, 0).await.map_err(sdo)?;
+        let mut bit = 0usize;
+        for sub in 1..=n {
+            let entry: u32 = sd.sdo_read(pdo, sub).await.map_err(sdo)?;
+            if let Some(m) = mapped(entry, bit) {
+                if rx {
+                    map.rx.push(m);
+                } else {
+                    map.tx.push(m);
+                }
+            }
+            bit += (entry & 0xFF) as usize;
+        }
+    }
+    for (list, object) in [
+        (&map.rx, 0x6040u16),
+        (&map.rx, 0x607A),
+        (&map.tx, 0x6041),
+        (&map.tx, 0x6064),
+    ] {
+        if !list.iter().any(|m| m.index == object) {
+            return Err(EthercatError::Mapping {
+                name: name.to_string(),
+                object,
+            });
+        }
+    }
+    Ok(map)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+
+    /// The emulated drive's mappings (docs/ethercat.md): RxPDO 0x1600 and TxPDO 0x1A00.
+    fn emulated() -> DriveMap {
+        let mut map = DriveMap::default();
+        let mut bit = 0;
+        for e in [0x6040_0010u32, 0x6060_0008, 0x607A_0020, 0x60B8_0010] {
+            map.rx.push(mapped(e, bit).unwrap());
+            bit += (e & 0xFF) as usize;
+        }
+        bit = 0;
+        for e in [
+            0x6041_0010u32,
+            0x6061_0008,
+            0x6064_0020,
+            0x606C_0020,
+            0x60B9_0010,
+            0x60BA_0020,
+            0x60BB_0020,
+        ] {
+            map.tx.push(mapped(e, bit).unwrap());
+            bit += (e & 0xFF) as usize;
+        }
+        map
+    }
+
+    #[test]
+    fn the_rxpdo_goes_out_at_the_mapped_offsets() {
+        let c = DriveCommand {
+            controlword: 0x000F,
+            mode: 8,
+            target_position: -2,
+            touch_probe_function: 0x0013,
+            target_velocity: 77,
+            ..DriveCommand::default()
+        };
+        let mut out = [0xAAu8; 9];
+        encode(&emulated(), &c, &mut out);
+        assert_eq!(out, [0x0F, 0x00, 8, 0xFE, 0xFF, 0xFF, 0xFF, 0x13, 0x00]);
+    }
+
+    #[test]
+    fn the_txpdo_comes_in_from_the_mapped_offsets() {
+        let mut input = [0u8; 21];
+        input[0..2].copy_from_slice(&0x1237u16.to_le_bytes());
+        input[2] = 0xF7; // -9
+        input[3..7].copy_from_slice(&(-123_456i32).to_le_bytes());
+        input[7..11].copy_from_slice(&(1_000_000i32).to_le_bytes());
+        input[11..13].copy_from_slice(&0x0202u16.to_le_bytes());
+        input[13..17].copy_from_slice(&(i32::MIN).to_le_bytes());
+        input[17..21].copy_from_slice(&(i32::MAX).to_le_bytes());
+        let f = decode(&emulated(), &input);
+        assert_eq!(
+            f,
+            DriveFeedback {
+                statusword: 0x1237,
+                mode_display: -9,
+                position_actual: -123_456,
+                velocity_actual: 1_000_000,
+                touch_probe_status: 0x0202,
+                touch_probe_1_positive: i32::MIN,
+                touch_probe_1_negative: i32::MAX,
+                ..DriveFeedback::default()
+            }
+        );
+    }
+
+    #[test]
+    fn a_short_image_reads_zeros_and_writes_nothing_beyond_it() {
+        let f = decode(&emulated(), &[0x27, 0x02]);
+        assert_eq!(f.statusword, 0x0227);
+        assert_eq!(f.position_actual, 0);
+        let mut out = [0u8; 2];
+        encode(
+            &emulated(),
+            &DriveCommand {
+                controlword: 6,
+                mode: 8,
+                ..DriveCommand::default()
+            },
+            &mut out,
+        );
+        assert_eq!(out, [6, 0]);
+    }
+
+    /// Runs `f` with a link on `config/ethercat.toml`'s drive whose bus end is the test: the
+    /// link, the node's executive, the images the link sends, the sender of the bus's answers,
+    /// and the drive's device.
+    fn with_link(
+        f: impl FnOnce(
+            &mut Link,
+            &mut Executive<'_>,
+            &Receiver<Box<Image>>,
+            &SyncSender<Box<Image>>,
+            usize,
+        ),
+    ) {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/ethercat.toml");
+        let cell = tandem_config::load(&path).unwrap();
+        let drive = cell.ethercat[0].subdevices[0].device.0;
+        let mut exec = Executive::new(&cell, Some(0)).unwrap();
+        let (to_bus, bus_in) = sync_channel(1);
+        let (bus_out, from_bus) = sync_channel(1);
+        let part = Part {
+            device: drive,
+            map: Some(emulated()),
+            command: DriveCommand::default(),
+            feedback: DriveFeedback::default(),
+            outputs: 0,
+            inputs: 0,
+            inputs_logged: 0,
+            inputs_device: None,
+            name: "slide_servo".into(),
+        };
+        let mut link = Link {
+            interface: "ecm".into(),
+            to_bus,
+            from_bus,
+            image: Some(Box::new(Image {
+                parts: vec![part],
+                ok: false,
+                round_trip_ns: 0,
+            })),
+            in_a_row: 0,
+            drives: vec![(drive, DriveFeedback::default())],
+            cycle_ns: 2_000_000,
+            started: false,
+            counts: Box::default(),
+        };
+        f(&mut link, &mut exec, &bus_in, &bus_out, drive);
+    }
+
+    #[test]
+    fn a_late_exchange_extrapolates_and_the_third_miss_in_a_row_is_the_alarm() {
+        with_link(|link, exec, bus_in, bus_out, drive| {
+            let mut log = Vec::new();
+            // Cycle 0: the first image goes out at once.
+            link.exchange(0, exec, &mut log);
+            let mut image = bus_in.try_recv().expect("sent at the first boundary");
+            // The bus answers: the drive at 1000 increments, 500 000 increments/s.
+            image.ok = true;
+            image.round_trip_ns = 120_000;
+            image.parts[0].feedback = DriveFeedback {
+                statusword: 0x0237,
+                position_actual: 1000,
+                velocity_actual: 500_000,
+                ..DriveFeedback::default()
+            };
+            bus_out.send(image).unwrap();
+            link.exchange(2_000_000, exec, &mut log);
+            assert_eq!(exec.drive_feedback(drive).unwrap().position_actual, 1000);
+            assert_eq!((link.counts.exchanges, link.counts.misses), (1, 0));
+            assert_eq!(link.counts.round_trip_10us[12], 1);
+            // The next image is out; nothing comes back for two cycles: the position goes on
+            // at the last velocity (1000 increments per 2 ms), no alarm.
+            let _held = bus_in.try_recv().expect("sent again");
+            for (k, want) in [(2i64, 2000), (3, 3000)] {
+                link.exchange(k * 2_000_000, exec, &mut log);
+                let f = exec.drive_feedback(drive).unwrap();
+                assert_eq!((f.position_actual, f.statusword), (want, 0x0237));
+            }
+            assert_eq!(link.counts.alarms, 0);
+            // The third miss in a row: fault with 0x8130.
+            link.exchange(8_000_000, exec, &mut log);
+            let f = exec.drive_feedback(drive).unwrap();
+            assert_eq!((f.statusword, f.error_code), (FAULT_STATUSWORD, LOST_CODE));
+            assert_eq!(
+                (
+                    link.counts.misses,
+                    link.counts.alarms,
+                    link.counts.most_in_a_row
+                ),
+                (3, 1, 3)
+            );
+            // Further misses are the same alarm, not new ones.
+            link.exchange(10_000_000, exec, &mut log);
+            assert_eq!(link.counts.alarms, 1);
+        });
+    }
+
+    #[test]
+    fn a_working_counter_error_is_a_miss_and_the_command_goes_out_anyway() {
+        with_link(|link, exec, bus_in, bus_out, _| {
+            let mut log = Vec::new();
+            link.exchange(0, exec, &mut log);
+            let image = bus_in.try_recv().unwrap();
+            // `ok` false: the exchange failed or its working counter was short.
+            bus_out.send(image).unwrap();
+            link.exchange(2_000_000, exec, &mut log);
+            assert_eq!((link.counts.exchanges, link.counts.misses), (0, 1));
+            let image = bus_in.try_recv().expect("the next command still goes out");
+            assert!(!image.ok);
+            assert!(image.parts[0].map.is_some());
+        });
+    }
+
+    #[test]
+    fn a_mismatch_names_position_and_both_identities() {
+        let e = EthercatError::Mismatch {
+            interface: "ecm".into(),
+            position: 1,
+            expected: Some((
+                "io".into(),
+                EthercatIdentity {
+                    vendor: 2,
+                    product: 0x0743_3052,
+                    revision: 0x0010_0000,
+                },
+            )),
+            found: Some((
+                "EL1859".into(),
+                EthercatIdentity {
+                    vendor: 2,
+                    product: 0x0743_3052,
+                    revision: 0x0011_0000,
+                },
+            )),
+        };
+        assert_eq!(
+            e.to_string(),
+            "EtherCAT segment on `ecm` does not match the cell file at position 1: expected `io` \
+             (vendor 0x00000002, product 0x07433052, revision 0x00100000), found `EL1859` \
+             (vendor 0x00000002, product 0x07433052, revision 0x00110000)"
+        );
+    }
+}
