@@ -55,6 +55,7 @@ use std::thread::JoinHandle;
 use tandem_config::script::Script;
 use tandem_config::{AxisIndex, Cell, Coupling, Leader};
 use tandem_motion::objects::action::Action;
+use tandem_motion::objects::axis::AxisStatus;
 use tandem_protocol::ipc;
 use tandem_rt as rt;
 use tandem_rt::retain::RetainStore;
@@ -80,8 +81,24 @@ pub struct Options {
     pub log: Option<PathBuf>,
 }
 
-/// Trace rows in the pool between the cyclic and the recorder thread.
-const TRACE_ROWS: usize = 256;
+/// Trace rows in the pool between the cyclic and the recorder thread, at least: the recorder
+/// may fall this many cycles behind (a busy disk) before a row is dropped (`trace_dropped`).
+const TRACE_ROWS_MIN: usize = 256;
+
+/// Trace rows in the pool, at most (4 s of 1 ms cycles).
+const TRACE_ROWS_MAX: usize = 4096;
+
+/// The memory the pool may take, where more than [`TRACE_ROWS_MIN`] rows fit in it.
+const TRACE_POOL_BYTES: usize = 16 << 20;
+
+/// The rows of the trace pool of a node with `axes` axes: as many as [`TRACE_POOL_BYTES`] hold,
+/// within [`TRACE_ROWS_MIN`] and [`TRACE_ROWS_MAX`] (the hour's soak of the line cell dropped
+/// 923 rows of a one-axis node with 256 while builds kept the disk busy; 4,096 rows of one axis
+/// take 0.7 MB, and a node of 1,024 axes keeps its 256 rows, 36 MB).
+fn trace_rows(axes: usize) -> usize {
+    let row = axes.max(1) * std::mem::size_of::<AxisStatus>() + std::mem::size_of::<Row>();
+    (TRACE_POOL_BYTES / row).clamp(TRACE_ROWS_MIN, TRACE_ROWS_MAX)
+}
 
 /// Runs the node until SIGINT/SIGTERM or the end of its duration, in a `node` span.
 pub fn run(o: &Options) -> Result<Report, NodeError> {
@@ -188,10 +205,11 @@ fn start_threads(
     let (cmd_tx, cmd_rx) = sync_channel::<Queued>(32);
     let (done_tx, done_rx) = sync_channel::<Done>(64);
     let (diag_tx, diag_rx) = sync_channel::<Record>(DIAG_RECORDS);
-    let (free_tx, free_rx) = sync_channel::<Row>(TRACE_ROWS);
-    let (row_tx, row_rx) = sync_channel::<Row>(TRACE_ROWS);
+    let pool = trace_rows(owned.len());
+    let (free_tx, free_rx) = sync_channel::<Row>(pool);
+    let (row_tx, row_rx) = sync_channel::<Row>(pool);
     // Trace rows only when a trace is written; the pool's channel holds them all.
-    let rows = if o.trace.is_some() { TRACE_ROWS } else { 0 };
+    let rows = if o.trace.is_some() { pool } else { 0 };
     for _ in 0..rows {
         if free_tx
             .try_send((0, Vec::with_capacity(owned.len())))
@@ -407,4 +425,29 @@ pub(crate) fn owns(cell: &Cell, n: usize, target: &str, action: &Action) -> bool
             }),
     };
     node == Some(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_trace_pool_holds_more_rows_for_small_nodes_within_its_bounds() {
+        assert_eq!(trace_rows(1), TRACE_ROWS_MAX);
+        assert_eq!(trace_rows(0), TRACE_ROWS_MAX);
+        assert_eq!(trace_rows(1024), TRACE_ROWS_MIN);
+        let mut last = usize::MAX;
+        for axes in [1, 8, 16, 32, 64, 128, 256, 512, 1024, 4096] {
+            let rows = trace_rows(axes);
+            assert!((TRACE_ROWS_MIN..=TRACE_ROWS_MAX).contains(&rows));
+            assert!(rows <= last, "{axes} axes: {rows} rows");
+            last = rows;
+        }
+        eprintln!(
+            "AxisStatus {} bytes; 1 axis: {} rows; 1,024 axes: {} rows",
+            std::mem::size_of::<AxisStatus>(),
+            trace_rows(1),
+            trace_rows(1024)
+        );
+    }
 }
