@@ -295,6 +295,10 @@ fn a_killed_leader_node_stops_its_followers_and_the_cell_recovers() {
         until(Duration::from_secs(20), "all three nodes up", || {
             status(&cell).status.success()
         });
+        // A follower reads the line at t - D: before t = D (cell time, which runs from `tandem
+        // up`'s epoch, before the nodes were up) there is no value to gear to (alarm 601). Two D
+        // of wall time from here put the cell past it whatever the machine's load.
+        std::thread::sleep(Duration::from_nanos(2 * D_NS as u64));
         for target in ["leaders/line", "followers/feed", "followers/unwind"] {
             let o = cmd(&cell, &[target, "MC_Power", "--wait"]);
             assert!(o.status.success(), "{target} MC_Power: {}", text(&o));
