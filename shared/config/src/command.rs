@@ -784,8 +784,58 @@ fn cam_in(a: &Args<'_>, master: LeaderId, cam: CamId) -> Result<Command, Command
     })
 }
 
+/// The positioning and velocity jobs that take a `buffer_mode` (MC_MoveAbsolute, MC_MoveRelative,
+/// MC_MoveAdditive, MC_MoveVelocity); `None` for another instruction.
+fn buffered_move(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
+    let name = a.spec.name;
+    let bad = |param: &'static str, allowed: &'static str| CommandError::BadValue {
+        instruction: name,
+        param,
+        allowed,
+    };
+    Ok(Some(match name {
+        "MC_MoveAbsolute" => with_buffer_mode(
+            BufferedMotion::MoveAbsolute {
+                position: a.num("position")?,
+                dynamics: a.dynamics("velocity")?,
+                direction: Direction::from_code(a.code("direction")?)
+                    .ok_or(bad("direction", "1, 2 or 3"))?,
+            },
+            a.buffer_mode()?,
+        ),
+        "MC_MoveRelative" => with_buffer_mode(
+            BufferedMotion::MoveRelative {
+                distance: a.num("distance")?,
+                dynamics: a.dynamics("velocity")?,
+            },
+            a.buffer_mode()?,
+        ),
+        "MC_MoveAdditive" => with_buffer_mode(
+            BufferedMotion::MoveAdditive {
+                distance: a.num("distance")?,
+                dynamics: a.dynamics("velocity")?,
+            },
+            a.buffer_mode()?,
+        ),
+        "MC_MoveVelocity" => with_buffer_mode(
+            BufferedMotion::MoveVelocity {
+                dynamics: a.dynamics("velocity")?,
+                direction: VelocityDirection::from_code(a.code("direction")?)
+                    .ok_or(bad("direction", "0, 1 or 2"))?,
+                current: a.flag("current")?,
+                position_controlled: a.flag("position_controlled")?,
+            },
+            a.buffer_mode()?,
+        ),
+        _ => return Ok(None),
+    }))
+}
+
 /// The single-axis instructions (power, homing, stop, moves, monitoring).
 fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
+    if let Some(c) = buffered_move(a)? {
+        return Ok(c);
+    }
     let name = a.spec.name;
     let bad = |param: &'static str, allowed: &'static str| CommandError::BadValue {
         instruction: name,
@@ -833,39 +883,6 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
             deceleration: a.num("deceleration")?,
             jerk: a.num("jerk")?,
         },
-        "MC_MoveAbsolute" => with_buffer_mode(
-            BufferedMotion::MoveAbsolute {
-                position: a.num("position")?,
-                dynamics: a.dynamics("velocity")?,
-                direction: Direction::from_code(a.code("direction")?)
-                    .ok_or(bad("direction", "1, 2 or 3"))?,
-            },
-            a.buffer_mode()?,
-        ),
-        "MC_MoveRelative" => with_buffer_mode(
-            BufferedMotion::MoveRelative {
-                distance: a.num("distance")?,
-                dynamics: a.dynamics("velocity")?,
-            },
-            a.buffer_mode()?,
-        ),
-        "MC_MoveAdditive" => with_buffer_mode(
-            BufferedMotion::MoveAdditive {
-                distance: a.num("distance")?,
-                dynamics: a.dynamics("velocity")?,
-            },
-            a.buffer_mode()?,
-        ),
-        "MC_MoveVelocity" => with_buffer_mode(
-            BufferedMotion::MoveVelocity {
-                dynamics: a.dynamics("velocity")?,
-                direction: VelocityDirection::from_code(a.code("direction")?)
-                    .ok_or(bad("direction", "0, 1 or 2"))?,
-                current: a.flag("current")?,
-                position_controlled: a.flag("position_controlled")?,
-            },
-            a.buffer_mode()?,
-        ),
         "MC_MoveJog" => Command::MoveJog {
             forward: a.flag("jog_forward")?,
             backward: a.flag("jog_backward")?,

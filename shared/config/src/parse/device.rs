@@ -431,72 +431,89 @@ pub(super) fn drives(
             pick("encoder.mounting", &t.mounting, &MOUNTINGS)
                 .map_err(|(_, p)| at(&["encoder", "mounting"], p))?;
         }
-        entry.drive = match &devices[k].kind {
-            DeviceKind::SimAnalogDrive(_) => {
-                let cycle_ns = (entry.config.cycle * 1e9).round() as i64;
-                let params = analog_params(a, cycle_ns, enable_timeout_ns, &at)?;
-                DriveConnection::Analog(Box::new(AnalogDriveConnection {
-                    device: DeviceIndex(k),
-                    params,
-                }))
-            }
-            DeviceKind::SimServo(servo) => {
-                let steps = servo.increments_per_revolution;
-                let scaling = scaling(a, steps, Some(steps))
-                    .map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
-                let inertia = a.drive.inertia.unwrap_or(servo.inertia);
-                if !(inertia.is_finite() && inertia > 0.0) {
-                    return Err(at(
-                        &["drive", "inertia"],
-                        Problem::Invalid("must be a positive moment of inertia (kg·m²)"),
-                    ));
-                }
-                DriveConnection::Cia402(Box::new(Cia402Connection {
-                    device: DeviceIndex(k),
-                    enable_timeout_ns,
-                    scaling,
-                    torque_precontrol_inertia: a
-                        .drive
-                        .torque_precontrol
-                        .unwrap_or(false)
-                        .then_some(inertia),
-                }))
-            }
-            DeviceKind::EthercatCia402(p) => {
-                if a.drive.torque_precontrol.is_some() || a.drive.inertia.is_some() {
-                    let key = if a.drive.torque_precontrol.is_some() {
-                        "torque_precontrol"
-                    } else {
-                        "inertia"
-                    };
-                    return Err(at(
-                        &["drive", key],
-                        Problem::Invalid(
-                            "not for a drive on an EtherCAT segment (its PDO has no torque offset 0x60B2)",
-                        ),
-                    ));
-                }
-                let steps = p.increments_per_revolution;
-                let scaling = scaling(a, steps, Some(steps))
-                    .map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
-                DriveConnection::Cia402(Box::new(Cia402Connection {
-                    device: DeviceIndex(k),
-                    enable_timeout_ns,
-                    scaling,
-                    torque_precontrol_inertia: None,
-                }))
-            }
-            // Refused by `Bound::device` (not a drive).
-            DeviceKind::EthercatDio
-            | DeviceKind::EthercatDioInputs
-            | DeviceKind::SimDigitalOutput(_)
-            | DeviceKind::SimDigitalInput(_)
-            | DeviceKind::SimAnalogInput(_)
-            | DeviceKind::SimAnalogOutput(_)
-            | DeviceKind::SimCounter(_) => continue,
-        };
+        let cycle_ns = (entry.config.cycle * 1e9).round() as i64;
+        if let Some(c) = connection(
+            a,
+            &devices[k].kind,
+            DeviceIndex(k),
+            (cycle_ns, enable_timeout_ns),
+            &at,
+        )? {
+            entry.drive = c;
+        }
     }
     Ok(())
+}
+
+/// The drive connection of axis section `a` on device `device` (of kind `kind`), with its
+/// cycle and enable timeout (ns); `None` for a device that is no drive (refused before, by
+/// `Bound::device`).
+fn connection(
+    a: &AxisSection,
+    kind: &DeviceKind,
+    device: DeviceIndex,
+    (cycle_ns, enable_timeout_ns): (i64, i64),
+    at: &dyn Fn(&[&str], Problem) -> ConfigError,
+) -> Result<Option<DriveConnection>, ConfigError> {
+    Ok(Some(match kind {
+        DeviceKind::SimAnalogDrive(_) => {
+            let params = analog_params(a, cycle_ns, enable_timeout_ns, at)?;
+            DriveConnection::Analog(Box::new(AnalogDriveConnection { device, params }))
+        }
+        DeviceKind::SimServo(servo) => {
+            let steps = servo.increments_per_revolution;
+            let scaling = scaling(a, steps, Some(steps))
+                .map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+            let inertia = a.drive.inertia.unwrap_or(servo.inertia);
+            if !(inertia.is_finite() && inertia > 0.0) {
+                return Err(at(
+                    &["drive", "inertia"],
+                    Problem::Invalid("must be a positive moment of inertia (kg·m²)"),
+                ));
+            }
+            DriveConnection::Cia402(Box::new(Cia402Connection {
+                device,
+                enable_timeout_ns,
+                scaling,
+                torque_precontrol_inertia: a
+                    .drive
+                    .torque_precontrol
+                    .unwrap_or(false)
+                    .then_some(inertia),
+            }))
+        }
+        DeviceKind::EthercatCia402(p) => {
+            if a.drive.torque_precontrol.is_some() || a.drive.inertia.is_some() {
+                let key = if a.drive.torque_precontrol.is_some() {
+                    "torque_precontrol"
+                } else {
+                    "inertia"
+                };
+                return Err(at(
+                    &["drive", key],
+                    Problem::Invalid(
+                        "not for a drive on an EtherCAT segment (its PDO has no torque offset 0x60B2)",
+                    ),
+                ));
+            }
+            let steps = p.increments_per_revolution;
+            let scaling = scaling(a, steps, Some(steps))
+                .map_err(|(key, e)| at(&key, Problem::Mechanics(Box::new(e))))?;
+            DriveConnection::Cia402(Box::new(Cia402Connection {
+                device,
+                enable_timeout_ns,
+                scaling,
+                torque_precontrol_inertia: None,
+            }))
+        }
+        DeviceKind::EthercatDio
+        | DeviceKind::EthercatDioInputs
+        | DeviceKind::SimDigitalOutput(_)
+        | DeviceKind::SimDigitalInput(_)
+        | DeviceKind::SimAnalogInput(_)
+        | DeviceKind::SimAnalogOutput(_)
+        | DeviceKind::SimCounter(_) => return Ok(None),
+    }))
 }
 
 /// The kind of device a drive type needs.
