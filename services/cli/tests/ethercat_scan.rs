@@ -7,40 +7,12 @@ use std::os::fd::AsRawFd;
 use std::process::Command;
 use std::sync::mpsc;
 use std::time::Duration;
-
-/// The namespace with the veth pair; deleted on drop (which deletes the pair too, and ends the
-/// emulator thread, whose socket loses its interface).
-struct Netns(String);
-
-impl Drop for Netns {
-    fn drop(&mut self) {
-        // Best effort at teardown: nothing more can be done if the delete fails.
-        let _ = Command::new("ip").args(["netns", "del", &self.0]).status();
-    }
-}
-
-fn ip(args: &[&str]) {
-    let out = Command::new("ip").args(args).output().expect("run ip");
-    assert!(
-        out.status.success(),
-        "ip {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
+use tandem_testkit::netns::VethNetns;
 
 #[test]
 fn scan_lists_exactly_the_emulated_subdevices() {
-    let name = format!("tscan{}", std::process::id());
-    ip(&["netns", "add", &name]);
-    let ns = Netns(name);
-    ip(&[
-        "-n", &ns.0, "link", "add", "ecm", "type", "veth", "peer", "name", "ecs",
-    ]);
-    for dev in ["ecm", "ecs", "lo"] {
-        ip(&["-n", &ns.0, "link", "set", dev, "up"]);
-    }
-    let path = format!("/var/run/netns/{}", ns.0);
+    let ns = VethNetns::create("tscan", "ecm", "ecs");
+    let path = ns.path();
     let (ready_tx, ready_rx) = mpsc::channel();
     std::thread::spawn(move || {
         let file = std::fs::File::open(&path).expect("open netns");
@@ -68,7 +40,7 @@ fn scan_lists_exactly_the_emulated_subdevices() {
             "ip",
             "netns",
             "exec",
-            &ns.0,
+            ns.name(),
             env!("CARGO_BIN_EXE_tandem"),
             "ethercat",
             "scan",

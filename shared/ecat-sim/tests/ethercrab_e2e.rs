@@ -19,43 +19,9 @@ use std::time::{Duration, Instant};
 
 use ethercrab::std::{ethercat_now, tx_rx_task};
 use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, Timeouts};
+use tandem_testkit::netns::VethNetns;
 
 static PDU_STORAGE: PduStorage<16, { PduStorage::element_size(1100) }> = PduStorage::new();
-
-/// The namespace with the veth pair; deleted on drop (which deletes the pair too).
-struct Netns(String);
-
-impl Netns {
-    fn create() -> Self {
-        let name = format!("tecat{}", std::process::id());
-        ip(&["netns", "add", &name]);
-        let ns = Self(name);
-        ip(&[
-            "-n", &ns.0, "link", "add", "ecm", "type", "veth", "peer", "name", "ecs",
-        ]);
-        for dev in ["ecm", "ecs", "lo"] {
-            ip(&["-n", &ns.0, "link", "set", dev, "up"]);
-        }
-        ns
-    }
-}
-
-impl Drop for Netns {
-    fn drop(&mut self) {
-        // Best effort at teardown: nothing more can be done if the delete fails.
-        let _ = Command::new("ip").args(["netns", "del", &self.0]).status();
-    }
-}
-
-fn ip(args: &[&str]) {
-    let out = Command::new("ip").args(args).output().expect("run ip");
-    assert!(
-        out.status.success(),
-        "ip {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 /// The emulator process; killed on drop.
 struct Sim(Child);
@@ -69,12 +35,12 @@ impl Drop for Sim {
     }
 }
 
-fn start_sim(ns: &Netns) -> Sim {
+fn start_sim(ns: &VethNetns) -> Sim {
     let mut child = Command::new("ip")
         .args([
             "netns",
             "exec",
-            &ns.0,
+            ns.name(),
             env!("CARGO_BIN_EXE_tandem-ecat-sim"),
         ])
         .args(["--interface", "ecs", "--devices", "drive,dio", "--loopback"])
@@ -243,10 +209,10 @@ async fn main_device(seen: &mut Seen) -> Result<(), ethercrab::error::Error> {
 
 #[test]
 fn ethercrab_brings_the_emulated_segment_to_op_and_exchanges_pdi() {
-    let ns = Netns::create();
+    let ns = VethNetns::create("tecat", "ecm", "ecs");
     let _sim = start_sim(&ns);
     let (tx, rx) = mpsc::channel();
-    let name = ns.0.clone();
+    let name = ns.name().to_string();
     std::thread::spawn(move || {
         enter(&name);
         let rt = tokio::runtime::Builder::new_multi_thread()

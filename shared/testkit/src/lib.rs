@@ -9,7 +9,8 @@
 //! - [`process`], [`workspace`] and [`tandem`]: the system tests' helpers that find the
 //!   workspace's programs, start them with their output collected, and wait for them and for
 //!   conditions, always with a timeout; [`scratch`]: their temporary directories;
-//!   [`node_log`]: reading the logs of the nodes.
+//!   [`node_log`]: reading the logs of the nodes; [`netns`]: a network namespace with a veth
+//!   pair for the EtherCAT tests.
 //!
 //! A test counting what a piece of code allocates:
 //!
@@ -34,6 +35,7 @@
 #![warn(missing_docs)]
 
 pub mod counting;
+pub mod netns;
 pub mod node_log;
 pub mod process;
 #[cfg(feature = "motion")]

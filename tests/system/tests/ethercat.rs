@@ -17,54 +17,18 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
+use tandem_testkit::netns::VethNetns;
 use tandem_testkit::process::{run, text, Spawned};
 use tandem_testkit::scratch::{fresh_dir, remove_dir};
 use tandem_testkit::workspace::{bin, root};
 
-/// The namespace with the veth pair `ecm` (the node's end) / `ecs` (the emulator's); deleted
-/// on drop (which deletes the pair too).
-struct Netns(String);
-
-impl Netns {
-    fn create(tag: &str) -> Self {
-        let name = format!("tec{tag}{}", std::process::id());
-        ip(&["netns", "add", &name]);
-        let ns = Self(name);
-        ip(&[
-            "-n", &ns.0, "link", "add", "ecm", "type", "veth", "peer", "name", "ecs",
-        ]);
-        for dev in ["ecm", "ecs", "lo"] {
-            ip(&["-n", &ns.0, "link", "set", dev, "up"]);
-        }
-        ns
-    }
-
-    /// `ip netns exec <ns> <program>`.
-    fn exec(&self, program: &Path) -> Command {
-        let mut c = Command::new("ip");
-        c.args(["netns", "exec", &self.0]).arg(program);
-        c
-    }
-}
-
-impl Drop for Netns {
-    fn drop(&mut self) {
-        // Best effort at teardown: nothing more can be done if the delete fails.
-        let _ = Command::new("ip").args(["netns", "del", &self.0]).status();
-    }
-}
-
-fn ip(args: &[&str]) {
-    let out = Command::new("ip").args(args).output().expect("run ip");
-    assert!(
-        out.status.success(),
-        "ip {}: {} (this test needs root to create a network namespace)",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
+/// The namespace `tec<tag><pid>` with the veth pair `ecm` (the node's end) / `ecs` (the
+/// emulator's).
+fn netns(tag: &str) -> VethNetns {
+    VethNetns::create(&format!("tec{tag}"), "ecm", "ecs")
 }
 
 /// The emulator process; killed on drop.
@@ -81,7 +45,7 @@ impl Drop for Sim {
 
 /// Starts `tandem-ecat-sim --devices <devices> --loopback` on `ecs` with a 2 ms cycle and waits
 /// (10 s at most) for it to say it runs `n` SubDevices.
-fn start_sim(ns: &Netns, devices: &str, n: usize) -> Sim {
+fn start_sim(ns: &VethNetns, devices: &str, n: usize) -> Sim {
     // SCHED_FIFO as the node's threads (see `cell`): on this shared host a starved emulator
     // answers late as much as a starved node asks late.
     let mut child = ns
@@ -177,7 +141,7 @@ velocity = 20.0
 
 #[test]
 fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_limit() {
-    let ns = Netns::create("m");
+    let ns = netns("m");
     let _sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-{}", std::process::id()));
     let other = OTHER_AXIS.replace(
@@ -276,7 +240,7 @@ fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_li
 }
 
 /// Runs node `drives` of `cell` in `ns` (60 s at most); returns its exit code and output.
-fn node(ns: &Netns, cell: &Path) -> (Option<i32>, String) {
+fn node(ns: &VethNetns, cell: &Path) -> (Option<i32>, String) {
     let mut c = ns.exec(&bin("tandem-node"));
     c.arg(cell).args(["--node", "drives", "--duration", "1"]);
     let out = run(c, Duration::from_secs(60));
@@ -285,7 +249,7 @@ fn node(ns: &Netns, cell: &Path) -> (Option<i32>, String) {
 
 #[test]
 fn a_bus_that_differs_from_the_cell_file_refuses_to_start_naming_the_first_mismatch() {
-    let ns = Netns::create("x");
+    let ns = netns("x");
     let dir = fresh_dir(&format!("tandem-ethercat-x-{}", std::process::id()));
     {
         let _sim = start_sim(&ns, "drive,dio", 2);
@@ -383,7 +347,7 @@ position = 450.0
 
 #[test]
 fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
-    let ns = Netns::create("k");
+    let ns = netns("k");
     let sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-k-{}", std::process::id()));
     let cell = cell(&dir, "\n[axes.slide]", OTHER_AXIS);
