@@ -17,7 +17,7 @@
 //! | [`cam`] | `cam` | the cam object: a position-to-position law built from points and segments |
 //! | [`plant`] | `drive`, `sensor` | the simulated drive and sensors that stand in for the hardware |
 //! | [`objects`] | `axis`, `encoder`, `leading`, `rejoin`, `output_cam`, `cam_track`, `measuring`, `job`, `action` | the technology objects, stepped once per cycle, and the command type |
-//! | [`hydraulic`] | `generator`, `monitor`, `finish`, `valve_table` | the stages of a hydraulic axis of the Beckhoff hydraulic positioning library |
+//! | [`hydraulic`] | `generator`, `time_ramp`, `monitor`, `finish`, `valve_table` | the stages of a hydraulic axis of the Beckhoff hydraulic positioning library |
 //!
 //! The principal types are re-exported here ([`Axis`], [`Profile`], [`Cam`], ...); their home
 //! modules are the paths to import.

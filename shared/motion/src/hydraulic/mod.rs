@@ -5,6 +5,8 @@
 //! Built so far, pure and allocation-free, not yet an axis kind of its own:
 //! - [`generator`]: the displacement-based set value generator `iTcMc_ProfileCtrlBased` (start
 //!   ramp, travel, square-root braking ramp to creep speed, creep, idle; stops);
+//! - [`time_ramp`]: the time-ramp generator `iTcMc_ProfileTimeRamp` for an axis without an
+//!   encoder, on four digital position cams;
 //! - [`monitor`]: the target window monitoring (InTargRng, InTarget with its filter time, Done);
 //! - [`finish`]: the Finish stage, `MC_AxRtFinish_BkPlcMc` (sectional linearisation: feed
 //!   forward, area ratio, bend point, ramped overlap compensation, clamping output, offset) and
@@ -15,4 +17,5 @@
 pub mod finish;
 pub mod generator;
 pub mod monitor;
+pub mod time_ramp;
 pub mod valve_table;
