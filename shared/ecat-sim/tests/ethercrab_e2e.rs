@@ -11,59 +11,29 @@
 //! enable sequence for controlwords 0x06, 0x07, 0x0F.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, unsafe_code)]
 
-use std::io::{BufRead, BufReader};
 use std::os::fd::AsRawFd;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use ethercrab::std::{ethercat_now, tx_rx_task};
 use ethercrab::{MainDevice, MainDeviceConfig, PduStorage, Timeouts};
-use tandem_testkit::netns::VethNetns;
+use tandem_testkit::netns::{Background, VethNetns};
 
 static PDU_STORAGE: PduStorage<16, { PduStorage::element_size(1100) }> = PduStorage::new();
 
-/// The emulator process; killed on drop.
-struct Sim(Child);
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        // The process may already have exited; either way it is reaped below.
-        let _ = self.0.kill();
-        // Reap it; its exit status is of no interest after a kill.
-        let _ = self.0.wait();
-    }
-}
-
-fn start_sim(ns: &VethNetns) -> Sim {
-    let mut child = Command::new("ip")
-        .args([
-            "netns",
-            "exec",
-            ns.name(),
-            env!("CARGO_BIN_EXE_tandem-ecat-sim"),
-        ])
-        .args(["--interface", "ecs", "--devices", "drive,dio", "--loopback"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn tandem-ecat-sim");
-    let stderr = child.stderr.take().expect("stderr");
-    let sim = Sim(child);
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut lines = BufReader::new(stderr).lines();
-        if let Some(Ok(line)) = lines.next() {
-            // The receiver may have given up waiting; then nobody needs the line.
-            let _ = tx.send(line);
-        }
-        // Keep draining so the emulator never blocks on a full pipe.
-        for line in lines.map_while(Result::ok) {
-            eprintln!("{line}");
-        }
-    });
-    let line = rx
-        .recv_timeout(Duration::from_secs(10))
-        .expect("tandem-ecat-sim did not start within 10 s");
+/// Starts the emulator (drive and digital I/O, looped back) on `ecs` and waits 10 s at most for
+/// it to say it runs both.
+fn start_sim(ns: &VethNetns) -> Background {
+    let mut c = Command::new("ip");
+    c.args([
+        "netns",
+        "exec",
+        ns.name(),
+        env!("CARGO_BIN_EXE_tandem-ecat-sim"),
+    ])
+    .args(["--interface", "ecs", "--devices", "drive,dio", "--loopback"]);
+    let (sim, line) = Background::start(&mut c, Duration::from_secs(10), "tandem-ecat-sim");
     assert!(line.contains("2 SubDevice(s) on ecs"), "{line}");
     sim
 }

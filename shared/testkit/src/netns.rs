@@ -63,3 +63,49 @@ pub fn ip(args: &[&str]) {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A background program (the EtherCAT emulator) whose first line on stderr was awaited; its
+/// other lines are passed on to the test's stderr. Killed and reaped on drop.
+#[derive(Debug)]
+pub struct Background(std::process::Child);
+
+impl Background {
+    /// Starts `c` with stderr piped and returns it with its first stderr line.
+    ///
+    /// # Panics
+    /// When it cannot be started, or says nothing within `limit` (naming it `what`).
+    pub fn start(c: &mut Command, limit: std::time::Duration, what: &str) -> (Self, String) {
+        use std::io::{BufRead, BufReader};
+        let mut child = c
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("spawn {what}: {e}"));
+        let stderr = child.stderr.take().expect("stderr");
+        let bg = Self(child);
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut lines = BufReader::new(stderr).lines();
+            if let Some(Ok(line)) = lines.next() {
+                // The receiver may have given up waiting; then nobody needs the line.
+                let _ = tx.send(line);
+            }
+            // Keep draining so the program never blocks on a full pipe.
+            for line in lines.map_while(Result::ok) {
+                eprintln!("{line}");
+            }
+        });
+        let line = rx
+            .recv_timeout(limit)
+            .unwrap_or_else(|_| panic!("{what} did not start within {limit:?}"));
+        (bg, line)
+    }
+}
+
+impl Drop for Background {
+    fn drop(&mut self) {
+        // The process may already have exited; either way it is reaped below.
+        let _ = self.0.kill();
+        // Reap it; its exit status is of no interest after a kill.
+        let _ = self.0.wait();
+    }
+}

@@ -17,10 +17,10 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Stdio};
+use std::process::Stdio;
 use std::sync::mpsc;
 use std::time::Duration;
-use tandem_testkit::netns::VethNetns;
+use tandem_testkit::netns::{Background, VethNetns};
 use tandem_testkit::process::{run, text, Spawned};
 use tandem_testkit::scratch::{fresh_dir, remove_dir};
 use tandem_testkit::workspace::{bin, root};
@@ -31,49 +31,17 @@ fn netns(tag: &str) -> VethNetns {
     VethNetns::create(&format!("tec{tag}"), "ecm", "ecs")
 }
 
-/// The emulator process; killed on drop.
-struct Sim(Child);
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        // The process may already have exited; either way it is reaped below.
-        let _ = self.0.kill();
-        // Reap it; its exit status is of no interest after a kill.
-        let _ = self.0.wait();
-    }
-}
-
 /// Starts `tandem-ecat-sim --devices <devices> --loopback` on `ecs` with a 2 ms cycle and waits
 /// (10 s at most) for it to say it runs `n` SubDevices.
-fn start_sim(ns: &VethNetns, devices: &str, n: usize) -> Sim {
+fn start_sim(ns: &VethNetns, devices: &str, n: usize) -> Background {
     // SCHED_FIFO as the node's threads (see `cell`): on this shared host a starved emulator
     // answers late as much as a starved node asks late.
-    let mut child = ns
-        .exec(Path::new("chrt"))
-        .args(["-f", "40"])
+    let mut c = ns.exec(Path::new("chrt"));
+    c.args(["-f", "40"])
         .arg(bin("tandem-ecat-sim"))
         .args(["--interface", "ecs", "--devices", devices])
-        .args(["--cycle-us", "2000", "--loopback"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn tandem-ecat-sim");
-    let stderr = child.stderr.take().expect("stderr");
-    let sim = Sim(child);
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut lines = BufReader::new(stderr).lines();
-        if let Some(Ok(line)) = lines.next() {
-            // The receiver may have given up waiting; then nobody needs the line.
-            let _ = tx.send(line);
-        }
-        // Keep draining so the emulator never blocks on a full pipe.
-        for line in lines.map_while(Result::ok) {
-            eprintln!("{line}");
-        }
-    });
-    let line = rx
-        .recv_timeout(Duration::from_secs(10))
-        .expect("tandem-ecat-sim did not start within 10 s");
+        .args(["--cycle-us", "2000", "--loopback"]);
+    let (sim, line) = Background::start(&mut c, Duration::from_secs(10), "tandem-ecat-sim");
     assert!(line.contains(&format!("{n} SubDevice(s) on ecs")), "{line}");
     sim
 }
