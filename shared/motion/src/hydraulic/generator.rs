@@ -236,6 +236,9 @@ pub struct CtrlBasedGenerator {
     mv: Move,
     /// A move in the other direction waits for the stop ramp.
     reverse_pending: bool,
+    /// The deceleration of the running stop (`TcDec`, mm/s²): `fRefVelo / fStopRamp`, or the
+    /// stop command's.
+    stop_dec: f64,
     /// Automatic starts by `fReposDistance`.
     repositioned: u64,
 }
@@ -300,6 +303,7 @@ impl CtrlBasedGenerator {
                 brake_point: 0.0,
             },
             reverse_pending: false,
+            stop_dec: p.ref_velo / p.stop_ramp,
             repositioned: 0,
         })
     }
@@ -387,6 +391,7 @@ impl CtrlBasedGenerator {
         let moving_other_way = self.velocity != 0.0 && (self.velocity > 0.0) != positive;
         self.reverse_pending = moving_other_way;
         if moving_other_way {
+            self.stop_dec = self.p.ref_velo / self.p.stop_ramp;
             self.state = HydState::TcDec;
         } else {
             self.positive = positive;
@@ -400,9 +405,43 @@ impl CtrlBasedGenerator {
 
     /// A regular stop (`MC_Stop_BkPlcMc`): the set velocity ramps to 0 with `fStopRamp`.
     pub fn stop(&mut self) {
+        self.stop_with(self.p.ref_velo / self.p.stop_ramp);
+    }
+
+    /// A stop with the command's `Deceleration` (mm/s², `MC_Stop_BkPlcMc` from V3.0.5; a
+    /// value that is not finite and above 0 takes `fStopRamp`'s): the set velocity ramps to 0
+    /// with it (`iTcHydStateTcDecP/M`).
+    pub fn stop_with(&mut self, deceleration: f64) {
         if self.state != HydState::Idle && self.state != HydState::EmergencyBreak {
+            self.stop_dec = if deceleration.is_finite() && deceleration > 0.0 {
+                deceleration
+            } else {
+                self.p.ref_velo / self.p.stop_ramp
+            };
             self.state = HydState::TcDec;
             self.reverse_pending = false;
+        }
+    }
+
+    /// Takes over a setpoint another generator produced (set position and set velocity,
+    /// mm and mm/s), as the axis does when a positioning follows a motion the generator did
+    /// not run: the next move starts from it without a step. An idle generator with a velocity
+    /// other than 0 ramps it down with the stop ramp until a move is given. Values that are not
+    /// finite change nothing.
+    pub fn take_over(&mut self, position: f64, velocity: f64) {
+        if !(position.is_finite() && velocity.is_finite()) {
+            return;
+        }
+        self.position = position;
+        self.velocity = velocity;
+        self.reverse_pending = false;
+        if velocity == 0.0 {
+            self.state = HydState::Idle;
+            self.mv.target = position;
+        } else {
+            self.positive = velocity > 0.0;
+            self.stop_dec = self.p.ref_velo / self.p.stop_ramp;
+            self.state = HydState::TcDec;
         }
     }
 
@@ -459,12 +498,12 @@ impl CtrlBasedGenerator {
                 return;
             }
             HydState::TcDec | HydState::EmergencyBreak => {
-                let ramp = if self.state == HydState::TcDec {
-                    self.p.stop_ramp
+                let dec = if self.state == HydState::TcDec {
+                    self.stop_dec
                 } else {
-                    self.p.emergency_ramp
+                    self.p.ref_velo / self.p.emergency_ramp
                 };
-                let s = (speed - self.p.ref_velo / ramp * dt).max(0.0);
+                let s = (speed - dec * dt).max(0.0);
                 self.set(s * sign, dt);
                 if s == 0.0 {
                     self.finish_stop();
@@ -670,6 +709,51 @@ mod tests {
         let last = out.last().unwrap();
         assert_eq!((last.state, last.velocity), (HydState::Idle, 0.0));
         assert_eq!(g.target(), last.position);
+    }
+
+    #[test]
+    fn a_stop_with_a_deceleration_ramps_down_with_it() {
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        g.move_absolute(1000.0, 100.0, 0.0, 0.0, 0.0).unwrap();
+        run(&mut g, 300);
+        // 1000 mm/s²: 100 mm/s in 0.1 s; a deceleration of 0 takes the stop ramp's 500.
+        g.stop_with(1000.0);
+        let out = run(&mut g, 1000);
+        let ramp = out.iter().filter(|s| s.state == HydState::TcDec).count();
+        assert_eq!(ramp + 1, 100);
+        g.move_absolute(2000.0, 100.0, 0.0, 0.0, g.position)
+            .unwrap();
+        run(&mut g, 300);
+        g.stop_with(0.0);
+        let out = run(&mut g, 1000);
+        let ramp = out.iter().filter(|s| s.state == HydState::TcDec).count();
+        assert_eq!(ramp + 1, 200);
+    }
+
+    #[test]
+    fn a_taken_over_setpoint_starts_the_next_move_without_a_step() {
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        // Another generator left the axis at 40 mm moving at -30 mm/s.
+        g.take_over(40.0, -30.0);
+        assert_eq!(g.state(), HydState::TcDec);
+        g.move_absolute(100.0, 100.0, 0.0, 0.0, 40.0).unwrap();
+        let out = run(&mut g, 20_000);
+        // From -30 mm/s with the stop ramp's 500 mm/s², then within the dynamics.
+        assert!(
+            (out[0].velocity + 30.0 - 500.0 * DT).abs() < 1e-9,
+            "{:?}",
+            out[0]
+        );
+        for w in out.windows(2) {
+            assert!(within_dynamics(w), "{w:?}");
+        }
+        // It stopped with the stop ramp, then reversed and landed.
+        assert_eq!(out.last().unwrap().position, 100.0);
+        // A standing setpoint: idle there.
+        g.take_over(7.0, 0.0);
+        assert_eq!((g.state(), g.target()), (HydState::Idle, 7.0));
+        g.take_over(f64::NAN, 0.0);
+        assert_eq!(g.target(), 7.0);
     }
 
     #[test]
