@@ -53,6 +53,7 @@ fn a_commissioned_hydraulic_axis_positions_out_and_back() {
     // fAreaRatio > 1 when the positive direction is the slower one (multiplied), < 1 when the
     // negative one is (divided): either way the ratio of the two velocities.
     let area_ratio = v_neg / v_pos;
+    eprintln!("commissioned: fRefVelo {ref_velo:.3} mm/s, fAreaRatio {area_ratio:.4}");
     let finish = Finish::new(FinishParams {
         ref_velo,
         area_ratio,

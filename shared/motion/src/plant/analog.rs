@@ -34,6 +34,7 @@ use core::fmt;
 use super::drive::{Actual, Plant};
 use super::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
 use super::mechanics::{RawCounter, Scaling, DEGREES_PER_REVOLUTION};
+use crate::hydraulic::controller::{HydControlInput, HydController};
 
 /// The word of an S7 analog output at its nominal value: ±27648 is ±10 V, ±100 % of the
 /// reference speed (S7 analog value representation, output ranges ±10 V).
@@ -595,10 +596,13 @@ pub struct AnalogStatus {
 /// [`AnalogFeedback`] / [`AnalogCommand`]. The node calls [`inputs`](Self::inputs) with the
 /// sample of the cycle boundary before the axis steps and [`command`](Self::command) with the
 /// axis's outputs after it (docs/io.md, "The process image and the order of a cycle").
-#[derive(Copy, Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct AnalogConnection {
     params: AnalogParams,
     controller: PositionController,
+    /// A hydraulic axis' position controller and Finish, in place of `controller`'s speed
+    /// setpoint ([`AnalogConnection::hydraulic`]).
+    hydraulic: Option<HydController>,
     enable: AnalogEnable,
     /// The encoder's raw word extended, from the first sample on.
     counter: Option<RawCounter>,
@@ -626,6 +630,7 @@ impl AnalogConnection {
         Ok(Self {
             params,
             controller,
+            hydraulic: None,
             enable,
             counter: None,
             previous_count: 0,
@@ -635,6 +640,21 @@ impl AnalogConnection {
             plant,
             status: AnalogStatus::default(),
         })
+    }
+
+    /// The connection of a hydraulic axis: the valve's output word comes from the library's
+    /// position controller and Finish (`hydraulic`) on the axis' set position and set
+    /// velocity, not from the speed controller of `params.controller` (whose cycle and
+    /// balancing filter the connection still uses).
+    pub fn hydraulic(
+        params: AnalogParams,
+        hydraulic: HydController,
+        plant: Plant,
+        p0: f64,
+    ) -> Result<Self, AnalogConnectionError> {
+        let mut c = Self::new(params, plant, p0)?;
+        c.hydraulic = Some(hydraulic);
+        Ok(c)
     }
 
     /// The configuration.
@@ -704,7 +724,9 @@ impl AnalogConnection {
     pub fn command(&mut self, out: &DriveOutputs) -> AnalogCommand {
         self.request = out.enable;
         let active = out.enable && self.enable.status() == AnalogEnableStatus::Enabled;
-        let c = if active {
+        let c = if let Some(h) = &self.hydraulic {
+            self.hydraulic_output(h, active, out)
+        } else if active {
             self.controller.step(
                 out.position,
                 out.velocity,
@@ -737,13 +759,44 @@ impl AnalogConnection {
     }
 }
 
+impl AnalogConnection {
+    /// The hydraulic controller's cycle: the lag from the set position of this cycle and the
+    /// actual position of its sample; nothing while the valve is not enabled.
+    fn hydraulic_output(
+        &self,
+        h: &HydController,
+        active: bool,
+        out: &DriveOutputs,
+    ) -> ControllerOutput {
+        if !active {
+            return ControllerOutput::default();
+        }
+        let o = h.step(&HydControlInput {
+            set_position: out.position,
+            set_velocity: out.velocity,
+            actual_position: self.actual,
+            position_control: out.position_controlled,
+            clamping_output: 0.0,
+        });
+        ControllerOutput {
+            normalized: o.output,
+            control_difference: out.position - self.actual,
+            saturated: o.output.abs() >= 1.0,
+        }
+    }
+}
+
 /// An [`AnalogConnection`] that cannot be built.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, PartialEq)]
 pub enum AnalogConnectionError {
     /// A controller parameter.
     Params(AnalogParamsError),
     /// The enable timeout.
     Timeout(InvalidReadyTimeout),
+    /// A hydraulic axis' position controller or Finish parameter.
+    Hydraulic(crate::hydraulic::finish::FinishError),
+    /// A simulated valve and cylinder's parameter.
+    Cylinder(crate::plant::hydraulic::CylinderError),
 }
 
 impl fmt::Display for AnalogConnectionError {
@@ -751,6 +804,8 @@ impl fmt::Display for AnalogConnectionError {
         match self {
             Self::Params(e) => write!(f, "{e}"),
             Self::Timeout(e) => write!(f, "analog drive: {e}"),
+            Self::Hydraulic(e) => write!(f, "hydraulic axis: {e}"),
+            Self::Cylinder(e) => write!(f, "valve and cylinder: {e}"),
         }
     }
 }

@@ -30,6 +30,8 @@
 //! mm³/s inside. Integrated with [`SUBSTEPS`] semi-implicit Euler steps per call (the oil spring
 //! is stiff). Pure: no IO, no clock (the cycle time is an input), no allocation.
 
+use super::analog::{word_to_normalized, AnalogCommand, AnalogFeedback};
+use super::mechanics::Scaling;
 use crate::catalog::hyd_error::HydErrorCode;
 /// Integration steps per [`SimCylinder::step`] call, at least (more when the call is long: no
 /// sub-step exceeds [`MAX_SUBSTEP`]).
@@ -385,6 +387,121 @@ impl SimCylinder {
         self.s.pressure_b = (self.s.pressure_b + dpb).clamp(0.0, p.supply);
         self.s.flow_a = qa / L_PER_MIN;
         self.s.flow_b = qb / L_PER_MIN;
+    }
+}
+
+/// The parameters of a simulated valve and cylinder on an analog output
+/// (`[devices.<name>] kind = "sim_valve_cylinder"`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SimValveCylinderParams {
+    /// The valve and cylinder.
+    pub cylinder: CylinderParams,
+    /// The valve amplifier's ready output follows its enable input after this time (s, >= 0).
+    pub ready_delay: f64,
+    /// A constant external load force (N, against positive motion).
+    pub load: f64,
+}
+
+/// A proportional valve with its amplifier on an analog output (enable DO and output word
+/// out, ready DI in) and the cylinder it drives, with a linear encoder on the piston (the raw
+/// word the axis' [`Scaling`] reads): the device of the process image a hydraulic axis' analog
+/// connection drives. While the amplifier is not enabled or in fault, the spool is commanded
+/// to 0 (it rests at the valve's zero offset). Nothing allocates.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct SimValveCylinder {
+    cylinder: SimCylinder,
+    scaling: Scaling,
+    ready_delay: f64,
+    /// The latched command.
+    command: AnalogCommand,
+    /// Time enabled without fault (s), for the ready delay.
+    enabled_for: f64,
+    fault_latched: bool,
+    fault_cause: bool,
+}
+
+impl SimValveCylinder {
+    /// The valve and cylinder at rest at position `x` (mm), the encoder read through
+    /// `scaling`. Refuses parameters out of range, naming the first.
+    pub fn new(p: SimValveCylinderParams, scaling: Scaling, x: f64) -> Result<Self, CylinderError> {
+        for (name, value) in [("ready_delay", p.ready_delay), ("load", p.load)] {
+            if !(value.is_finite() && (name == "load" || value >= 0.0)) {
+                return Err(CylinderError { name, value });
+            }
+        }
+        let mut cylinder = SimCylinder::new(p.cylinder, x)?;
+        cylinder.set_load(p.load);
+        Ok(Self {
+            cylinder,
+            scaling,
+            ready_delay: p.ready_delay,
+            command: AnalogCommand::default(),
+            enabled_for: 0.0,
+            fault_latched: false,
+            fault_cause: false,
+        })
+    }
+
+    /// Latches the command of the boundary (its effect starts now); an enable removed with
+    /// the cause gone acknowledges a fault.
+    pub fn exchange(&mut self, command: &AnalogCommand) {
+        self.command = *command;
+        if !command.enable && !self.fault_cause {
+            self.fault_latched = false;
+        }
+    }
+
+    /// Runs `dt_ns` with the latched command.
+    pub fn advance(&mut self, dt_ns: i64) {
+        let dt = dt_ns.max(0) as f64 * 1e-9;
+        let on = self.command.enable && !self.fault_latched;
+        let u = if on {
+            word_to_normalized(self.command.word)
+        } else {
+            0.0
+        };
+        self.cylinder.step(u, dt);
+        self.enabled_for = if on { self.enabled_for + dt } else { 0.0 };
+    }
+
+    /// The process image inputs now: the amplifier's ready output and the encoder's raw word.
+    pub fn feedback(&self) -> AnalogFeedback {
+        let ready = self.command.enable
+            && !self.fault_latched
+            && self.enabled_for >= self.ready_delay
+            && self.enabled_for > 0.0;
+        AnalogFeedback {
+            ready,
+            // The low 32 bits; the counter masks them to `raw_bits`.
+            encoder_raw: self.scaling.count(self.cylinder.state().position) as u32,
+        }
+    }
+
+    /// The cylinder's state (position, velocity, pressures, force, spool, flows).
+    pub fn state(&self) -> &CylinderState {
+        self.cylinder.state()
+    }
+
+    /// The latched command.
+    pub fn command(&self) -> &AnalogCommand {
+        &self.command
+    }
+
+    /// A fault of the valve amplifier: ready drops, the spool is commanded to 0. Latched until
+    /// the cause is cleared and the enable input is off.
+    pub fn inject_fault(&mut self) {
+        self.fault_cause = true;
+        self.fault_latched = true;
+    }
+
+    /// The cause of the fault is gone (the latch stays until the enable input is off).
+    pub fn clear_fault_cause(&mut self) {
+        self.fault_cause = false;
+    }
+
+    /// Whether the amplifier is in fault.
+    pub fn in_fault(&self) -> bool {
+        self.fault_latched
     }
 }
 
