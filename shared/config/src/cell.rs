@@ -145,6 +145,9 @@ pub enum DeviceKind {
     SimDigitalOutput(DigitalOutputParams),
     /// A simulated analog drive with its load encoder (`kind = "sim_analog_drive"`).
     SimAnalogDrive(tandem_motion::plant::analog::SimAnalogParams),
+    /// A simulated proportional valve on an analog output with the cylinder it drives
+    /// (`kind = "sim_valve_cylinder"`): the device of a hydraulic axis.
+    SimValveCylinder(tandem_motion::plant::hydraulic::SimValveCylinderParams),
     /// A simulated digital input terminal (`kind = "sim_digital_input"`).
     SimDigitalInput(DigitalInputParams),
     /// A simulated analog input terminal (`kind = "sim_analog_input"`): `float` channels.
@@ -239,6 +242,7 @@ impl DeviceKind {
             DeviceKind::SimServo(_) => "sim_servo",
             DeviceKind::SimDigitalOutput(_) => "sim_digital_output",
             DeviceKind::SimAnalogDrive(_) => "sim_analog_drive",
+            DeviceKind::SimValveCylinder(_) => "sim_valve_cylinder",
             DeviceKind::SimDigitalInput(_) => "sim_digital_input",
             DeviceKind::SimAnalogInput(_) => "sim_analog_input",
             DeviceKind::SimAnalogOutput(_) => "sim_analog_output",
@@ -255,6 +259,7 @@ impl DeviceKind {
         match self {
             DeviceKind::SimServo(_)
             | DeviceKind::SimAnalogDrive(_)
+            | DeviceKind::SimValveCylinder(_)
             | DeviceKind::EthercatCia402(_) => None,
             DeviceKind::EthercatDio => Some((8, false, SignalDirection::Output)),
             DeviceKind::EthercatDioInputs => Some((8, false, SignalDirection::Input)),
@@ -275,6 +280,7 @@ impl DeviceKind {
         match self {
             DeviceKind::SimServo(_)
             | DeviceKind::SimAnalogDrive(_)
+            | DeviceKind::SimValveCylinder(_)
             | DeviceKind::EthercatCia402(_) => None,
             DeviceKind::EthercatDio | DeviceKind::EthercatDioInputs => Some(SignalType::Bool),
             DeviceKind::SimDigitalOutput(DigitalOutputParams { timestamped, .. })
@@ -498,6 +504,9 @@ pub struct AnalogDriveConnection {
     /// The position controller, the enable timeout, the ready input, the encoder and the
     /// mechanics.
     pub params: tandem_motion::plant::analog::AnalogParams,
+    /// A hydraulic axis' position controller and Finish (`[axes.<name>.hydraulic]`): the
+    /// valve's output comes from them instead of the speed controller of `params`.
+    pub hydraulic: Option<tandem_motion::hydraulic::controller::HydControllerParams>,
 }
 
 /// An axis on a CiA 402 drive of the process image.

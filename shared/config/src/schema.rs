@@ -136,6 +136,124 @@ pub struct DeviceSection {
     /// sim_analog_input, sim_analog_output: resolution including the sign (2 to 24, default
     /// 16); sim_counter: the register's width (16 or 32, default 32).
     pub bits: Option<u32>,
+    /// sim_valve_cylinder: a constant external load on the piston (N, against positive
+    /// motion; default 0).
+    pub load: Option<f64>,
+    /// sim_valve_cylinder: `[devices.<name>.cylinder]`, the valve and the cylinder.
+    pub cylinder: Option<CylinderSection>,
+}
+
+/// `[devices.<name>.cylinder]` of a `sim_valve_cylinder`: a proportional valve and a
+/// differential cylinder. Every key has a default: a 63/45 mm cylinder of 500 mm stroke with
+/// 200 kg on a 40 l/min valve at 100 bar.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderSection {
+    /// Piston area, chamber A (mm²).
+    pub area_a: Option<f64>,
+    /// Annulus area, chamber B (mm²).
+    pub area_b: Option<f64>,
+    /// Stroke (mm): the piston moves between 0 and the stroke.
+    pub stroke: Option<f64>,
+    /// Dead volume of each chamber with its line (mm³).
+    pub dead_volume: Option<f64>,
+    /// Moving mass (kg).
+    pub mass: Option<f64>,
+    /// Bulk modulus of the oil (bar).
+    pub bulk_modulus: Option<f64>,
+    /// Viscous friction (N per mm/s).
+    pub viscous: Option<f64>,
+    /// Coulomb friction (N).
+    pub coulomb: Option<f64>,
+    /// Supply pressure (bar).
+    pub supply: Option<f64>,
+    /// Tank pressure (bar).
+    pub tank: Option<f64>,
+    /// Nominal flow of one control edge of chamber A at full opening (l/min).
+    pub nominal_flow: Option<f64>,
+    /// Nominal flow of chamber B's edges relative to A's (1: a symmetric valve).
+    pub flow_ratio_b: Option<f64>,
+    /// Pressure drop per edge of the nominal flow (bar).
+    pub nominal_drop: Option<f64>,
+    /// Overlap: spool travel (0..1) before an edge opens.
+    pub overlap: Option<f64>,
+    /// Zero offset of the spool (normalised, within ±0.2).
+    pub offset: Option<f64>,
+    /// Opening (0..1) of the flow curve's bend.
+    pub bend_opening: Option<f64>,
+    /// Flow (0..1 of nominal) at the bend.
+    pub bend_flow: Option<f64>,
+    /// Response time of the spool (s).
+    pub response_time: Option<f64>,
+}
+
+/// `[axes.<name>.hydraulic]` of a `kind = "hydraulic"` axis: the members of the Beckhoff
+/// TwinCAT PLC Hydraulic Positioning library's `ST_TcHydAxParam`, under the library's names.
+/// Every key has the library's default.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct HydraulicSection {
+    /// Reference velocity (mm/s): the velocity at 100 % (10 V) output.
+    pub fRefVelo: Option<f64>,
+    /// Highest velocity of a command (mm/s).
+    pub fMaxVelo: Option<f64>,
+    /// Acceleration of the start ramp (mm/s²).
+    pub fAcc: Option<f64>,
+    /// Highest acceleration (mm/s²).
+    pub fMaxAcc: Option<f64>,
+    /// Deceleration of the braking ramp (mm/s²).
+    pub fDec: Option<f64>,
+    /// Highest deceleration (mm/s²).
+    pub fMaxDec: Option<f64>,
+    /// Creep velocity, positive direction (mm/s).
+    pub fCreepSpeedP: Option<f64>,
+    /// Creep velocity, negative direction (with `bAsymmetricalTargeting`).
+    pub fCreepSpeedM: Option<f64>,
+    /// Creep distance, positive direction (mm).
+    pub fCreepDistanceP: Option<f64>,
+    /// Creep distance, negative direction.
+    pub fCreepDistanceM: Option<f64>,
+    /// Braking distance, positive direction (mm).
+    pub fBrakeDistanceP: Option<f64>,
+    /// Braking distance, negative direction.
+    pub fBrakeDistanceM: Option<f64>,
+    /// Brake dead time, positive direction (s).
+    pub fBrakeDeadTimeP: Option<f64>,
+    /// Brake dead time, negative direction.
+    pub fBrakeDeadTimeM: Option<f64>,
+    /// The `…M` approach parameters serve the negative direction.
+    pub bAsymmetricalTargeting: Option<bool>,
+    /// Stop ramp (s from `fRefVelo` to 0).
+    pub fStopRamp: Option<f64>,
+    /// Emergency ramp (s from `fRefVelo` to 0).
+    pub fEmergencyRamp: Option<f64>,
+    /// Automatic repositioning beyond this distance from the target (mm; 0: off).
+    pub fReposDistance: Option<f64>,
+    /// Position range of the target window monitoring (mm).
+    pub fMonPositionRange: Option<f64>,
+    /// Target range (mm).
+    pub fMonTargetRange: Option<f64>,
+    /// Filter time of the target range (s).
+    pub fMonTargetFilter: Option<f64>,
+    /// P gain of the position controller (mm/s per mm).
+    pub fLagAmp: Option<f64>,
+    /// Output limit of the position controller (normalised; 0: none).
+    pub fLagAmpOutL: Option<f64>,
+    /// Weight of the set velocity in the output (1.0: full feed forward).
+    pub fFeedForward: Option<f64>,
+    /// Area ratio A:B (velocity ratio of the two directions).
+    pub fAreaRatio: Option<f64>,
+    /// Overlap compensation, positive direction (normalised).
+    pub fValve_OverlapCompP: Option<f64>,
+    /// Overlap compensation, negative direction (normalised).
+    pub fValve_OverlapCompM: Option<f64>,
+    /// Velocity (normalised) of the flow curve's bend point.
+    pub fValve_BendPointVelo: Option<f64>,
+    /// Output (normalised) of the flow curve's bend point.
+    pub fValve_BendPointOutput: Option<f64>,
+    /// Zero (offset) compensation (V).
+    pub fZeroCompensation: Option<f64>,
 }
 
 /// `[signals.<name>]`: a named signal on a channel of a device. Its type comes from the
@@ -731,7 +849,7 @@ pub struct NodeSection {
 pub struct AxisSection {
     /// The node that hosts the axis.
     pub node: String,
-    /// `speed` or `positioning`.
+    /// `speed`, `positioning`, `synchronous` or `hydraulic`.
     #[serde(default = "default_kind")]
     pub kind: String,
     /// `linear` or `rotary`.
@@ -789,6 +907,8 @@ pub struct AxisSection {
     /// The reaction to alarm 601 (leading value missing): `stop_current_dynamics`,
     /// `stop_max_dynamics` (default, the table value), `emergency_stop`, `remove_enable`.
     pub leader_missing_reaction: Option<String>,
+    /// `[axes.<name>.hydraulic]`: the parameters of a `kind = "hydraulic"` axis.
+    pub hydraulic: Option<HydraulicSection>,
 }
 
 /// `[axes.<name>.extrapolation]`.

@@ -28,6 +28,7 @@ const EXAMPLES: &[&str] = &[
     "servo",
     "analog",
     "inputs",
+    "hydraulic",
 ];
 
 fn root() -> PathBuf {

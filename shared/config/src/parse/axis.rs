@@ -31,8 +31,21 @@ pub(super) fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, Fie
             ("speed", AxisKind::Speed),
             ("positioning", AxisKind::Positioning),
             ("synchronous", AxisKind::Synchronous),
+            // A synchronous axis whose positionings run the hydraulic library's generator.
+            (super::hydraulic::HYDRAULIC_KIND, AxisKind::Synchronous),
         ],
     )?;
+    let hydraulic = match (&a.hydraulic, a.kind == super::hydraulic::HYDRAULIC_KIND) {
+        (Some(h), true) => Some(super::hydraulic::profile(h)?),
+        (None, true) => Some(super::hydraulic::profile(&Default::default())?),
+        (Some(_), false) => {
+            return Err((
+                "hydraulic",
+                Problem::Invalid("only for `kind = \"hydraulic\"`"),
+            ))
+        }
+        (None, false) => None,
+    };
     let motion_type = pick(
         "motion_type",
         &a.motion_type,
@@ -98,6 +111,7 @@ pub(super) fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, Fie
         plant: plant(a),
         initial_position: a.initial_position,
         extrapolation,
+        hydraulic,
     })
 }
 

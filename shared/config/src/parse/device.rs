@@ -10,7 +10,10 @@ use crate::cell::{
     Node, MAX_CHANNELS,
 };
 use crate::error::{ConfigError, Problem};
-use crate::schema::{AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable};
+use crate::schema::{
+    AxisSection, CellFile, DeviceSection, EncoderSpec, EncoderTable, HydraulicSection,
+};
+use tandem_motion::hydraulic::controller::HydControllerParams;
 use tandem_motion::plant::analog::{
     AnalogParams, AnalogParamsError, ControllerParams, SimAnalogParams,
 };
@@ -30,13 +33,15 @@ enum Kind {
     AnalogInput,
     AnalogOutput,
     Counter,
+    ValveCylinder,
 }
 
 /// The device kinds by name.
-const DEVICE_KINDS: [(&str, Kind); 7] = [
+const DEVICE_KINDS: [(&str, Kind); 8] = [
     ("sim_servo", Kind::Servo),
     ("sim_digital_output", Kind::DigitalOutput),
     ("sim_analog_drive", Kind::Analog),
+    ("sim_valve_cylinder", Kind::ValveCylinder),
     ("sim_digital_input", Kind::DigitalInput),
     ("sim_analog_input", Kind::AnalogInput),
     ("sim_analog_output", Kind::AnalogOutput),
@@ -83,7 +88,33 @@ pub(super) fn devices(
     for (name, d) in &raw.devices {
         let node = node_named(cx, nodes, &d.node, &["devices", name, "node"])?;
         let at = |k: &str, p| cx.at(&["devices", name, k], p);
-        let kind = match pick("kind", &d.kind, &DEVICE_KINDS).map_err(|(k, p)| at(k, p))? {
+        let picked = pick("kind", &d.kind, &DEVICE_KINDS).map_err(|(k, p)| at(k, p))?;
+        if !matches!(picked, Kind::ValveCylinder) {
+            let given = [
+                ("load", d.load.is_some()),
+                ("cylinder", d.cylinder.is_some()),
+            ];
+            if let Some((k, _)) = given.into_iter().find(|(_, g)| *g) {
+                return Err(at(k, Problem::NotForKind("sim_valve_cylinder")));
+            }
+        }
+        let kind = match picked {
+            Kind::ValveCylinder => {
+                let foreign = servo_key_given(d)
+                    .or_else(|| output_key_given(d))
+                    .or_else(|| analog_key_given(d).filter(|k| *k != "ready_delay"));
+                if let Some(k) = foreign {
+                    return Err(at(k, Problem::NotForKind("sim_servo or sim_analog_drive")));
+                }
+                let params = super::hydraulic::valve_cylinder(d).map_err(|(k, p)| {
+                    if k == "ready_delay" || k == "load" {
+                        at(k, p)
+                    } else {
+                        cx.at_or_table(&["devices", name, "cylinder", k], p)
+                    }
+                })?;
+                DeviceKind::SimValveCylinder(params)
+            }
             Kind::Servo => {
                 if let Some(k) = output_key_given(d).or_else(|| analog_key_given(d)) {
                     return Err(at(k, Problem::NotForKind("sim_servo")));
@@ -403,6 +434,15 @@ pub(super) fn drives(
             return Err(at(&["virtual"], Problem::VirtualWithDrive));
         }
         let want = match ty {
+            DriveType::Analog if a.kind == super::hydraulic::HYDRAULIC_KIND => Wanted {
+                needs: "a valve (`sim_valve_cylinder`) or an analog drive (`sim_analog_drive`)",
+                kind_ok: |k| {
+                    matches!(
+                        k,
+                        DeviceKind::SimAnalogDrive(_) | DeviceKind::SimValveCylinder(_)
+                    )
+                },
+            },
             DriveType::Analog => Wanted {
                 needs: "an analog drive (`sim_analog_drive`)",
                 kind_ok: |k| matches!(k, DeviceKind::SimAnalogDrive(_)),
@@ -456,9 +496,14 @@ fn connection(
     at: &dyn Fn(&[&str], Problem) -> ConfigError,
 ) -> Result<Option<DriveConnection>, ConfigError> {
     Ok(Some(match kind {
-        DeviceKind::SimAnalogDrive(_) => {
+        DeviceKind::SimAnalogDrive(_) | DeviceKind::SimValveCylinder(_) => {
+            let hydraulic = hydraulic_controller(a, kind, at)?;
             let params = analog_params(a, cycle_ns, enable_timeout_ns, at)?;
-            DriveConnection::Analog(Box::new(AnalogDriveConnection { device, params }))
+            DriveConnection::Analog(Box::new(AnalogDriveConnection {
+                device,
+                params,
+                hydraulic,
+            }))
         }
         DeviceKind::SimServo(servo) => {
             let steps = servo.increments_per_revolution;
@@ -635,8 +680,15 @@ fn analog_params(
     at: &dyn Fn(&[&str], Problem) -> ConfigError,
 ) -> Result<AnalogParams, ConfigError> {
     let d = &a.drive;
+    // A hydraulic axis' reference velocity is its `fRefVelo`.
+    let hydraulic_ref = a
+        .hydraulic
+        .as_ref()
+        .and_then(|h| h.fRefVelo)
+        .filter(|_| a.kind == super::hydraulic::HYDRAULIC_KIND);
     let reference_velocity = d
         .reference_velocity
+        .or(hydraulic_ref)
         .ok_or_else(|| at(&["drive"], Problem::Missing("reference_velocity")))?;
     let controller = ControllerParams {
         cycle_ns,
@@ -679,6 +731,29 @@ fn analog_params(
         ready: d.ready.unwrap_or(true),
         scaling,
     })
+}
+
+/// The position controller and Finish of a hydraulic axis on an analog output (`None` for an
+/// electric axis); a `sim_valve_cylinder` drives only a hydraulic axis.
+fn hydraulic_controller(
+    a: &AxisSection,
+    kind: &DeviceKind,
+    at: &dyn Fn(&[&str], Problem) -> ConfigError,
+) -> Result<Option<HydControllerParams>, ConfigError> {
+    if a.kind != super::hydraulic::HYDRAULIC_KIND {
+        if matches!(kind, DeviceKind::SimValveCylinder(_)) {
+            return Err(at(
+                &["drive", "device"],
+                Problem::Invalid("a `sim_valve_cylinder` drives an axis of `kind = \"hydraulic\"`"),
+            ));
+        }
+        return Ok(None);
+    }
+    let section = a.hydraulic.as_ref();
+    let default = HydraulicSection::default();
+    super::hydraulic::controller(section.unwrap_or(&default))
+        .map(Some)
+        .map_err(|(k, p)| at(&["hydraulic", k], p))
 }
 
 /// On a simulated drive the keys of a drive of the process image are refused: the key path of

@@ -7,6 +7,7 @@ mod cam;
 mod device;
 mod encoder;
 mod ethercat;
+mod hydraulic;
 mod names;
 mod objects;
 mod security;
@@ -372,7 +373,15 @@ fn axes(cx: Ctx<'_>, raw: &CellFile, nodes: &[Node]) -> Result<Vec<AxisEntry>, C
     for (name, a) in &raw.axes {
         let node = node_named(cx, nodes, &a.node, &["axes", name, "node"])?;
         let cycle = nodes[node].cycle_ns as f64 * 1e-9;
-        let config = axis::axis_config(a, cycle).map_err(|(k, p)| cx.at(&["axes", name, k], p))?;
+        let config = axis::axis_config(a, cycle).map_err(|(k, p)| {
+            if k.contains('.') {
+                let mut path = vec!["axes", name.as_str()];
+                path.extend(k.split('.'));
+                cx.at_or_table(&path, p)
+            } else {
+                cx.at(&["axes", name, k], p)
+            }
+        })?;
         config.validate().map_err(|e| {
             let mut path = vec!["axes", name.as_str()];
             path.extend(e.field.split('.'));

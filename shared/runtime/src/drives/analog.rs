@@ -7,19 +7,83 @@
 //! next boundary.
 
 use tandem_config::{AnalogDriveConnection, Cell, DeviceKind, DriveConnection};
+use tandem_motion::hydraulic::controller::HydController;
 use tandem_motion::objects::axis::Axis;
 use tandem_motion::plant::analog::{
     AnalogCommand, AnalogConnection, AnalogConnectionError, AnalogFeedback, AnalogStatus,
     SimAnalogDrive, SimAnalogParams,
 };
+use tandem_motion::plant::hydraulic::SimValveCylinder;
 use tandem_motion::plant::link::{DriveInputs, DriveOutputs};
 
 use crate::error::ExecError;
 
+/// A simulated device on an analog output: a speed-controlled drive, or a proportional valve
+/// with its cylinder (a hydraulic axis).
+#[derive(Debug)]
+enum AnalogDevice {
+    Motor(SimAnalogDrive),
+    Cylinder(SimValveCylinder),
+}
+
+impl AnalogDevice {
+    fn exchange(&mut self, c: &AnalogCommand) {
+        match self {
+            Self::Motor(d) => d.exchange(c),
+            Self::Cylinder(d) => d.exchange(c),
+        }
+    }
+
+    fn advance(&mut self, dt_ns: i64) {
+        match self {
+            Self::Motor(d) => d.advance(dt_ns),
+            Self::Cylinder(d) => d.advance(dt_ns),
+        }
+    }
+
+    fn feedback(&self) -> AnalogFeedback {
+        match self {
+            Self::Motor(d) => d.feedback(),
+            Self::Cylinder(d) => d.feedback(),
+        }
+    }
+
+    fn command(&self) -> AnalogCommand {
+        match self {
+            Self::Motor(d) => *d.command(),
+            Self::Cylinder(d) => *d.command(),
+        }
+    }
+
+    /// The load's position and velocity (units, units/s).
+    fn motion(&self) -> (f64, f64) {
+        match self {
+            Self::Motor(d) => (d.position(), d.velocity()),
+            Self::Cylinder(d) => (d.state().position, d.state().velocity),
+        }
+    }
+
+    fn inject_fault(&mut self, on: bool) {
+        match (self, on) {
+            (Self::Motor(d), true) => d.inject_fault(),
+            (Self::Motor(d), false) => d.clear_fault_cause(),
+            (Self::Cylinder(d), true) => d.inject_fault(),
+            (Self::Cylinder(d), false) => d.clear_fault_cause(),
+        }
+    }
+
+    fn in_fault(&self) -> bool {
+        match self {
+            Self::Motor(d) => d.in_fault(),
+            Self::Cylinder(d) => d.in_fault(),
+        }
+    }
+}
+
 /// A simulated analog drive with its process data.
 #[derive(Debug)]
 struct AnalogSlot {
-    drive: SimAnalogDrive,
+    drive: AnalogDevice,
     /// Its node's cycle (ns).
     cycle_ns: i64,
     /// The command written by the last step, latched at the next boundary.
@@ -50,10 +114,19 @@ impl AnalogLink {
         plant: tandem_motion::plant::drive::Plant,
         p0: f64,
     ) -> Result<Self, AnalogConnectionError> {
+        let connection = match c.hydraulic {
+            Some(h) => AnalogConnection::hydraulic(
+                c.params,
+                HydController::new(h, None).map_err(AnalogConnectionError::Hydraulic)?,
+                plant,
+                p0,
+            )?,
+            None => AnalogConnection::new(c.params, plant, p0)?,
+        };
         Ok(Self {
             axis,
             device: c.device.0,
-            connection: AnalogConnection::new(c.params, plant, p0)?,
+            connection,
         })
     }
 
@@ -104,10 +177,6 @@ impl AnalogDrives {
             let Some(dev) = cell.devices.get(c.device.0) else {
                 continue;
             };
-            let DeviceKind::SimAnalogDrive(params) = &dev.kind else {
-                // Refused by the configuration: an analog axis's device is an analog drive.
-                continue;
-            };
             let refused = |reason| ExecError::AnalogDrive {
                 name: dev.name.clone(),
                 reason,
@@ -115,14 +184,24 @@ impl AnalogDrives {
             let scaling = c.params.scaling;
             let p0 = a.config.initial_position;
             // The load starts where the axis's initial position puts it.
-            let drive = SimAnalogDrive::new(
-                SimAnalogParams {
-                    initial_revolutions: SimAnalogDrive::revolutions_at(&scaling, p0),
-                    ..*params
-                },
-                scaling,
-            )
-            .map_err(|e| refused(AnalogConnectionError::Params(e)))?;
+            let drive = match &dev.kind {
+                DeviceKind::SimAnalogDrive(params) => AnalogDevice::Motor(
+                    SimAnalogDrive::new(
+                        SimAnalogParams {
+                            initial_revolutions: SimAnalogDrive::revolutions_at(&scaling, p0),
+                            ..*params
+                        },
+                        scaling,
+                    )
+                    .map_err(|e| refused(AnalogConnectionError::Params(e)))?,
+                ),
+                DeviceKind::SimValveCylinder(params) => AnalogDevice::Cylinder(
+                    SimValveCylinder::new(*params, scaling, p0)
+                        .map_err(|e| refused(AnalogConnectionError::Cylinder(e)))?,
+                ),
+                // Refused by the configuration: an analog axis's device is an analog drive.
+                _ => continue,
+            };
             if let Some(slot) = slots.get_mut(c.device.0) {
                 *slot = Some(AnalogSlot {
                     drive,
@@ -192,11 +271,7 @@ impl AnalogDrives {
     /// its ready output drops), or its cause removed (`code == 0`).
     pub(crate) fn inject_fault(&mut self, device: usize, code: u16) {
         if let Some(Some(slot)) = self.slots.get_mut(device) {
-            if code == 0 {
-                slot.drive.clear_fault_cause();
-            } else {
-                slot.drive.inject_fault();
-            }
+            slot.drive.inject_fault(code != 0);
         }
     }
 
@@ -204,12 +279,13 @@ impl AnalogDrives {
     pub(crate) fn status(&self, device: usize) -> Option<AnalogDriveStatus> {
         let slot = self.slots.get(device)?.as_ref()?;
         let link = self.links.iter().find(|l| l.device == device)?;
+        let (position, velocity) = slot.drive.motion();
         Some(AnalogDriveStatus {
             link: *link.connection.status(),
-            latched: *slot.drive.command(),
+            latched: slot.drive.command(),
             feedback: slot.feedback,
-            position: slot.drive.position(),
-            velocity: slot.drive.velocity(),
+            position,
+            velocity,
             in_fault: slot.drive.in_fault(),
         })
     }

@@ -389,7 +389,7 @@ impl Axis {
             q.end_v = v;
             return;
         }
-        let finished = self.elapsed(self.t0) >= self.prof.duration();
+        let finished = self.main_motion_finished();
         if let Goal::Position { target, lim, .. } = self.goal {
             if !finished {
                 self.set_goal(Goal::Position {

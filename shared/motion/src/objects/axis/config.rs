@@ -218,6 +218,20 @@ pub struct AxisConfig {
     /// stopped publishing): stop with the current or the maximum dynamics (default, the table
     /// value), emergency stop, or remove the enable. `None`: the table value.
     pub leader_missing_reaction: Option<crate::catalog::alarm::Reaction>,
+    /// A hydraulic axis (`kind = "hydraulic"` in a cell file): its positionings run the
+    /// displacement-based generator of the Beckhoff TwinCAT PLC Hydraulic Positioning library
+    /// instead of the jerk-limited profile. `None`: an electric axis.
+    pub hydraulic: Option<HydraulicProfile>,
+}
+
+/// The displacement-based positioning of a hydraulic axis: the generator's parameters and the
+/// target window (members of `ST_TcHydAxParam`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct HydraulicProfile {
+    /// The generator `iTcMc_ProfileCtrlBased`.
+    pub generator: crate::hydraulic::generator::GeneratorParams,
+    /// `fMonPositionRange`, `fMonTargetRange`, `fMonTargetFilter`.
+    pub monitor: crate::hydraulic::monitor::MonitorParams,
 }
 
 /// What is wrong with a value of an [`AxisConfig`] (see [`AxisConfigError`]).
@@ -255,6 +269,8 @@ pub enum AxisConfigProblem {
     ReferenceCamReversed,
     /// The upper hardware limit switch is not above the lower one.
     HardwareLimitsReversed,
+    /// A parameter of a hydraulic axis out of its range (the field is the library's name).
+    HydraulicParameter,
 }
 
 impl AxisConfigProblem {
@@ -277,6 +293,7 @@ impl AxisConfigProblem {
             Self::KpcOutOfRange => "must be between 0 and 150 %",
             Self::ReferenceCamReversed => "must be [low, high] with high > low",
             Self::HardwareLimitsReversed => "must be greater than plant.hw_limit_min",
+            Self::HydraulicParameter => "is out of its range (Beckhoff hydraulic positioning library, ST_TcHydAxParam)",
         }
     }
 }
@@ -388,6 +405,7 @@ impl AxisConfig {
             initial_position: 0.0,
             extrapolation: ExtrapolationConfig::default(),
             leader_missing_reaction: None,
+            hydraulic: None,
         }
     }
 
@@ -412,6 +430,24 @@ impl AxisConfig {
         self.validate_homing_and_drive()?;
         self.validate_plant()?;
         self.validate_extrapolation()?;
+        self.validate_hydraulic()?;
+        Ok(())
+    }
+
+    /// The generator's and the target window's parameters of a hydraulic axis.
+    fn validate_hydraulic(&self) -> Result<(), AxisConfigError> {
+        let Some(h) = &self.hydraulic else {
+            return Ok(());
+        };
+        let refused = |field| AxisConfigError {
+            field,
+            problem: AxisConfigProblem::HydraulicParameter,
+        };
+        crate::hydraulic::generator::CtrlBasedGenerator::new(h.generator, 0.0).map_err(|e| {
+            let crate::hydraulic::generator::GeneratorError::Invalid { name, .. } = e;
+            refused(name)
+        })?;
+        crate::hydraulic::monitor::TargetMonitor::new(h.monitor).map_err(|e| refused(e.name))?;
         Ok(())
     }
 

@@ -10,6 +10,7 @@ mod adjustment;
 mod buffer;
 mod command;
 mod config;
+mod hydraulic;
 mod step;
 mod sync;
 
@@ -21,9 +22,10 @@ pub use command::{
 };
 pub use config::{
     AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
-    FollowingErrorMonitoring, HomingConfig, HomingMark, MotionType, PassiveDirection,
-    PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
+    FollowingErrorMonitoring, HomingConfig, HomingMark, HydraulicProfile, MotionType,
+    PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
 };
+pub use hydraulic::HydraulicStatus;
 
 use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
 use crate::catalog::error_id::ErrorId;
@@ -359,6 +361,8 @@ pub struct Axis {
     absolute: AbsoluteOffset,
     /// Jobs queued behind `main` (PLCopen BufferMode); read only when a job ends.
     queue: buffer::JobQueue,
+    /// A hydraulic axis' generator and target window ([`AxisConfig::hydraulic`]).
+    hyd: Option<Box<hydraulic::HydAxis>>,
 }
 
 fn sign(x: f64) -> f64 {
@@ -443,6 +447,10 @@ impl Axis {
             events: EventQueue::default(),
             next_id: 1,
             queue: buffer::JobQueue::default(),
+            hyd: cfg
+                .hydraulic
+                .as_ref()
+                .and_then(|h| hydraulic::HydAxis::new(h, p0)),
             now: 0,
             status: OnceCell::new(),
             status_kept: Cell::new(false),
@@ -651,6 +659,9 @@ impl Axis {
 
     /// Plans the current goal from the current basic setpoint at the current time.
     fn replan(&mut self) {
+        if self.hyd_replan() {
+            return;
+        }
         let s = self.basic;
         let ovr = self.override_pct / 100.0;
         let planned = match self.goal {

@@ -60,7 +60,7 @@ impl Axis {
             position: tot.p - self.offset,
             velocity: tot.v,
             enable: self.enabled || self.power.awaiting_drive,
-            position_controlled: self.pos_ctrl,
+            position_controlled: self.pos_ctrl && self.hyd_position_control(),
             fault_reset: self.power.fault_reset,
             acceleration: tot.a,
             quick_stop: self.power.quick_stop && !self.enabled && !self.power.awaiting_drive,
@@ -155,6 +155,10 @@ impl Axis {
                 p: self.basic.p + self.basic.v * dt,
                 ..self.basic
             },
+            _ if self.hyd_finished().is_some() => State {
+                p: self.basic.p + self.basic.v * dt,
+                ..self.basic
+            },
             _ => self.prof.at(self.elapsed(self.t0) + dt),
         };
         let sup = match &self.sup_job {
@@ -170,6 +174,7 @@ impl Axis {
 
     fn generate(&mut self) {
         let dt = self.cfg.cycle;
+        let by_generator = self.hyd_generate();
         match self.goal {
             Goal::Direct {
                 position: Some(p),
@@ -196,6 +201,7 @@ impl Axis {
                 };
                 self.sup = State::default();
             }
+            _ if by_generator => {}
             _ => self.basic = self.prof.at(self.elapsed(self.t0)),
         }
         if let Some(j) = &self.sup_job {
@@ -273,6 +279,7 @@ impl Axis {
                 },
             ) {
                 self.goal = Goal::Stop { lim: max };
+                self.hyd_disengage();
                 self.prof = p;
                 self.t0 = self.now;
             }
@@ -518,7 +525,7 @@ impl Axis {
     }
 
     fn update_jobs(&mut self) {
-        let finished = self.elapsed(self.t0) >= self.prof.duration();
+        let finished = self.main_motion_finished();
         let sup_done = self
             .sup_job
             .as_ref()
@@ -576,6 +583,12 @@ impl Axis {
                 {
                     // Still searching (a stop in between is not the end), or a superimposed
                     // motion is still running: positioning monitoring waits for the total.
+                } else if let Some(done) = self.hyd_done() {
+                    // The hydraulic library's Done: idle, InTargRng and InTarget.
+                    if done {
+                        self.finish_main(m.id, m.instr);
+                        return;
+                    }
                 } else {
                     let target = self.total().p;
                     let pm = *m.monitoring.get_or_insert(PosMon {
@@ -606,6 +619,12 @@ impl Axis {
                 *slot = m;
             }
         }
+    }
+
+    /// Whether the basic motion's profile (or the engaged hydraulic generator) has ended.
+    pub(super) fn main_motion_finished(&self) -> bool {
+        self.hyd_finished()
+            .unwrap_or_else(|| self.elapsed(self.t0) >= self.prof.duration())
     }
 
     fn finish_main(&mut self, id: crate::objects::job::JobId, instr: Instruction) {

@@ -1,0 +1,221 @@
+//! Hydraulic axes: `[axes.<name>.hydraulic]` (the members of the Beckhoff TwinCAT PLC Hydraulic
+//! Positioning library's `ST_TcHydAxParam`, under its names, with its defaults) and the
+//! `sim_valve_cylinder` device (`[devices.<name>.cylinder]`).
+
+use super::FieldError;
+use crate::error::Problem;
+use crate::schema::{CylinderSection, DeviceSection, HydraulicSection};
+use tandem_motion::hydraulic::controller::{HydController, HydControllerParams};
+use tandem_motion::hydraulic::finish::{FinishError, FinishParams};
+use tandem_motion::hydraulic::generator::{
+    Approach, CtrlBasedGenerator, GeneratorError, GeneratorParams,
+};
+use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
+use tandem_motion::objects::axis::HydraulicProfile;
+use tandem_motion::plant::hydraulic::{CylinderParams, SimValveCylinderParams};
+
+/// The axis kind of a hydraulic axis in the cell file.
+pub(super) const HYDRAULIC_KIND: &str = "hydraulic";
+
+/// `fMonPositionRange`, `fMonTargetRange`, `fMonTargetFilter` by default (mm, mm, s).
+const MONITOR_DEFAULTS: MonitorParams = MonitorParams {
+    position_range: 1.0,
+    target_range: 1.0,
+    target_filter: 1.0,
+};
+
+/// The keys of `[axes.<name>.hydraulic]` the generator and the target window check, as paths
+/// from the axis.
+const PROFILE_KEYS: [&str; 21] = [
+    "hydraulic.fRefVelo",
+    "hydraulic.fMaxVelo",
+    "hydraulic.fAcc",
+    "hydraulic.fMaxAcc",
+    "hydraulic.fDec",
+    "hydraulic.fMaxDec",
+    "hydraulic.fStopRamp",
+    "hydraulic.fEmergencyRamp",
+    "hydraulic.fCreepSpeedP",
+    "hydraulic.fCreepSpeedM",
+    "hydraulic.fCreepDistanceP",
+    "hydraulic.fCreepDistanceM",
+    "hydraulic.fBrakeDistanceP",
+    "hydraulic.fBrakeDistanceM",
+    "hydraulic.fBrakeDeadTimeP",
+    "hydraulic.fBrakeDeadTimeM",
+    "hydraulic.fReposDistance",
+    "hydraulic.fTargetClamping",
+    "hydraulic.fMonPositionRange",
+    "hydraulic.fMonTargetRange",
+    "hydraulic.fMonTargetFilter",
+];
+
+/// The path from the axis of the library's parameter `name`.
+fn profile_key(name: &str) -> &'static str {
+    PROFILE_KEYS
+        .iter()
+        .find(|k| k.strip_prefix("hydraulic.") == Some(name))
+        .copied()
+        .unwrap_or("hydraulic")
+}
+
+/// The generator and the target window of section `h`, checked: the path of the parameter out
+/// of range.
+pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldError> {
+    let p = unchecked_profile(h);
+    CtrlBasedGenerator::new(p.generator, 0.0).map_err(|e| {
+        let GeneratorError::Invalid { name, .. } = e;
+        (
+            profile_key(name),
+            Problem::Invalid("out of its range (ST_TcHydAxParam)"),
+        )
+    })?;
+    TargetMonitor::new(p.monitor).map_err(|e| {
+        (
+            profile_key(e.name),
+            Problem::Invalid("out of its range (ST_TcHydAxParam)"),
+        )
+    })?;
+    Ok(p)
+}
+
+/// The generator and the target window of section `h`.
+fn unchecked_profile(h: &HydraulicSection) -> HydraulicProfile {
+    let d = GeneratorParams::default();
+    let approach = |given: [Option<f64>; 4], of: &Approach| Approach {
+        creep_speed: given[0].unwrap_or(of.creep_speed),
+        creep_distance: given[1].unwrap_or(of.creep_distance),
+        brake_distance: given[2].unwrap_or(of.brake_distance),
+        brake_dead_time: given[3].unwrap_or(of.brake_dead_time),
+    };
+    let approach_p = approach(
+        [
+            h.fCreepSpeedP,
+            h.fCreepDistanceP,
+            h.fBrakeDistanceP,
+            h.fBrakeDeadTimeP,
+        ],
+        &d.approach_p,
+    );
+    let approach_m = approach(
+        [
+            h.fCreepSpeedM,
+            h.fCreepDistanceM,
+            h.fBrakeDistanceM,
+            h.fBrakeDeadTimeM,
+        ],
+        &d.approach_m,
+    );
+    let ref_velo = h.fRefVelo.unwrap_or(d.ref_velo);
+    HydraulicProfile {
+        generator: GeneratorParams {
+            ref_velo,
+            max_velo: h.fMaxVelo.unwrap_or(ref_velo),
+            acc: h.fAcc.unwrap_or(d.acc),
+            max_acc: h.fMaxAcc.unwrap_or(d.max_acc),
+            dec: h.fDec.unwrap_or(d.dec),
+            max_dec: h.fMaxDec.unwrap_or(d.max_dec),
+            approach_p,
+            approach_m,
+            asymmetrical: h.bAsymmetricalTargeting.unwrap_or(d.asymmetrical),
+            stop_ramp: h.fStopRamp.unwrap_or(d.stop_ramp),
+            emergency_ramp: h.fEmergencyRamp.unwrap_or(d.emergency_ramp),
+            // Target clamping needs the pressing output on the drive connection: not yet.
+            target_clamping: 0.0,
+            repos_distance: h.fReposDistance.unwrap_or(d.repos_distance),
+        },
+        monitor: MonitorParams {
+            position_range: h
+                .fMonPositionRange
+                .unwrap_or(MONITOR_DEFAULTS.position_range),
+            target_range: h.fMonTargetRange.unwrap_or(MONITOR_DEFAULTS.target_range),
+            target_filter: h.fMonTargetFilter.unwrap_or(MONITOR_DEFAULTS.target_filter),
+        },
+    }
+}
+
+/// The position controller and Finish of section `h`, checked: the key of the parameter out
+/// of range and its problem.
+pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, FieldError> {
+    let d = FinishParams::default();
+    let g = GeneratorParams::default();
+    let asymmetrical = h.bAsymmetricalTargeting.unwrap_or(d.asymmetrical);
+    let creep_p = h.fCreepSpeedP.unwrap_or(g.approach_p.creep_speed);
+    let params = HydControllerParams {
+        lag_amp: h.fLagAmp.unwrap_or(HydControllerParams::default().lag_amp),
+        lag_out_limit: h.fLagAmpOutL.unwrap_or(0.0),
+        finish: FinishParams {
+            ref_velo: h.fRefVelo.unwrap_or(d.ref_velo),
+            feed_forward: h.fFeedForward.unwrap_or(d.feed_forward),
+            area_ratio: h.fAreaRatio.unwrap_or(d.area_ratio),
+            overlap_comp_p: h.fValve_OverlapCompP.unwrap_or(d.overlap_comp_p),
+            overlap_comp_m: h.fValve_OverlapCompM.unwrap_or(d.overlap_comp_m),
+            creep_speed_p: creep_p,
+            creep_speed_m: h.fCreepSpeedM.unwrap_or(creep_p),
+            asymmetrical,
+            bend_point_velo: h.fValve_BendPointVelo.unwrap_or(d.bend_point_velo),
+            bend_point_output: h.fValve_BendPointOutput.unwrap_or(d.bend_point_output),
+            zero_compensation: h.fZeroCompensation.unwrap_or(d.zero_compensation),
+            ..d
+        },
+    };
+    HydController::new(params, None).map_err(|e| match e {
+        FinishError::OutOfRange { parameter, .. } | FinishError::NotAbove { parameter, .. } => (
+            parameter,
+            Problem::Invalid("out of its range (ST_TcHydAxParam)"),
+        ),
+        FinishError::BendPoint { .. } => (
+            "fValve_BendPointVelo",
+            Problem::Invalid(
+                "with fValve_BendPointOutput: both 0 (no bend) or both above 0 and below 1",
+            ),
+        ),
+    })?;
+    Ok(params)
+}
+
+/// The parameters of a `sim_valve_cylinder` device: `load` and `[devices.<name>.cylinder]`
+/// over the defaults, checked: the key out of range.
+pub(super) fn valve_cylinder(d: &DeviceSection) -> Result<SimValveCylinderParams, FieldError> {
+    let c = d.cylinder.as_ref();
+    let e = CylinderParams::example();
+    let get =
+        |f: fn(&CylinderSection) -> Option<f64>, default: f64| c.and_then(f).unwrap_or(default);
+    let cylinder = CylinderParams {
+        area_a: get(|c| c.area_a, e.area_a),
+        area_b: get(|c| c.area_b, e.area_b),
+        stroke: get(|c| c.stroke, e.stroke),
+        dead_volume: get(|c| c.dead_volume, e.dead_volume),
+        mass: get(|c| c.mass, e.mass),
+        bulk_modulus: get(|c| c.bulk_modulus, e.bulk_modulus),
+        viscous: get(|c| c.viscous, e.viscous),
+        coulomb: get(|c| c.coulomb, e.coulomb),
+        supply: get(|c| c.supply, e.supply),
+        tank: get(|c| c.tank, e.tank),
+        nominal_flow: get(|c| c.nominal_flow, e.nominal_flow),
+        flow_ratio_b: get(|c| c.flow_ratio_b, e.flow_ratio_b),
+        nominal_drop: get(|c| c.nominal_drop, e.nominal_drop),
+        overlap: get(|c| c.overlap, e.overlap),
+        offset: get(|c| c.offset, e.offset),
+        bend_opening: get(|c| c.bend_opening, e.bend_opening),
+        bend_flow: get(|c| c.bend_flow, e.bend_flow),
+        response_time: get(|c| c.response_time, e.response_time),
+    };
+    cylinder
+        .check()
+        .map_err(|e| (e.name, Problem::Invalid("out of its range")))?;
+    let p = SimValveCylinderParams {
+        cylinder,
+        ready_delay: d.ready_delay.unwrap_or(0.01),
+        load: d.load.unwrap_or(0.0),
+    };
+    for (key, value) in [("ready_delay", p.ready_delay), ("load", p.load)] {
+        if !(value.is_finite() && (key == "load" || value >= 0.0)) {
+            return Err((
+                key,
+                Problem::Invalid("must be a finite number (ready_delay >= 0)"),
+            ));
+        }
+    }
+    Ok(p)
+}

@@ -1,0 +1,194 @@
+//! A hydraulic axis' positionings (`AxisConfig::hydraulic`): the displacement-based generator
+//! of the Beckhoff TwinCAT PLC Hydraulic Positioning library (`iTcMc_ProfileCtrlBased`) in
+//! place of the jerk-limited profile, and its target window monitoring.
+//!
+//! The generator is **engaged** by a positioning (MC_MoveAbsolute, MC_MoveRelative,
+//! MC_MoveAdditive, a queued one): it then computes the basic setpoint every cycle from the
+//! actual position, and it stays engaged through a stop (MC_Halt, MC_Stop, an alarm's stop
+//! reaction: its time ramp with the command's deceleration) and at standstill after the move
+//! (idle: the set position is the target; automatic repositioning and target clamping act
+//! there). Any other motion (velocity, jog, gearing, camming, direct setpoints, a disabled
+//! axis) runs on tandem's profiles and disengages it; the next positioning takes the setpoint
+//! over without a step. While the generator runs a move, the position controller is off
+//! ([`DriveOutputs::position_controlled`] false: the library's displacement mode closes the
+//! loop only at standstill); a positioning is Done when the generator is idle and the target
+//! window monitoring reports InTargRng and InTarget.
+//!
+//! [`DriveOutputs::position_controlled`]: crate::plant::link::DriveOutputs::position_controlled
+
+use super::{Axis, Goal};
+use crate::hydraulic::generator::{CtrlBasedGenerator, HydState, Setpoint};
+use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
+use crate::kinematics::profile::{Profile, State};
+
+/// The hydraulic part of an axis (boxed in the axis: allocated when it is built).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct HydAxis {
+    gen: CtrlBasedGenerator,
+    monitor: TargetMonitor,
+    /// The generator computes the basic setpoint.
+    engaged: bool,
+    /// The generator's output of the last cycle.
+    last: Setpoint,
+    /// The target window of the last cycle.
+    window: TargetStatus,
+}
+
+/// What a hydraulic axis shows besides the axis' status.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct HydraulicStatus {
+    /// The generator's state (`E_TcHydAxState`; [`HydState::name`] with
+    /// [`positive`](Self::positive) gives the library's name).
+    pub state: HydState,
+    /// The direction of the last motion.
+    pub positive: bool,
+    /// The generator computes the setpoint (a positioning, its stop, or standstill after it).
+    pub engaged: bool,
+    /// `fTargetPos`.
+    pub target: f64,
+    /// `dwTcHydNsDwInTargRng`.
+    pub in_target_range: bool,
+    /// `dwTcHydNsDwInTarget`.
+    pub in_target: bool,
+}
+
+impl HydAxis {
+    /// The hydraulic part of an axis at position `p0`, from its validated configuration.
+    pub(super) fn new(cfg: &super::config::HydraulicProfile, p0: f64) -> Option<Box<Self>> {
+        let gen = CtrlBasedGenerator::new(cfg.generator, p0).ok()?;
+        let monitor = TargetMonitor::new(cfg.monitor).ok()?;
+        Some(Box::new(Self {
+            gen,
+            monitor,
+            engaged: false,
+            last: Setpoint {
+                velocity: 0.0,
+                position: p0,
+                state: HydState::Idle,
+                positive: true,
+                clamping_output: 0.0,
+                position_control: true,
+            },
+            window: TargetStatus::default(),
+        }))
+    }
+}
+
+impl Axis {
+    /// Plans the current goal on the generator when it takes it: a positioning (engaging it),
+    /// or a stop or standstill while it is engaged. Returns whether it did; any other goal
+    /// disengages it.
+    pub(super) fn hyd_replan(&mut self) -> bool {
+        let (basic, actual, ovr) = (self.basic, self.actual_p, self.override_pct / 100.0);
+        let Some(h) = self.hyd.as_deref_mut() else {
+            return false;
+        };
+        let taken = match self.goal {
+            Goal::Position { target, lim, .. } => {
+                h.gen.take_over(basic.p, basic.v);
+                if ovr > 0.0 {
+                    h.gen
+                        .move_absolute(target, lim.vel * ovr, lim.acc, lim.dec, actual)
+                        .is_ok()
+                } else {
+                    h.gen.stop_with(lim.dec);
+                    true
+                }
+            }
+            Goal::Stop { lim } if h.engaged => {
+                h.gen.take_over(basic.p, basic.v);
+                h.gen.stop_with(lim.dec);
+                true
+            }
+            Goal::Hold if h.engaged => {
+                h.gen.take_over(basic.p, basic.v);
+                true
+            }
+            _ => false,
+        };
+        h.engaged = taken;
+        if taken {
+            self.basic = State { a: 0.0, ..basic };
+            self.prof = Profile::hold(self.basic);
+            self.t0 = self.now;
+        }
+        taken
+    }
+
+    /// The generator no longer computes the setpoint (a profile took over the goal).
+    pub(super) fn hyd_disengage(&mut self) {
+        if let Some(h) = self.hyd.as_deref_mut() {
+            h.engaged = false;
+        }
+    }
+
+    /// One cycle of the engaged generator from the actual position: the basic setpoint and the
+    /// target window. Returns whether the generator computed the setpoint.
+    pub(super) fn hyd_generate(&mut self) -> bool {
+        let dt = self.cfg.cycle;
+        let (actual, actual_v, v0) = (self.actual_p, self.actual_v, self.basic.v);
+        let its_goal = matches!(
+            self.goal,
+            Goal::Position { .. } | Goal::Stop { .. } | Goal::Hold
+        );
+        let Some(h) = self.hyd.as_deref_mut() else {
+            return false;
+        };
+        // A goal set without planning (synchronous operation, a disabled axis) is not the
+        // generator's.
+        h.engaged &= its_goal;
+        if !h.engaged {
+            return false;
+        }
+        let sp = h.gen.step(dt, actual, actual_v);
+        h.last = sp;
+        h.window = h
+            .monitor
+            .step(dt, actual, h.gen.target(), sp.state == HydState::Idle);
+        self.basic = State {
+            p: sp.position,
+            v: sp.velocity,
+            a: (sp.velocity - v0) / dt,
+        };
+        true
+    }
+
+    /// Whether the engaged generator has ended its motion (idle); `None` when it is not
+    /// engaged (the profile's end counts).
+    pub(super) fn hyd_finished(&self) -> Option<bool> {
+        self.hyd
+            .as_deref()
+            .filter(|h| h.engaged)
+            .map(|h| h.gen.state() == HydState::Idle)
+    }
+
+    /// Whether a positioning on the engaged generator is Done (idle, InTargRng, InTarget);
+    /// `None` when it is not engaged.
+    pub(super) fn hyd_done(&self) -> Option<bool> {
+        self.hyd
+            .as_deref()
+            .filter(|h| h.engaged)
+            .map(|h| h.window.done)
+    }
+
+    /// Whether the position controller acts: not while the engaged generator runs a move.
+    pub(super) fn hyd_position_control(&self) -> bool {
+        self.hyd
+            .as_deref()
+            .filter(|h| h.engaged)
+            .map(|h| h.last.position_control)
+            .unwrap_or(true)
+    }
+
+    /// The hydraulic axis' generator and target window; `None` for an electric axis.
+    pub fn hydraulic_status(&self) -> Option<HydraulicStatus> {
+        self.hyd.as_deref().map(|h| HydraulicStatus {
+            state: h.last.state,
+            positive: h.last.positive,
+            engaged: h.engaged,
+            target: h.gen.target(),
+            in_target_range: h.window.in_target_range,
+            in_target: h.window.in_target,
+        })
+    }
+}

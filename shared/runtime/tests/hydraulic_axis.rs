@@ -1,0 +1,320 @@
+//! A hydraulic axis end to end in the executive (`config/hydraulic.toml`): a `kind = "hydraulic"`
+//! axis on a simulated valve and cylinder through the process image. Its positionings run the
+//! hydraulic library's displacement-based generator, the valve output comes from its position
+//! controller and Finish stage; a move lands in the target window in both directions of the
+//! differential cylinder; a 20 % overlap valve creeps short of its target without overlap
+//! compensation and lands with it; MC_Halt stops on the generator's ramp with its deceleration;
+//! a velocity motion after a positioning closes the position loop without a step; bad
+//! parameters are refused naming the key.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use tandem_config::{AxisIndex, Cell};
+use tandem_motion::hydraulic::generator::HydState;
+use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::action::Action;
+use tandem_motion::objects::axis::{
+    AxisState, Command, Direction, HydraulicStatus, StartMode, StopMode, VelocityDirection,
+};
+use tandem_runtime::exec::Executive;
+use tandem_testkit::workspace::root;
+
+const MS: i64 = 1_000_000;
+
+fn source() -> String {
+    std::fs::read_to_string(root().join("config/hydraulic.toml")).unwrap()
+}
+
+/// The bundled cell with `from` replaced by `to` (which must occur).
+fn cell(edits: &[(&str, &str)]) -> Cell {
+    let mut s = source();
+    for (from, to) in edits {
+        assert!(s.contains(from), "{from}");
+        s = s.replacen(from, to, 1);
+    }
+    tandem_config::parse("hydraulic.toml", &s).unwrap()
+}
+
+struct Run<'c> {
+    exec: Executive<'c>,
+    k: i64,
+    log: Vec<u8>,
+}
+
+impl<'c> Run<'c> {
+    /// The axis powered and homed at 100 mm, standing.
+    fn enabled(cell: &'c Cell) -> Self {
+        let mut r = Self {
+            exec: Executive::new(cell, None).unwrap(),
+            k: 0,
+            log: Vec::new(),
+        };
+        r.step();
+        r.cmd(Command::Power {
+            enable: true,
+            start_mode: StartMode::PositionControlled,
+            stop_mode: StopMode::Emergency,
+        });
+        r.cmd(Command::Home {
+            mode: 0,
+            position: 100.0,
+        });
+        r.until(100, "enabled", |r| r.state() == AxisState::Standstill);
+        r
+    }
+
+    fn cmd(&mut self, c: Command) {
+        let t = self.k * MS;
+        let r = self
+            .exec
+            .apply_at(t, t, "ram", "test", Action::Command(c), &mut self.log)
+            .unwrap();
+        assert!(r.is_ok(), "{r:?}\n{}", self.log());
+    }
+
+    fn step(&mut self) {
+        self.exec.step(self.k * MS, &mut self.log).unwrap();
+        self.k += 1;
+    }
+
+    fn log(&self) -> String {
+        String::from_utf8_lossy(&self.log).into_owned()
+    }
+
+    fn state(&mut self) -> AxisState {
+        self.exec.status()[0].state
+    }
+
+    fn hyd(&self) -> HydraulicStatus {
+        let axis = self.exec.axis(AxisIndex(0)).unwrap();
+        axis.hydraulic_status().unwrap()
+    }
+
+    fn until(&mut self, max: usize, what: &str, f: impl Fn(&mut Self) -> bool) {
+        for _ in 0..max {
+            if f(self) {
+                return;
+            }
+            self.step();
+        }
+        panic!("{what}: not within {max} cycles\n{}", self.log());
+    }
+
+    fn move_to(&mut self, position: f64, velocity: f64) {
+        self.cmd(Command::MoveAbsolute {
+            position,
+            dynamics: Dynamics {
+                velocity,
+                acceleration: -1.0,
+                deceleration: -1.0,
+                jerk: -1.0,
+            },
+            direction: Direction::Shortest,
+        });
+    }
+
+    /// Steps until the positioning job is Done (or `max` cycles): the states the generator
+    /// passed (deduplicated) and the largest change of the set velocity per cycle before idle.
+    fn run_move(&mut self, max: usize) -> (Vec<HydState>, f64) {
+        let (mut states, mut worst, mut last_v) = (Vec::new(), 0.0_f64, None::<f64>);
+        for _ in 0..max {
+            self.step();
+            let h = self.hyd();
+            if states.last() != Some(&h.state) {
+                states.push(h.state);
+            }
+            let v = self.exec.status()[0].velocity;
+            if h.state != HydState::Idle {
+                if let Some(l) = last_v {
+                    worst = worst.max((v - l).abs() / 1e-3);
+                }
+            }
+            last_v = Some(v);
+            if self.exec.status()[0].motion_job.is_none() {
+                return (states, worst);
+            }
+        }
+        panic!("the move did not end within {max} cycles\n{}", self.log());
+    }
+}
+
+#[test]
+fn a_positioning_runs_the_displacement_profile_and_lands_in_the_target_window_both_ways() {
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    for (target, velocity) in [(350.0, 120.0), (120.0, 150.0)] {
+        r.move_to(target, velocity);
+        let (states, worst) = r.run_move(8000);
+        assert_eq!(
+            states,
+            [
+                HydState::TcAcc,
+                HydState::ConstVelo,
+                HydState::PcDec,
+                HydState::CreepVelo,
+                HydState::Idle
+            ],
+            "to {target}"
+        );
+        // Done: idle, InTargRng and InTarget (0.2 mm for 0.2 s).
+        let h = r.hyd();
+        assert!(h.in_target && h.in_target_range && h.engaged, "{h:?}");
+        assert_eq!(h.target, target);
+        let s = r.exec.status()[0];
+        assert!(
+            (s.actual_position - target).abs() < 0.2,
+            "at {} for {target}",
+            s.actual_position
+        );
+        // The set position is the target at standstill (the controller's setpoint).
+        assert_eq!(s.position, target);
+        // The time ramps within fAcc / fDec (400 mm/s²); the square-root ramp follows the
+        // actual position and may exceed it where the cylinder runs ahead (docs/hydraulics.md).
+        assert!(worst <= 2.0 * 400.0, "{worst} mm/s² to {target}");
+        // It stands and stays there.
+        for _ in 0..500 {
+            r.step();
+        }
+        let s = r.exec.status()[0];
+        assert!((s.actual_position - target).abs() < 0.2, "{s:?}");
+        assert!(s.actual_velocity.abs() < 0.5, "{s:?}");
+    }
+}
+
+#[test]
+fn overlap_compensation_makes_a_20_percent_overlap_valve_land() {
+    let overlap = ("overlap = 0.05 ", "overlap = 0.20 ");
+    // Without compensation the controller's output at standstill stays inside the overlap:
+    // the cylinder creeps to a halt short of the target and never reports InTarget.
+    let short = cell(&[
+        overlap,
+        ("fValve_OverlapCompP = 0.05", "fValve_OverlapCompP = 0.0"),
+    ]);
+    let mut r = Run::enabled(&short);
+    r.move_to(300.0, 120.0);
+    for _ in 0..6000 {
+        r.step();
+    }
+    let s = r.exec.status()[0];
+    let h = r.hyd();
+    assert!(s.motion_job.is_some(), "Done without landing: {s:?}");
+    assert!(!h.in_target, "{h:?}");
+    assert!(
+        300.0 - s.actual_position > 0.2,
+        "reached {} without compensation",
+        s.actual_position
+    );
+    // With the overlap compensated it lands within the window and reports Done.
+    let comp = cell(&[
+        overlap,
+        ("fValve_OverlapCompP = 0.05", "fValve_OverlapCompP = 0.20"),
+    ]);
+    let mut r = Run::enabled(&comp);
+    r.move_to(300.0, 120.0);
+    r.run_move(8000);
+    let s = r.exec.status()[0];
+    assert!((s.actual_position - 300.0).abs() < 0.2, "{s:?}");
+}
+
+#[test]
+fn mc_halt_stops_on_the_generator_ramp_and_a_velocity_motion_takes_over_without_a_step() {
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    r.move_to(450.0, 120.0);
+    r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
+    for _ in 0..200 {
+        r.step();
+    }
+    // MC_Halt with 300 mm/s² (below the axis' 400): 120 mm/s down in 0.4 s on the
+    // generator's time ramp.
+    r.cmd(Command::Halt {
+        deceleration: 300.0,
+        jerk: -1.0,
+        abort_acceleration: false,
+    });
+    let v0 = r.exec.status()[0].velocity;
+    assert!((v0 - 120.0).abs() < 1e-9, "{v0}");
+    let mut ramp = 0;
+    let mut last = v0;
+    loop {
+        r.step();
+        let (h, v) = (r.hyd(), r.exec.status()[0].velocity);
+        if h.state != HydState::TcDec {
+            break;
+        }
+        // 300 mm/s² x 1 ms a cycle.
+        assert!((last - v - 0.3).abs() < 1e-9, "{last} -> {v}");
+        last = v;
+        ramp += 1;
+        assert!(ramp < 1000, "no end of the stop ramp");
+    }
+    // 120 / 0.3 = 400 decrements (the last may leave a rounding residue for one more cycle).
+    assert!(
+        (399..=401).contains(&ramp),
+        "{ramp} cycles in the stop ramp"
+    );
+    assert_eq!(r.hyd().state, HydState::Idle);
+    // MC_MoveVelocity: a profile from the standing setpoint; the generator lets go and the
+    // position controller acts while moving.
+    r.until(2000, "halt done", |r| {
+        r.exec.status()[0].motion_job.is_none()
+    });
+    let p0 = r.exec.status()[0].position;
+    r.cmd(Command::MoveVelocity {
+        dynamics: Dynamics {
+            velocity: 50.0,
+            acceleration: 400.0,
+            deceleration: 400.0,
+            jerk: 100000.0,
+        },
+        direction: VelocityDirection::Positive,
+        current: false,
+        position_controlled: true,
+    });
+    r.step();
+    let s = r.exec.status()[0];
+    assert!((s.position - p0).abs() < 0.01, "{} after {p0}", s.position);
+    assert!(!r.hyd().engaged);
+    for _ in 0..1000 {
+        r.step();
+    }
+    let s = r.exec.status()[0];
+    assert!((s.actual_velocity - 50.0).abs() < 2.0, "{s:?}");
+    // Closed loop: the actual position follows the set position within a millimetre.
+    assert!((s.position - s.actual_position).abs() < 1.0, "{s:?}");
+}
+
+#[test]
+fn bad_hydraulic_parameters_are_refused_naming_the_key() {
+    let src = source();
+    for (from, to, key) in [
+        (
+            "fRefVelo = 327.06",
+            "fRefVelo = -1.0",
+            "axes.ram.hydraulic.fRefVelo",
+        ),
+        (
+            "fMonTargetRange = 0.2 ",
+            "fMonTargetRange = 0.0 ",
+            "axes.ram.hydraulic.fMonTargetRange",
+        ),
+        (
+            "fLagAmp = 50.0",
+            "fLagAmp = -2.0",
+            "axes.ram.hydraulic.fLagAmp",
+        ),
+        (
+            "overlap = 0.05",
+            "overlap = 1.5",
+            "devices.ram_valve.cylinder.overlap",
+        ),
+        (
+            "kind = \"hydraulic\"",
+            "kind = \"positioning\"",
+            "axes.ram.hydraulic",
+        ),
+    ] {
+        assert!(src.contains(from), "{from}");
+        let e = tandem_config::parse("hydraulic.toml", &src.replacen(from, to, 1)).unwrap_err();
+        assert!(e.to_string().contains(key), "{from} -> {to}: {e}");
+    }
+}
