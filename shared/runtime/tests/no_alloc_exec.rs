@@ -184,17 +184,14 @@ fn the_output_stage_steps_without_allocating() {
     );
 }
 
-/// The analog drive stages (`config/analog.toml`: an axis on a simulated analog drive with a
-/// 16-bit counter): the exchange at the boundary, the encoder, the enable / ready handshake,
-/// tandem's position controller and the output word, through a move, a lost ready, the reset
-/// and a move, with 0 allocations.
-#[test]
-fn the_analog_drive_stages_step_without_allocating() {
+/// Runs bundled example `name` (`config/<name>.toml` with its script) through the executive,
+/// counting the allocations of every step and drain: the executive after the run and the count.
+fn run_counting<'c>(cell: &'c tandem_config::Cell, name: &str) -> (Executive<'c>, u64) {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let cell = tandem_config::load(&root.join("config/analog.toml")).unwrap();
-    let src = std::fs::read_to_string(root.join("config/analog-script.toml")).unwrap();
-    let script = tandem_config::script::parse_cell("analog-script.toml", &src, &cell).unwrap();
-    let mut exec = Executive::new(&cell, None).unwrap();
+    let file = format!("{name}-script.toml");
+    let src = std::fs::read_to_string(root.join("config").join(&file)).unwrap();
+    let script = tandem_config::script::parse_cell(&file, &src, cell).unwrap();
+    let mut exec = Executive::new(cell, None).unwrap();
     let mut log = std::io::sink();
     let (mut next, mut allocations) = (0, 0);
     let end = script.duration_ns / 1_000_000;
@@ -211,12 +208,44 @@ fn the_analog_drive_stages_step_without_allocating() {
         exec.drain_io_notes(|_| {});
         allocations += disarm().0;
     }
+    (exec, allocations)
+}
+
+/// The cell of bundled example `name`.
+fn example_cell(name: &str) -> tandem_config::Cell {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    tandem_config::load(&root.join(format!("config/{name}.toml"))).unwrap()
+}
+
+/// The analog drive stages (`config/analog.toml`: an axis on a simulated analog drive with a
+/// 16-bit counter): the exchange at the boundary, the encoder, the enable / ready handshake,
+/// tandem's position controller and the output word, through a move, a lost ready, the reset
+/// and a move, with 0 allocations.
+#[test]
+fn the_analog_drive_stages_step_without_allocating() {
+    let cell = example_cell("analog");
+    let (mut exec, allocations) = run_counting(&cell, "analog");
     assert_eq!(allocations, 0, "allocations on the cyclic path");
     // It did work: the move after the reset ended where it was sent, on the drive too.
     let st = exec.status()[0];
     assert_eq!((st.state.name(), st.position), ("Standstill", 100.0));
     assert!((exec.analog_drive(0).unwrap().position - 100.0).abs() < 0.01);
     assert!(exec.commands >= 8 && exec.rejected == 0);
+}
+
+/// A hydraulic axis (`config/hydraulic.toml`): the displacement-based generator, the target
+/// window, the position controller and Finish, and the simulated valve and cylinder, through
+/// two positionings, with 0 allocations.
+#[test]
+fn the_hydraulic_stages_step_without_allocating() {
+    let cell = example_cell("hydraulic");
+    let (mut exec, allocations) = run_counting(&cell, "hydraulic");
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    // It did work: the second positioning ended at its target, the cylinder within 0.2 mm.
+    let st = exec.status()[0];
+    assert_eq!((st.state.name(), st.position), ("Standstill", 120.0));
+    assert!((exec.analog_drive(0).unwrap().position - 120.0).abs() < 0.2);
+    assert!(exec.commands == 4 && exec.rejected == 0);
 }
 
 /// The input stage (`config/inputs.toml`): a timestamped input driven by a sensor on the web
