@@ -21,7 +21,7 @@
 
 use std::hint::black_box;
 use std::time::Instant;
-use tandem_bench::median;
+use tandem_bench::{arg_usize, median};
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
     Axis, AxisConfig, BufferMode, BufferedMotion, Command, StartMode, StopMode, JOB_QUEUE_CAPACITY,
@@ -81,22 +81,13 @@ fn fill(axis: &mut Axis, n: &mut u64, distance: f64) {
     while axis.pop_event().is_some() {}
 }
 
-fn arg(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .map(|v| v.parse().unwrap())
-        .unwrap_or(default)
-}
-
 fn main() {
     let (n, cycles, rounds) = (
-        arg("--axes", 256),
-        arg("--cycles", 2000),
-        arg("--rounds", 7),
+        arg_usize("--axes", 256),
+        arg_usize("--cycles", 2000),
+        arg_usize("--rounds", 7),
     );
-    let distance = arg("--distance", 20) as f64;
+    let distance = arg_usize("--distance", 20) as f64;
     let mut single: Vec<Axis> = (0..n).map(|_| powered()).collect();
     for a in &mut single {
         a.command(&relative(1e7, 50.0, BufferMode::Aborting))

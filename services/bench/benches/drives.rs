@@ -18,7 +18,7 @@
 
 use std::hint::black_box;
 use std::time::Instant;
-use tandem_bench::median;
+use tandem_bench::{arg_usize, median};
 use tandem_config::{AxisEntry, Cell, DriveConnection};
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{Axis, Command, StartMode, StopMode, VelocityDirection};
@@ -105,20 +105,11 @@ fn start(axis: &mut Axis, mut link: Option<(&mut Cia402Link, &mut IdealDrive)>) 
     while axis.pop_event().is_some() {}
 }
 
-fn arg(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .map(|v| v.parse().unwrap())
-        .unwrap_or(default)
-}
-
 fn main() {
     let (n, cycles, rounds) = (
-        arg("--axes", 256),
-        arg("--cycles", 2000),
-        arg("--rounds", 7),
+        arg_usize("--axes", 256),
+        arg_usize("--cycles", 2000),
+        arg_usize("--rounds", 7),
     );
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let cell: Cell = tandem_config::load(&root.join("config/servo.toml")).unwrap();

@@ -287,3 +287,57 @@ pub fn cargo_bench_flag() -> clap::Arg {
         .action(clap::ArgAction::SetTrue)
         .hide(true)
 }
+
+/// The value of command-line option `name` (`--axes 64`), or `default` when it is not given
+/// or not a number (said on stderr).
+pub fn arg_usize(name: &str, default: usize) -> usize {
+    let args: Vec<String> = std::env::args().collect();
+    let given = args
+        .iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1));
+    match given.map(|v| v.parse()) {
+        Some(Ok(v)) => v,
+        Some(Err(_)) => {
+            eprintln!("{name}: not a number, {default} taken");
+            default
+        }
+        None => default,
+    }
+}
+
+/// Times `cycles` cycles of `n` objects with `step(object, cycle)`: ns per object and cycle.
+pub fn time_cycles<T>(
+    objects: &mut [T],
+    k0: i64,
+    cycles: usize,
+    mut step: impl FnMut(&mut T, i64),
+) -> f64 {
+    let t0 = std::time::Instant::now();
+    for c in 0..cycles as i64 {
+        for o in objects.iter_mut() {
+            step(o, k0 + c);
+        }
+    }
+    t0.elapsed().as_nanos() as f64 / (cycles * objects.len().max(1)) as f64
+}
+
+/// Runs `a` and `b` once per round, `a` first in even rounds and `b` first in odd ones (so
+/// neither always runs on a warm or a cold machine): their figures per round.
+pub fn alternate(
+    rounds: usize,
+    mut a: impl FnMut(usize) -> f64,
+    mut b: impl FnMut(usize) -> f64,
+) -> Vec<(f64, f64)> {
+    (0..rounds)
+        .map(|r| {
+            if r % 2 == 0 {
+                let x = a(r);
+                (x, b(r))
+            } else {
+                let y = b(r);
+                (a(r), y)
+            }
+        })
+        .collect()
+}
