@@ -394,7 +394,7 @@ fn connection_reports_a_lost_ready_and_a_fault_is_reset_by_removing_the_enable()
         l.cycle(0.0, 0.0, true);
     }
     assert_eq!(l.conn.status().enable, AnalogEnableStatus::Enabled);
-    l.drive.inject_fault();
+    l.drive.amplifier_mut().inject_fault();
     // The drive's ready output is off at the next boundary; the connection reads it there.
     let inp = l.cycle(0.0, 0.0, true);
     assert_eq!(inp.state, DriveState::Disabled);
@@ -404,11 +404,11 @@ fn connection_reports_a_lost_ready_and_a_fault_is_reset_by_removing_the_enable()
     for _ in 0..5 {
         l.cycle(0.0, 0.0, false);
     }
-    assert!(l.drive.in_fault());
-    l.drive.clear_fault_cause();
+    assert!(l.drive.amplifier().in_fault());
+    l.drive.amplifier_mut().clear_fault_cause();
     l.cycle(0.0, 0.0, false);
     l.cycle(0.0, 0.0, false);
-    assert!(!l.drive.in_fault());
+    assert!(!l.drive.amplifier().in_fault());
     // Enabled again.
     for _ in 0..20 {
         l.cycle(0.0, 0.0, true);
@@ -489,14 +489,14 @@ fn simulated_drive_ready_delay_offset_and_fault_latch() {
     // 0.1 V offset: 1 % of 3000/min with a 0 command.
     d.advance(1000 * MS);
     assert!((d.speed() - 30.0).abs() < 1e-9);
-    d.inject_fault();
+    d.amplifier_mut().inject_fault();
     assert!(!d.feedback().ready);
     // Enable off with the cause present: still in fault.
     d.exchange(&AnalogCommand::default());
-    assert!(d.in_fault());
-    d.clear_fault_cause();
+    assert!(d.amplifier().in_fault());
+    d.amplifier_mut().clear_fault_cause();
     d.exchange(&AnalogCommand::default());
-    assert!(!d.in_fault());
+    assert!(!d.amplifier().in_fault());
     let bad = SimAnalogDrive::new(
         SimAnalogParams {
             offset: 10.5,

@@ -906,12 +906,84 @@ pub struct SimAnalogDrive {
     /// Motor position (revolutions) and speed (revolutions/s).
     revolutions: f64,
     speed: f64,
-    /// The latched command.
+    /// The latched command, the ready output and the fault latch.
+    amplifier: Amplifier,
+}
+
+/// The process-data side of a simulated device on an analog output (a drive, a valve
+/// amplifier): the command latched at the boundary, the ready output a delay after the enable
+/// input, and a fault latched until its cause is gone and the enable input is off.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Amplifier {
     command: AnalogCommand,
-    /// Time enabled without fault (s), for the ready delay.
+    /// From the enable input to the ready output (s).
+    ready_delay: f64,
+    /// Time enabled without fault (s).
     enabled_for: f64,
     fault_latched: bool,
     fault_cause: bool,
+}
+
+impl Amplifier {
+    /// Not enabled, no fault, ready `ready_delay` seconds after its enable input.
+    pub fn new(ready_delay: f64) -> Self {
+        Self {
+            command: AnalogCommand::default(),
+            ready_delay,
+            enabled_for: 0.0,
+            fault_latched: false,
+            fault_cause: false,
+        }
+    }
+
+    /// Latches the command of the boundary; an enable removed with the cause gone
+    /// acknowledges a fault.
+    pub fn exchange(&mut self, command: &AnalogCommand) {
+        self.command = *command;
+        if !command.enable && !self.fault_cause {
+            self.fault_latched = false;
+        }
+    }
+
+    /// Whether it drives its output: enabled and not in fault.
+    pub fn on(&self) -> bool {
+        self.command.enable && !self.fault_latched
+    }
+
+    /// `dt` seconds pass (after the device has run them).
+    pub fn advance(&mut self, dt: f64) {
+        self.enabled_for = if self.on() {
+            self.enabled_for + dt
+        } else {
+            0.0
+        };
+    }
+
+    /// The ready output now.
+    pub fn ready(&self) -> bool {
+        self.on() && self.enabled_for >= self.ready_delay && self.enabled_for > 0.0
+    }
+
+    /// The latched command.
+    pub fn command(&self) -> &AnalogCommand {
+        &self.command
+    }
+
+    /// A fault: ready drops. Latched until the cause is cleared and the enable input is off.
+    pub fn inject_fault(&mut self) {
+        self.fault_cause = true;
+        self.fault_latched = true;
+    }
+
+    /// The cause of the fault is gone (the latch stays until the enable input is off).
+    pub fn clear_fault_cause(&mut self) {
+        self.fault_cause = false;
+    }
+
+    /// Whether it is in fault.
+    pub fn in_fault(&self) -> bool {
+        self.fault_latched
+    }
 }
 
 impl SimAnalogDrive {
@@ -930,10 +1002,7 @@ impl SimAnalogDrive {
             units_per_revolution,
             revolutions: params.initial_revolutions,
             speed: 0.0,
-            command: AnalogCommand::default(),
-            enabled_for: 0.0,
-            fault_latched: false,
-            fault_cause: false,
+            amplifier: Amplifier::new(params.ready_delay),
         })
     }
 
@@ -948,26 +1017,22 @@ impl SimAnalogDrive {
 
     /// Latches the command of the boundary (its effect starts now).
     pub fn exchange(&mut self, command: &AnalogCommand) {
-        self.command = *command;
-        if !command.enable && !self.fault_cause {
-            self.fault_latched = false;
-        }
+        self.amplifier.exchange(command);
     }
 
     /// Runs `dt_ns` with the latched command.
     pub fn advance(&mut self, dt_ns: i64) {
         let dt = dt_ns.max(0) as f64 * 1e-9;
         let reference = self.params.reference_speed / 60.0;
-        if self.command.enable && !self.fault_latched {
-            let volts =
-                word_to_normalized(self.command.word) * NOMINAL_VOLTAGE + self.params.offset;
+        if self.amplifier.on() {
+            let volts = word_to_normalized(self.amplifier.command().word) * NOMINAL_VOLTAGE
+                + self.params.offset;
             let limit = self.params.max_speed / 60.0;
             let target = (volts / NOMINAL_VOLTAGE * reference).clamp(-limit, limit);
             let tau = self.params.time_constant;
             let e = decay(dt, tau);
             self.revolutions += target * dt + (self.speed - target) * tau * (1.0 - e);
             self.speed = target + (self.speed - target) * e;
-            self.enabled_for += dt;
         } else {
             let deceleration = reference / self.params.ramp_down_time;
             let stop = self.speed.abs() / deceleration;
@@ -979,18 +1044,14 @@ impl SimAnalogDrive {
                 self.revolutions += 0.5 * (self.speed + v1) * dt;
                 self.speed = v1;
             }
-            self.enabled_for = 0.0;
         }
+        self.amplifier.advance(dt);
     }
 
     /// The process image inputs now: the ready output and the encoder's raw word.
     pub fn feedback(&self) -> AnalogFeedback {
-        let ready = self.command.enable
-            && !self.fault_latched
-            && self.enabled_for >= self.params.ready_delay
-            && self.enabled_for > 0.0;
         AnalogFeedback {
-            ready,
+            ready: self.amplifier.ready(),
             // The low 32 bits; the counter masks them to `raw_bits`.
             encoder_raw: self.scaling.count(self.position()) as u32,
         }
@@ -1011,25 +1072,14 @@ impl SimAnalogDrive {
         self.speed * 60.0
     }
 
-    /// The latched command.
-    pub fn command(&self) -> &AnalogCommand {
-        &self.command
+    /// The latched command, the ready output and the fault latch. A fault (e.g. overcurrent,
+    /// [`Amplifier::inject_fault`]) drops ready and the drive brakes on its ramp.
+    pub fn amplifier(&self) -> &Amplifier {
+        &self.amplifier
     }
 
-    /// A fault (e.g. overcurrent): ready drops, the drive brakes on its ramp. Latched until
-    /// the cause is cleared and the enable input is off.
-    pub fn inject_fault(&mut self) {
-        self.fault_cause = true;
-        self.fault_latched = true;
-    }
-
-    /// The cause of the fault is gone (the latch stays until the enable input is off).
-    pub fn clear_fault_cause(&mut self) {
-        self.fault_cause = false;
-    }
-
-    /// Whether the drive is in fault.
-    pub fn in_fault(&self) -> bool {
-        self.fault_latched
+    /// The same, to inject or clear a fault.
+    pub fn amplifier_mut(&mut self) -> &mut Amplifier {
+        &mut self.amplifier
     }
 }

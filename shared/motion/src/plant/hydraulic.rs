@@ -30,7 +30,7 @@
 //! mm³/s inside. Integrated with [`SUBSTEPS`] semi-implicit Euler steps per call (the oil spring
 //! is stiff). Pure: no IO, no clock (the cycle time is an input), no allocation.
 
-use super::analog::{word_to_normalized, AnalogCommand, AnalogFeedback};
+use super::analog::{word_to_normalized, Amplifier, AnalogCommand, AnalogFeedback};
 use super::mechanics::Scaling;
 use crate::catalog::hyd_error::HydErrorCode;
 /// Integration steps per [`SimCylinder::step`] call, at least (more when the call is long: no
@@ -411,13 +411,8 @@ pub struct SimValveCylinderParams {
 pub struct SimValveCylinder {
     cylinder: SimCylinder,
     scaling: Scaling,
-    ready_delay: f64,
-    /// The latched command.
-    command: AnalogCommand,
-    /// Time enabled without fault (s), for the ready delay.
-    enabled_for: f64,
-    fault_latched: bool,
-    fault_cause: bool,
+    /// The latched command, the ready output and the fault latch.
+    amplifier: Amplifier,
 }
 
 impl SimValveCylinder {
@@ -434,44 +429,31 @@ impl SimValveCylinder {
         Ok(Self {
             cylinder,
             scaling,
-            ready_delay: p.ready_delay,
-            command: AnalogCommand::default(),
-            enabled_for: 0.0,
-            fault_latched: false,
-            fault_cause: false,
+            amplifier: Amplifier::new(p.ready_delay),
         })
     }
 
-    /// Latches the command of the boundary (its effect starts now); an enable removed with
-    /// the cause gone acknowledges a fault.
+    /// Latches the command of the boundary (its effect starts now).
     pub fn exchange(&mut self, command: &AnalogCommand) {
-        self.command = *command;
-        if !command.enable && !self.fault_cause {
-            self.fault_latched = false;
-        }
+        self.amplifier.exchange(command);
     }
 
     /// Runs `dt_ns` with the latched command.
     pub fn advance(&mut self, dt_ns: i64) {
         let dt = dt_ns.max(0) as f64 * 1e-9;
-        let on = self.command.enable && !self.fault_latched;
-        let u = if on {
-            word_to_normalized(self.command.word)
+        let u = if self.amplifier.on() {
+            word_to_normalized(self.amplifier.command().word)
         } else {
             0.0
         };
         self.cylinder.step(u, dt);
-        self.enabled_for = if on { self.enabled_for + dt } else { 0.0 };
+        self.amplifier.advance(dt);
     }
 
     /// The process image inputs now: the amplifier's ready output and the encoder's raw word.
     pub fn feedback(&self) -> AnalogFeedback {
-        let ready = self.command.enable
-            && !self.fault_latched
-            && self.enabled_for >= self.ready_delay
-            && self.enabled_for > 0.0;
         AnalogFeedback {
-            ready,
+            ready: self.amplifier.ready(),
             // The low 32 bits; the counter masks them to `raw_bits`.
             encoder_raw: self.scaling.count(self.cylinder.state().position) as u32,
         }
@@ -482,26 +464,15 @@ impl SimValveCylinder {
         self.cylinder.state()
     }
 
-    /// The latched command.
-    pub fn command(&self) -> &AnalogCommand {
-        &self.command
+    /// The latched command, the ready output and the fault latch (a fault of the valve
+    /// amplifier commands the spool to 0).
+    pub fn amplifier(&self) -> &Amplifier {
+        &self.amplifier
     }
 
-    /// A fault of the valve amplifier: ready drops, the spool is commanded to 0. Latched until
-    /// the cause is cleared and the enable input is off.
-    pub fn inject_fault(&mut self) {
-        self.fault_cause = true;
-        self.fault_latched = true;
-    }
-
-    /// The cause of the fault is gone (the latch stays until the enable input is off).
-    pub fn clear_fault_cause(&mut self) {
-        self.fault_cause = false;
-    }
-
-    /// Whether the amplifier is in fault.
-    pub fn in_fault(&self) -> bool {
-        self.fault_latched
+    /// The same, to inject or clear a fault.
+    pub fn amplifier_mut(&mut self) -> &mut Amplifier {
+        &mut self.amplifier
     }
 }
 

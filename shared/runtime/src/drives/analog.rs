@@ -10,8 +10,8 @@ use tandem_config::{AnalogDriveConnection, Cell, DeviceKind, DriveConnection};
 use tandem_motion::hydraulic::controller::HydController;
 use tandem_motion::objects::axis::Axis;
 use tandem_motion::plant::analog::{
-    AnalogCommand, AnalogConnection, AnalogConnectionError, AnalogFeedback, AnalogStatus,
-    SimAnalogDrive, SimAnalogParams,
+    Amplifier, AnalogCommand, AnalogConnection, AnalogConnectionError, AnalogFeedback,
+    AnalogStatus, SimAnalogDrive, SimAnalogParams,
 };
 use tandem_motion::plant::hydraulic::SimValveCylinder;
 use tandem_motion::plant::link::{DriveInputs, DriveOutputs};
@@ -48,10 +48,17 @@ impl AnalogDevice {
         }
     }
 
-    fn command(&self) -> AnalogCommand {
+    fn amplifier(&self) -> &Amplifier {
         match self {
-            Self::Motor(d) => *d.command(),
-            Self::Cylinder(d) => *d.command(),
+            Self::Motor(d) => d.amplifier(),
+            Self::Cylinder(d) => d.amplifier(),
+        }
+    }
+
+    fn amplifier_mut(&mut self) -> &mut Amplifier {
+        match self {
+            Self::Motor(d) => d.amplifier_mut(),
+            Self::Cylinder(d) => d.amplifier_mut(),
         }
     }
 
@@ -60,22 +67,6 @@ impl AnalogDevice {
         match self {
             Self::Motor(d) => (d.position(), d.velocity()),
             Self::Cylinder(d) => (d.state().position, d.state().velocity),
-        }
-    }
-
-    fn inject_fault(&mut self, on: bool) {
-        match (self, on) {
-            (Self::Motor(d), true) => d.inject_fault(),
-            (Self::Motor(d), false) => d.clear_fault_cause(),
-            (Self::Cylinder(d), true) => d.inject_fault(),
-            (Self::Cylinder(d), false) => d.clear_fault_cause(),
-        }
-    }
-
-    fn in_fault(&self) -> bool {
-        match self {
-            Self::Motor(d) => d.in_fault(),
-            Self::Cylinder(d) => d.in_fault(),
         }
     }
 }
@@ -271,7 +262,12 @@ impl AnalogDrives {
     /// its ready output drops), or its cause removed (`code == 0`).
     pub(crate) fn inject_fault(&mut self, device: usize, code: u16) {
         if let Some(Some(slot)) = self.slots.get_mut(device) {
-            slot.drive.inject_fault(code != 0);
+            let amplifier = slot.drive.amplifier_mut();
+            if code == 0 {
+                amplifier.clear_fault_cause();
+            } else {
+                amplifier.inject_fault();
+            }
         }
     }
 
@@ -282,11 +278,11 @@ impl AnalogDrives {
         let (position, velocity) = slot.drive.motion();
         Some(AnalogDriveStatus {
             link: *link.connection.status(),
-            latched: slot.drive.command(),
+            latched: *slot.drive.amplifier().command(),
             feedback: slot.feedback,
             position,
             velocity,
-            in_fault: slot.drive.in_fault(),
+            in_fault: slot.drive.amplifier().in_fault(),
         })
     }
 }
