@@ -18,5 +18,6 @@ pub mod controller;
 pub mod finish;
 pub mod generator;
 pub mod monitor;
+pub mod pressure;
 pub mod time_ramp;
 pub mod valve_table;
