@@ -61,6 +61,7 @@ impl Rig {
         let feedback = AnalogFeedback {
             ready: false,
             encoder_raw: c.params.scaling.count(p0) as u32,
+            ..AnalogFeedback::default()
         };
         Self {
             axis,
@@ -81,6 +82,7 @@ impl Rig {
         self.feedback = AnalogFeedback {
             ready: cmd.enable,
             encoder_raw: self.conn.params().scaling.count(out.position) as u32,
+            ..AnalogFeedback::default()
         };
         while self.axis.pop_event().is_some() {}
     }

@@ -507,6 +507,8 @@ pub struct AnalogDriveConnection {
     /// A hydraulic axis' position controller and Finish (`[axes.<name>.hydraulic]`): the
     /// valve's output comes from them instead of the speed controller of `params`.
     pub hydraulic: Option<tandem_motion::hydraulic::controller::HydControllerParams>,
+    /// A hydraulic axis' pressure inputs (`ScaleFactorA` … in `[axes.<name>.hydraulic]`).
+    pub pressure: Option<tandem_motion::hydraulic::pressure::ForceScaling>,
 }
 
 /// An axis on a CiA 402 drive of the process image.

@@ -152,6 +152,20 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         name: "MC_SetOverride",
         params: &[("velocity", None)],
     },
+    // The Beckhoff hydraulic library's pressure or force controller (a hydraulic axis with
+    // pressure inputs).
+    InstructionSpec {
+        name: "MC_AxCtrlPressure_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("set_value", Some(Value::Num(0.0))),
+            ("kp", Some(Value::Num(0.0))),
+            ("tn", Some(Value::Num(0.0))),
+            ("preset", Some(Value::Num(0.0))),
+            ("windup_limit", Some(Value::Num(1.0))),
+            ("force", Some(Value::Bool(true))),
+        ],
+    },
     InstructionSpec {
         name: "MC_MotionInPosition",
         params: &[
@@ -895,6 +909,15 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
         },
         "MC_SetOverride" => Command::SetOverride {
             velocity: a.num("velocity")?,
+        },
+        "MC_AxCtrlPressure_BkPlcMc" => Command::PressureControl {
+            enable: a.flag("enable")?,
+            set_value: a.num("set_value")?,
+            kp: a.num("kp")?,
+            tn: a.num("tn")?,
+            preset: a.num("preset")?,
+            windup_limit: a.num("windup_limit")?,
+            force: a.flag("force")?,
         },
         "MC_MotionInPosition" => Command::MotionInPosition {
             enable: a.flag("enable")?,

@@ -141,6 +141,9 @@ pub struct DeviceSection {
     pub load: Option<f64>,
     /// sim_valve_cylinder: `[devices.<name>.cylinder]`, the valve and the cylinder.
     pub cylinder: Option<CylinderSection>,
+    /// sim_valve_cylinder: the pressure sensors' range (bar at 10 V, input word 27648;
+    /// default 250).
+    pub pressure_range: Option<f64>,
 }
 
 /// `[devices.<name>.cylinder]` of a `sim_valve_cylinder`: a proportional valve and a
@@ -254,6 +257,19 @@ pub struct HydraulicSection {
     pub fValve_BendPointOutput: Option<f64>,
     /// Zero (offset) compensation (V).
     pub fZeroCompensation: Option<f64>,
+    /// The pressure inputs (`MC_AxRtReadForceDiff_BkPlcMc`): chamber A's pressure per input
+    /// increment (bar). Given, the axis reads its two pressure inputs every cycle.
+    pub ScaleFactorA: Option<f64>,
+    /// Chamber A's pressure at input word 0 (bar; default 0).
+    pub ScaleOffsetA: Option<f64>,
+    /// Chamber B's pressure per input increment (bar; default `ScaleFactorA`).
+    pub ScaleFactorB: Option<f64>,
+    /// Chamber B's pressure at input word 0 (bar; default 0).
+    pub ScaleOffsetB: Option<f64>,
+    /// The piston area for the force (mm²; default 1: the pressure).
+    pub ScaleArreaA: Option<f64>,
+    /// The annulus area for the force (mm²; default 1).
+    pub ScaleArreaB: Option<f64>,
 }
 
 /// `[signals.<name>]`: a named signal on a channel of a device. Its type comes from the

@@ -29,6 +29,7 @@ const EXAMPLES: &[&str] = &[
     "analog",
     "inputs",
     "hydraulic",
+    "hydraulic-press",
 ];
 
 fn root() -> PathBuf {

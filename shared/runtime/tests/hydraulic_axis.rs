@@ -318,3 +318,102 @@ fn bad_hydraulic_parameters_are_refused_naming_the_key() {
         assert!(e.to_string().contains(key), "{from} -> {to}: {e}");
     }
 }
+
+/// The press (`config/hydraulic-press.toml` with its script) through the executive: contact,
+/// MC_AxCtrlPressure_BkPlcMc holds 20 kN within 2 % for the second before the decompression,
+/// 2 kN within 5 % before the release, and the ram returns to 300 mm in position control.
+#[test]
+fn the_press_holds_its_force_under_the_force_controller_and_returns() {
+    let root = root();
+    let cell = tandem_config::load(&root.join("config/hydraulic-press.toml")).unwrap();
+    let src = std::fs::read_to_string(root.join("config/hydraulic-press-script.toml")).unwrap();
+    let script =
+        tandem_config::script::parse_cell("hydraulic-press-script.toml", &src, &cell).unwrap();
+    let mut exec = Executive::new(&cell, None).unwrap();
+    let mut log = Vec::new();
+    let (mut next, mut worst_20k, mut worst_2k) = (0, 0.0_f64, 0.0_f64);
+    let mut controlled = 0;
+    for k in 0..=script.duration_ns / MS {
+        let t = k * MS;
+        while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
+            next += 1;
+            let r = exec
+                .apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log)
+                .unwrap();
+            assert!(r.is_ok(), "{r:?}");
+        }
+        exec.step(t, &mut log).unwrap();
+        let h = exec.axis(AxisIndex(0)).unwrap().hydraulic_status().unwrap();
+        let force = h.actual.expect("pressure inputs").force;
+        if h.pressure_control.is_some() {
+            controlled += 1;
+        }
+        if (3000..4000).contains(&k) {
+            worst_20k = worst_20k.max((force - 20_000.0).abs() / 20_000.0);
+        }
+        if (4300..4500).contains(&k) {
+            worst_2k = worst_2k.max((force - 2_000.0).abs() / 2_000.0);
+        }
+    }
+    let log = String::from_utf8(log).unwrap();
+    eprintln!(
+        "20 kN: {:.3} %, 2 kN: {:.3} %",
+        worst_20k * 100.0,
+        worst_2k * 100.0
+    );
+    assert!(worst_20k <= 0.02, "20 kN held within {worst_20k}\n{log}");
+    assert!(worst_2k <= 0.05, "2 kN held within {worst_2k}\n{log}");
+    // The controller ran from its enable (2.5 s) to its release (4.5 s).
+    assert_eq!(controlled, 2000, "{log}");
+    let s = exec.status()[0];
+    assert_eq!(
+        (s.state, s.position),
+        (AxisState::Standstill, 300.0),
+        "{log}"
+    );
+    assert!((s.actual_position - 300.0).abs() < 0.2, "{s:?}");
+    assert!(
+        log.contains("MC_AxCtrlPressure_BkPlcMc job 4: Done"),
+        "{log}"
+    );
+}
+
+#[test]
+fn pressure_control_is_refused_without_pressure_inputs_and_with_bad_parameters() {
+    use tandem_motion::catalog::error_id::ErrorId;
+    let pressure = |enable, kp: f64, windup_limit: f64| {
+        Action::Command(Command::PressureControl {
+            enable,
+            set_value: 1000.0,
+            kp,
+            tn: 0.0,
+            preset: 0.0,
+            windup_limit,
+            force: true,
+        })
+    };
+    // config/hydraulic.toml has no pressure inputs.
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    let t = r.k * MS;
+    let out = r
+        .exec
+        .apply_at(t, t, "ram", "test", pressure(true, 1e-5, 1.0), &mut r.log)
+        .unwrap();
+    assert_eq!(out, Err(ErrorId::IllegalControllerParameter));
+    // The press has them; a negative kP or a WindupLimit of 0 is refused and changes nothing.
+    let root = root();
+    let press = tandem_config::load(&root.join("config/hydraulic-press.toml")).unwrap();
+    let mut r = Run::enabled(&press);
+    for bad in [pressure(true, -1.0, 1.0), pressure(true, 1e-5, 0.0)] {
+        let t = r.k * MS;
+        let out = r
+            .exec
+            .apply_at(t, t, "ram", "test", bad, &mut r.log)
+            .unwrap();
+        assert_eq!(out, Err(ErrorId::IllegalControllerParameter));
+        r.step();
+        assert_eq!(r.state(), AxisState::Standstill);
+        assert!(r.hyd().pressure_control.is_none());
+    }
+}

@@ -248,6 +248,19 @@ fn the_hydraulic_stages_step_without_allocating() {
     assert!(exec.commands == 4 && exec.rejected == 0);
 }
 
+/// A hydraulic press (`config/hydraulic-press.toml`): the pressure inputs, the force controller
+/// (MC_AxCtrlPressure_BkPlcMc) through contact, pressing, decompression and release, and the
+/// return, with 0 allocations.
+#[test]
+fn the_force_control_stages_step_without_allocating() {
+    let cell = example_cell("hydraulic-press");
+    let (mut exec, allocations) = run_counting(&cell, "hydraulic-press");
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    let st = exec.status()[0];
+    assert_eq!((st.state.name(), st.position), ("Standstill", 300.0));
+    assert!(exec.commands == 7 && exec.rejected == 0);
+}
+
 /// The input stage (`config/inputs.toml`): a timestamped input driven by a sensor on the web
 /// feeding a cyclic measuring input, a probe pulsed by the script, and a plain input as the
 /// web's limit switch (alarm 531): sampled, sensed, measured and drained with 0 allocations.

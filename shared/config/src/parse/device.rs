@@ -498,11 +498,17 @@ fn connection(
     Ok(Some(match kind {
         DeviceKind::SimAnalogDrive(_) | DeviceKind::SimValveCylinder(_) => {
             let hydraulic = hydraulic_controller(a, kind, at)?;
+            let pressure = match (&a.hydraulic, hydraulic.is_some()) {
+                (Some(h), true) => super::hydraulic::pressure_inputs(h)
+                    .map_err(|(k, p)| at(&["hydraulic", k], p))?,
+                _ => None,
+            };
             let params = analog_params(a, cycle_ns, enable_timeout_ns, at)?;
             DriveConnection::Analog(Box::new(AnalogDriveConnection {
                 device,
                 params,
                 hydraulic,
+                pressure,
             }))
         }
         DeviceKind::SimServo(servo) => {

@@ -11,6 +11,7 @@ use tandem_motion::hydraulic::generator::{
     Approach, CtrlBasedGenerator, GeneratorError, GeneratorParams,
 };
 use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
+use tandem_motion::hydraulic::pressure::ForceScaling;
 use tandem_motion::objects::axis::HydraulicProfile;
 use tandem_motion::plant::hydraulic::{CylinderParams, SimValveCylinderParams};
 
@@ -208,6 +209,7 @@ pub(super) fn valve_cylinder(d: &DeviceSection) -> Result<SimValveCylinderParams
         cylinder,
         ready_delay: d.ready_delay.unwrap_or(0.01),
         load: d.load.unwrap_or(0.0),
+        pressure_range: d.pressure_range.unwrap_or(250.0),
     };
     for (key, value) in [("ready_delay", p.ready_delay), ("load", p.load)] {
         if !(value.is_finite() && (key == "load" || value >= 0.0)) {
@@ -217,5 +219,34 @@ pub(super) fn valve_cylinder(d: &DeviceSection) -> Result<SimValveCylinderParams
             ));
         }
     }
+    if !(p.pressure_range.is_finite() && p.pressure_range > 0.0) {
+        return Err((
+            "pressure_range",
+            Problem::Invalid("must be a number above 0 (bar at 10 V)"),
+        ));
+    }
     Ok(p)
+}
+
+/// The pressure inputs of section `h` (`None` without `ScaleFactorA`), checked: the key out of
+/// range.
+pub(super) fn pressure_inputs(h: &HydraulicSection) -> Result<Option<ForceScaling>, FieldError> {
+    let Some(factor_a) = h.ScaleFactorA else {
+        return Ok(None);
+    };
+    let s = ForceScaling {
+        factor_a,
+        offset_a: h.ScaleOffsetA.unwrap_or(0.0),
+        factor_b: h.ScaleFactorB.unwrap_or(factor_a),
+        offset_b: h.ScaleOffsetB.unwrap_or(0.0),
+        area_a: h.ScaleArreaA.unwrap_or(1.0),
+        area_b: h.ScaleArreaB.unwrap_or(1.0),
+    };
+    s.check().map_err(|e| {
+        (
+            e.name,
+            Problem::Invalid("out of its range (MC_AxRtReadForceDiff_BkPlcMc)"),
+        )
+    })?;
+    Ok(Some(s))
 }

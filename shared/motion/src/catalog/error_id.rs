@@ -191,6 +191,12 @@ error_ids! {
         /// MC_MoveVelocity - Motion with speed preset', `Mode`); S7-1500 has no BufferMode and
         /// no code for it.
         BufferModeNotAllowed = 0x80F4 => "Tandem extension: BufferMode not allowed now (synchronous operation, MC_Halt, or MoveVelocity behind MoveVelocity).",
+        /// **Tandem extension.** A parameter of a hydraulic axis' controller instruction out of
+        /// its range (MC_AxCtrlPressure_BkPlcMc: `kP`, `Tn`, `PreSet`, `WindupLimit`, the set
+        /// value), or the instruction on an axis that is not hydraulic or has no pressure
+        /// inputs. The Beckhoff hydraulic library answers with `dwTcHydAdsErrIllegalValue`
+        /// (16#0706); S7 has no such instruction.
+        IllegalControllerParameter = 0x80F5 => "Tandem extension: hydraulic controller parameter out of range, or no pressure inputs (Beckhoff hydraulic library: 16#0706).",
         Unspecified = 0x8FFF => "Unspecified error.",
     }
 }
@@ -216,6 +222,7 @@ impl ErrorId {
                 | ErrorId::NotHomed
                 | ErrorId::JobRejectedInErrorStop
                 | ErrorId::BufferModeNotAllowed
+                | ErrorId::IllegalControllerParameter
         )
     }
 }
@@ -297,13 +304,13 @@ mod tests {
             assert_eq!(ErrorId::from_code(code), None);
         }
         // 73 codes in S7-1500T Motion Control V4.0 function manual, A.9 'Error ID for Motion
-        // Control instructions', plus 5 tandem extensions.
+        // Control instructions', plus 6 tandem extensions.
         let reference = ErrorId::ALL
             .iter()
             .filter(|e| !e.is_tandem_extension())
             .count();
         assert_eq!(reference, 73);
-        assert_eq!(ErrorId::ALL.len(), 78);
+        assert_eq!(ErrorId::ALL.len(), 79);
     }
 
     #[test]

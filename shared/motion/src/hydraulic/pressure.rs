@@ -196,6 +196,12 @@ impl PressureController {
         &self.p
     }
 
+    /// The controller with new parameters `p` (checked by [`PressureController::new`]), its
+    /// state (active, I part) kept: a change while it runs (no new `PreSet`).
+    pub fn retuned(self, p: PressureParams) -> Self {
+        Self { p, ..self }
+    }
+
     /// One cycle of `dt` seconds: `Enable`, `Reset`, the set value `fSetPressure` and the
     /// actual values. A non-finite set or actual value holds the output at its I part.
     pub fn step(

@@ -42,6 +42,8 @@ pub enum Instruction {
     MotionInPosition,
     /// `MC_MotionInVelocity`.
     MotionInVelocity,
+    /// `MC_AxCtrlPressure_BkPlcMc` (Beckhoff hydraulic library): pressure or force control.
+    PressureControl,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -84,6 +86,7 @@ impl Instruction {
             Self::SetOverride => "MC_SetOverride",
             Self::MotionInPosition => "MC_MotionInPosition",
             Self::MotionInVelocity => "MC_MotionInVelocity",
+            Self::PressureControl => "MC_AxCtrlPressure_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::GearOut => "MC_GearOut",

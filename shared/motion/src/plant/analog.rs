@@ -35,6 +35,7 @@ use super::drive::{Actual, Plant};
 use super::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
 use super::mechanics::{RawCounter, Scaling, DEGREES_PER_REVOLUTION};
 use crate::hydraulic::controller::{HydControlInput, HydController};
+use crate::hydraulic::pressure::{ActualForce, ForceScaling};
 
 /// The word of an S7 analog output at its nominal value: ±27648 is ±10 V, ±100 % of the
 /// reference speed (S7 analog value representation, output ranges ±10 V).
@@ -557,6 +558,11 @@ pub struct AnalogFeedback {
     /// The encoder's raw position word (its low `raw_bits` count; an incremental encoder's
     /// counter on a technology module, e.g. an EL5101 counter value).
     pub encoder_raw: u32,
+    /// The pressure sensor of chamber A of a hydraulic axis, its analog input word (0 where
+    /// there is none).
+    pub pressure_a: i16,
+    /// The pressure sensor of chamber B, its analog input word.
+    pub pressure_b: i16,
 }
 
 /// The configuration of an axis's analog drive connection.
@@ -603,6 +609,9 @@ pub struct AnalogConnection {
     /// A hydraulic axis' position controller and Finish, in place of `controller`'s speed
     /// setpoint ([`AnalogConnection::hydraulic`]).
     hydraulic: Option<HydController>,
+    /// A hydraulic axis' pressure inputs: their scaling, and the actual values of the last
+    /// sample.
+    force: Option<(ForceScaling, ActualForce)>,
     enable: AnalogEnable,
     /// The encoder's raw word extended, from the first sample on.
     counter: Option<RawCounter>,
@@ -631,6 +640,7 @@ impl AnalogConnection {
             params,
             controller,
             hydraulic: None,
+            force: None,
             enable,
             counter: None,
             previous_count: 0,
@@ -655,6 +665,22 @@ impl AnalogConnection {
         let mut c = Self::new(params, plant, p0)?;
         c.hydraulic = Some(hydraulic);
         Ok(c)
+    }
+
+    /// Reads the two pressure inputs of each sample with `scaling`
+    /// (`MC_AxRtReadForceDiff_BkPlcMc`): [`AnalogConnection::actual_force`].
+    pub fn with_pressure_inputs(
+        mut self,
+        scaling: ForceScaling,
+    ) -> Result<Self, AnalogConnectionError> {
+        scaling.check().map_err(AnalogConnectionError::Pressure)?;
+        self.force = Some((scaling, ActualForce::default()));
+        Ok(self)
+    }
+
+    /// The pressures and the force of the last sample; `None` without pressure inputs.
+    pub fn actual_force(&self) -> Option<&ActualForce> {
+        self.force.as_ref().map(|(_, a)| a)
     }
 
     /// The configuration.
@@ -694,6 +720,9 @@ impl AnalogConnection {
             }
         };
         self.previous_count = count;
+        if let Some((s, a)) = &mut self.force {
+            *a = s.read(fb.pressure_a, fb.pressure_b);
+        }
         let p = scaling.position(count);
         let prev = std::mem::replace(&mut self.actual, p);
         let out = self
@@ -797,6 +826,8 @@ pub enum AnalogConnectionError {
     Hydraulic(crate::hydraulic::finish::FinishError),
     /// A simulated valve and cylinder's parameter.
     Cylinder(crate::plant::hydraulic::CylinderError),
+    /// The scaling of a hydraulic axis' pressure inputs.
+    Pressure(crate::hydraulic::pressure::PressureError),
 }
 
 impl fmt::Display for AnalogConnectionError {
@@ -806,6 +837,7 @@ impl fmt::Display for AnalogConnectionError {
             Self::Timeout(e) => write!(f, "analog drive: {e}"),
             Self::Hydraulic(e) => write!(f, "hydraulic axis: {e}"),
             Self::Cylinder(e) => write!(f, "valve and cylinder: {e}"),
+            Self::Pressure(e) => write!(f, "pressure inputs: {e}"),
         }
     }
 }
@@ -1054,6 +1086,8 @@ impl SimAnalogDrive {
             ready: self.amplifier.ready(),
             // The low 32 bits; the counter masks them to `raw_bits`.
             encoder_raw: self.scaling.count(self.position()) as u32,
+            pressure_a: 0,
+            pressure_b: 0,
         }
     }
 

@@ -400,6 +400,9 @@ pub struct SimValveCylinderParams {
     pub ready_delay: f64,
     /// A constant external load force (N, against positive motion).
     pub load: f64,
+    /// The pressure sensors' range (bar at 10 V, the input word 27648; > 0): each chamber's
+    /// pressure is read through a 16-bit analog input.
+    pub pressure_range: f64,
 }
 
 /// A proportional valve with its amplifier on an analog output (enable DO and output word
@@ -413,6 +416,8 @@ pub struct SimValveCylinder {
     scaling: Scaling,
     /// The latched command, the ready output and the fault latch.
     amplifier: Amplifier,
+    /// The pressure inputs' words per bar.
+    words_per_bar: f64,
 }
 
 impl SimValveCylinder {
@@ -424,12 +429,19 @@ impl SimValveCylinder {
                 return Err(CylinderError { name, value });
             }
         }
+        if !(p.pressure_range.is_finite() && p.pressure_range > 0.0) {
+            return Err(CylinderError {
+                name: "pressure_range",
+                value: p.pressure_range,
+            });
+        }
         let mut cylinder = SimCylinder::new(p.cylinder, x)?;
         cylinder.set_load(p.load);
         Ok(Self {
             cylinder,
             scaling,
             amplifier: Amplifier::new(p.ready_delay),
+            words_per_bar: f64::from(super::analog::NOMINAL_WORD) / p.pressure_range,
         })
     }
 
@@ -456,7 +468,14 @@ impl SimValveCylinder {
             ready: self.amplifier.ready(),
             // The low 32 bits; the counter masks them to `raw_bits`.
             encoder_raw: self.scaling.count(self.cylinder.state().position) as u32,
+            pressure_a: self.word(self.cylinder.state().pressure_a),
+            pressure_b: self.word(self.cylinder.state().pressure_b),
         }
+    }
+
+    /// A pressure's analog input word (rounded, saturated).
+    fn word(&self, bar: f64) -> i16 {
+        (bar * self.words_per_bar).round().clamp(-32768.0, 32767.0) as i16
     }
 
     /// The cylinder's state (position, velocity, pressures, force, spool, flows).

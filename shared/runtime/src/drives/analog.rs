@@ -114,6 +114,10 @@ impl AnalogLink {
             )?,
             None => AnalogConnection::new(c.params, plant, p0)?,
         };
+        let connection = match c.pressure {
+            Some(s) => connection.with_pressure_inputs(s)?,
+            None => connection,
+        };
         Ok(Self {
             axis,
             device: c.device.0,
@@ -298,6 +302,9 @@ impl AnalogDrives {
             };
             if let (Some(inputs), Some(a)) = (self.inputs(k, t), axes.get_mut(axis)) {
                 a.set_drive_inputs(&inputs);
+                if let Some(f) = self.links.get(k).and_then(|l| l.connection.actual_force()) {
+                    a.set_hydraulic_actual(f);
+                }
             }
         }
     }

@@ -425,6 +425,27 @@ pub enum Command {
         /// `VelocityDiff` (as `velocity`), `Acceleration`, `Deceleration`, `Jerk`.
         dynamics: Dynamics,
     },
+    /// The pressure or force controller of a hydraulic axis (Beckhoff TwinCAT PLC Hydraulic
+    /// Positioning library, `MC_AxCtrlPressure_BkPlcMc` with `fSetPressure`): with `enable` it
+    /// takes the control value from the generator and controls the actual pressure or force
+    /// to `set_value`; without, the axis stands in position control where it is.
+    #[doc(alias = "MC_AxCtrlPressure_BkPlcMc")]
+    PressureControl {
+        /// `Enable`.
+        enable: bool,
+        /// `fSetPressure`: bar, or N with `force`.
+        set_value: f64,
+        /// `kP`: output (normalised) per bar or per N.
+        kp: f64,
+        /// `Tn` (s; 0: no I part).
+        tn: f64,
+        /// `PreSet`: the I part on enabling.
+        preset: f64,
+        /// `WindupLimit` (> 0).
+        windup_limit: f64,
+        /// `ReadingMode`: the force (`iTcHydPressureReadingActForce`), else the pressure.
+        force: bool,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

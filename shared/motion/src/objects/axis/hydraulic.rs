@@ -17,9 +17,12 @@
 //! [`DriveOutputs::position_controlled`]: crate::plant::link::DriveOutputs::position_controlled
 
 use super::{Axis, Goal};
+use crate::catalog::error_id::ErrorId;
 use crate::hydraulic::generator::{CtrlBasedGenerator, HydState, Setpoint};
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
+use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
 use crate::kinematics::profile::{Profile, State};
+use crate::objects::job::{Instruction, JobEventKind, JobId};
 
 /// The hydraulic part of an axis (boxed in the axis: allocated when it is built).
 #[derive(Clone, Debug, PartialEq)]
@@ -32,6 +35,22 @@ pub(super) struct HydAxis {
     last: Setpoint,
     /// The target window of the last cycle.
     window: TargetStatus,
+    /// `fRefVelo` (mm/s): the velocity of a control value of 1.0.
+    ref_velo: f64,
+    /// The pressures and the force of the last sample; `None` without pressure inputs.
+    actual: Option<ActualForce>,
+    /// The running MC_AxCtrlPressure_BkPlcMc job.
+    pressure: Option<PressureJob>,
+}
+
+/// A running pressure or force control.
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct PressureJob {
+    ctrl: PressureController,
+    /// `fSetPressure`.
+    set: f64,
+    job: JobId,
+    last: PressureOutput,
 }
 
 /// What a hydraulic axis shows besides the axis' status.
@@ -50,6 +69,12 @@ pub struct HydraulicStatus {
     pub in_target_range: bool,
     /// `dwTcHydNsDwInTarget`.
     pub in_target: bool,
+    /// The pressures and the force of the last sample (`fActPressureA`, `fActPressureB`,
+    /// `fActPressure`, `fActForce`); `None` without pressure inputs.
+    pub actual: Option<ActualForce>,
+    /// The pressure or force controller runs (MC_AxCtrlPressure_BkPlcMc), with its set value
+    /// and its output of the last cycle.
+    pub pressure_control: Option<(f64, PressureOutput)>,
 }
 
 impl HydAxis {
@@ -70,6 +95,9 @@ impl HydAxis {
                 position_control: true,
             },
             window: TargetStatus::default(),
+            ref_velo: cfg.generator.ref_velo,
+            actual: None,
+            pressure: None,
         }))
     }
 }
@@ -125,6 +153,9 @@ impl Axis {
     /// One cycle of the engaged generator from the actual position: the basic setpoint and the
     /// target window. Returns whether the generator computed the setpoint.
     pub(super) fn hyd_generate(&mut self) -> bool {
+        if self.hyd_pressure_generate() {
+            return true;
+        }
         let dt = self.cfg.cycle;
         let (actual, actual_v, v0) = (self.actual_p, self.actual_v, self.basic.v);
         let its_goal = matches!(
@@ -171,13 +202,117 @@ impl Axis {
             .map(|h| h.window.done)
     }
 
-    /// Whether the position controller acts: not while the engaged generator runs a move.
+    /// Whether the position controller acts: not while the engaged generator runs a move, nor
+    /// while the pressure controller gives the control value (it cancels `fLagCtrlOutput`).
     pub(super) fn hyd_position_control(&self) -> bool {
-        self.hyd
-            .as_deref()
-            .filter(|h| h.engaged)
-            .map(|h| h.last.position_control)
-            .unwrap_or(true)
+        match self.hyd.as_deref() {
+            Some(h) if h.pressure.is_some() => false,
+            Some(h) if h.engaged => h.last.position_control,
+            _ => true,
+        }
+    }
+
+    /// The pressures and the force of the sample of this cycle, for a hydraulic axis with
+    /// pressure inputs (the edge sets them with the drive inputs, before the step).
+    pub fn set_hydraulic_actual(&mut self, actual: &ActualForce) {
+        if let Some(h) = self.hyd.as_deref_mut() {
+            h.actual = Some(*actual);
+        }
+    }
+
+    /// `MC_AxCtrlPressure_BkPlcMc`: with `enable` the pressure or force controller takes the
+    /// control value (a running one takes the new set value and parameters, its I part
+    /// kept); without, a running one ends (Done) and the axis stands in position control at
+    /// its actual position. Refused (16#80F5) on an axis that is not hydraulic or has no
+    /// pressure inputs, or with a parameter out of its range.
+    pub(super) fn cmd_pressure_control(
+        &mut self,
+        enable: bool,
+        set: f64,
+        params: PressureParams,
+    ) -> Result<JobId, ErrorId> {
+        let refused = ErrorId::IllegalControllerParameter;
+        let running = self.hyd.as_deref().ok_or(refused)?.pressure;
+        if self.hyd.as_deref().is_some_and(|h| h.actual.is_none()) {
+            return Err(refused);
+        }
+        if !enable {
+            let Some(pj) = running else {
+                let id = self.new_id();
+                self.emit(id, Instruction::PressureControl, JobEventKind::Done);
+                return Ok(id);
+            };
+            self.hyd_pressure_end();
+            self.basic = State::rest(self.actual_p);
+            self.finish_main(pj.job, Instruction::PressureControl);
+            return Ok(pj.job);
+        }
+        self.check_motion_allowed()?;
+        if !set.is_finite() {
+            return Err(refused);
+        }
+        let mut ctrl = PressureController::new(params).map_err(|_| refused)?;
+        if let Some(pj) = running {
+            ctrl = pj.ctrl.retuned(params);
+            if let Some(p) = self.hyd.as_deref_mut().and_then(|h| h.pressure.as_mut()) {
+                *p = PressureJob { ctrl, set, ..*p };
+            }
+            return Ok(pj.job);
+        }
+        self.fold_superimposed();
+        let v = self.basic.v;
+        let lim = self.default_limits();
+        let job = self.start_main(
+            Instruction::PressureControl,
+            lim,
+            Goal::Direct {
+                position: None,
+                v,
+                a: 0.0,
+            },
+        );
+        if let Some(h) = self.hyd.as_deref_mut() {
+            h.pressure = Some(PressureJob {
+                ctrl,
+                set,
+                job,
+                last: PressureOutput::default(),
+            });
+        }
+        Ok(job)
+    }
+
+    /// The pressure controller no longer runs.
+    fn hyd_pressure_end(&mut self) {
+        if let Some(h) = self.hyd.as_deref_mut() {
+            h.pressure = None;
+        }
+    }
+
+    /// One cycle of a running pressure or force control: the control value from the
+    /// controller, the set position following the actual one (no position control). Returns
+    /// whether it ran; a pressure job that is no longer the axis' job (aborted) ends it.
+    fn hyd_pressure_generate(&mut self) -> bool {
+        let (dt, actual_p) = (self.cfg.cycle, self.actual_p);
+        let main = self.main.map(|m| m.id);
+        let Some(h) = self.hyd.as_deref_mut() else {
+            return false;
+        };
+        let Some(pj) = h.pressure.as_mut() else {
+            return false;
+        };
+        if main != Some(pj.job) {
+            h.pressure = None;
+            return false;
+        }
+        let actual = h.actual.unwrap_or_default();
+        pj.last = pj.ctrl.step(true, false, pj.set, &actual, dt);
+        self.basic = State {
+            p: actual_p,
+            v: pj.last.set_speed * h.ref_velo,
+            a: 0.0,
+        };
+        true
     }
 
     /// The hydraulic axis' generator and target window; `None` for an electric axis.
@@ -189,6 +324,8 @@ impl Axis {
             target: h.gen.target(),
             in_target_range: h.window.in_target_range,
             in_target: h.window.in_target,
+            actual: h.actual,
+            pressure_control: h.pressure.map(|p| (p.set, p.last)),
         })
     }
 }

@@ -1044,6 +1044,29 @@ impl Axis {
             | Command::Offset { .. }
             | Command::Phasing { .. } => self.apply_sync(cmd),
             Command::SetOverride { velocity } => self.cmd_set_override(velocity),
+            Command::PressureControl {
+                enable,
+                set_value,
+                kp,
+                tn,
+                preset,
+                windup_limit,
+                force,
+            } => self.cmd_pressure_control(
+                enable,
+                set_value,
+                crate::hydraulic::pressure::PressureParams {
+                    kp,
+                    tn,
+                    preset,
+                    windup_limit,
+                    reading: if force {
+                        crate::hydraulic::pressure::PressureReading::Force
+                    } else {
+                        crate::hydraulic::pressure::PressureReading::Pressure
+                    },
+                },
+            ),
             Command::MotionInPosition {
                 enable,
                 position,

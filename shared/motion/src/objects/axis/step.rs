@@ -176,6 +176,7 @@ impl Axis {
         let dt = self.cfg.cycle;
         let by_generator = self.hyd_generate();
         match self.goal {
+            _ if by_generator => {}
             Goal::Direct {
                 position: Some(p),
                 v,
@@ -201,7 +202,6 @@ impl Axis {
                 };
                 self.sup = State::default();
             }
-            _ if by_generator => {}
             _ => self.basic = self.prof.at(self.elapsed(self.t0)),
         }
         if let Some(j) = &self.sup_job {
@@ -627,7 +627,7 @@ impl Axis {
             .unwrap_or_else(|| self.elapsed(self.t0) >= self.prof.duration())
     }
 
-    fn finish_main(&mut self, id: crate::objects::job::JobId, instr: Instruction) {
+    pub(super) fn finish_main(&mut self, id: crate::objects::job::JobId, instr: Instruction) {
         self.main = None;
         self.emit(id, instr, JobEventKind::Done);
         // A Buffered job waiting behind it starts now (PLCopen BufferMode).
@@ -879,7 +879,8 @@ impl Axis {
                     Instruction::MoveVelocity
                     | Instruction::MoveJog
                     | Instruction::MotionInPosition
-                    | Instruction::MotionInVelocity,
+                    | Instruction::MotionInVelocity
+                    | Instruction::PressureControl,
                 ) => AxisState::ContinuousMotion,
                 Some(_) => AxisState::DiscreteMotion,
                 None if self.sync.is_some() => AxisState::SynchronizedMotion,
