@@ -353,6 +353,10 @@ struct Outcome {
     steal: f64,
     /// The engine alone on the same cell and script.
     engine: EngineOnly,
+    /// The engine alone, sleeping to each cycle's start and reading the statuses every
+    /// [`TELEMETRY_EVERY`] cycles as the node does: what a cycle costs without the node's own
+    /// work (IPC, telemetry, recording, its other threads).
+    asleep: EngineOnly,
 }
 
 /// The engine alone on the same cell and script: `Executive::step` of the node's objects in a
@@ -368,6 +372,9 @@ struct EngineOnly {
     p50_us: f64,
     /// The thread's CPU time per cycle (µs).
     cpu_us: f64,
+    /// The thread's CPU time per cycle over the whole loop (µs): with `sleep`, the wake-ups'
+    /// cost too.
+    loop_cpu_us: f64,
 }
 
 impl EngineOnly {
@@ -391,6 +398,9 @@ struct EngineRun {
     /// Before each cycle, evict the caches (write a buffer larger than the last-level cache),
     /// outside the measured time: the engine as a node finds its state after sleeping, at worst.
     cold: bool,
+    /// Sleep to each cycle's start on the real clock (1 ms grid) as the node does, so that the
+    /// engine finds the caches, TLB and branch predictors as a sleeping node finds them.
+    sleep: bool,
 }
 
 /// Bytes written to evict the caches (twice the machine's 32 MiB L3).
@@ -420,8 +430,15 @@ fn engine_only(
         Vec::new()
     };
     let (mut cpu, mut wall) = (0, 0);
+    // Cycle 0 on the next ms boundary, 2 ms from now (when sleeping).
+    let epoch = (rt::now_ns() + 2 * cycle_ns) / cycle_ns * cycle_ns;
+    let loop0 = rt::thread_cpu_ns();
     for k in 0..cycles {
         let t = k * cycle_ns;
+        if run.sleep {
+            // An overrun runs the next cycle at once, as the node does below its rejoin bound.
+            rt::sleep_until(epoch + t);
+        }
         for (i, x) in evict.iter_mut().enumerate().step_by(64) {
             *x = x.wrapping_add(i as u8);
         }
@@ -454,6 +471,7 @@ fn engine_only(
         mean_us: wall as f64 / n / 1e3,
         p50_us: hist.quantile_us(0.5),
         cpu_us: cpu as f64 / n / 1e3,
+        loop_cpu_us: (rt::thread_cpu_ns() - loop0) as f64 / n / 1e3,
     })
 }
 
@@ -478,6 +496,7 @@ fn engine_alone(n: usize, seconds: f64, dir: &Path, cold: bool) -> Result<(), St
     let run = EngineRun {
         read_status: Some(TELEMETRY_EVERY),
         cold,
+        sleep: false,
     };
     let e = engine_only(&cell_path, &script_path, seconds, run)?;
     println!(
@@ -538,6 +557,22 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         engine.p50_us,
         engine.cpu_us,
         engine.percent()
+    );
+    let asleep_run = EngineRun {
+        read_status: Some(TELEMETRY_EVERY),
+        cold: false,
+        sleep: true,
+    };
+    let asleep = engine_only(&cell_path, &script_path, seconds, asleep_run)?;
+    eprintln!(
+        "tandem-bench-axes: {n} axes, engine only, sleeping to each 1 ms cycle: step {:.1} µs \
+         mean, {:.0} µs p50, CPU {:.1} µs per cycle ({:.1} % of a core), {:.1} µs with the \
+         wake-ups",
+        asleep.mean_us,
+        asleep.p50_us,
+        asleep.cpu_us,
+        asleep.percent(),
+        asleep.loop_cpu_us
     );
 
     let stop = Arc::new(AtomicBool::new(false));
@@ -658,6 +693,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         threads,
         steal,
         engine,
+        asleep,
     })
 }
 
@@ -673,13 +709,14 @@ fn verdict(ok: bool) -> &'static str {
 fn print_engine_table(outcomes: &[Outcome]) {
     println!();
     println!(
-        "{:>5} | {:>14} | {:>14} {:>14} | {:>36} | {:>11}",
+        "{:>5} | {:>14} | {:>13} | {:>14} {:>14} | {:>36} | {:>17}",
         "axes",
         "engine CPU",
+        "asleep µs",
         "cyclic CPU",
         "process CPU",
         "stages µs: recv/cmds/step/publ/rec",
-        "node/engine"
+        "node/engine/asleep"
     );
     for o in outcomes {
         let r = &o.report;
@@ -690,10 +727,12 @@ fn print_engine_table(outcomes: &[Outcome]) {
         let process = per(r.cpu_ns);
         let st = &r.stages;
         println!(
-            "{:>5} | {:>6.1} µs {:>4.1}% | {:>6.1} µs {:>4.1}% {:>6.1} µs {:>4.1}% | {:>6.1}/{:>5.1}/{:>6.1}/{:>5.1}/{:>6.1} | {:>5.2} {:>5.2}",
+            "{:>5} | {:>6.1} µs {:>4.1}% | {:>6.1} {:>6.1} | {:>6.1} µs {:>4.1}% {:>6.1} µs {:>4.1}% | {:>6.1}/{:>5.1}/{:>6.1}/{:>5.1}/{:>6.1} | {:>5.2} {:>5.2} {:>5.2}",
             o.n,
             o.engine.cpu_us,
             o.engine.percent(),
+            o.asleep.cpu_us,
+            o.asleep.loop_cpu_us,
             cyclic,
             pct(cyclic),
             process,
@@ -705,14 +744,18 @@ fn print_engine_table(outcomes: &[Outcome]) {
             per(st.record_ns),
             tandem_bench::ratio(cyclic, o.engine.cpu_us),
             tandem_bench::ratio(process, o.engine.cpu_us),
+            tandem_bench::ratio(process, o.asleep.loop_cpu_us),
         );
     }
     println!(
         "engine CPU: the engine alone (Executive::step of the same cell and script in a tight \
-         loop, this thread's CPU time per cycle); cyclic CPU: the node's cyclic thread; process \
-         CPU: the whole process (every thread of the node and this bench's telemetry watcher), \
-         both per cycle run and in % of a core at 1 ms; stages: wall time per cycle of the \
-         node's stages; node/engine: cyclic / engine and process / engine."
+         loop, this thread's CPU time per cycle); asleep: the engine alone sleeping to each 1 ms \
+         cycle as the node does and reading the statuses every {TELEMETRY_EVERY}th cycle, CPU per \
+         cycle of its steps, then of its whole loop (the wake-ups too); cyclic CPU: the node's \
+         cyclic thread; process CPU: the whole process (every thread of the node and this \
+         bench's telemetry watcher), both per cycle run and in % of a core at 1 ms; stages: wall \
+         time per cycle of the node's stages; node/engine/asleep: cyclic / engine, process / \
+         engine and process / asleep loop (the node's own share)."
     );
 }
 
