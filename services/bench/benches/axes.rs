@@ -5,7 +5,11 @@
 //! moves back and forth, gear followers of `master` (MC_GearIn, ratios 1/2, 1 and 3/2) and cam
 //! followers of `master` (MC_CamIn on the cross cutter's cam, application mode 2, phases spread
 //! over the cam). The cell and a script are generated into a temporary directory, validated
-//! with `tandem_config`, and run with [`tandem_node::run`] for a fixed engine time.
+//! with `tandem_config`, and run with [`tandem_node::run`] for a fixed engine time. Before
+//! the node, the engine alone runs the same cell and script twice: back to back (a tight
+//! loop), and sleeping to each 1 ms cycle as the node does, so that the node's own cost
+//! (process − the sleeping engine) is told apart from the cost of running once per
+//! millisecond (cold caches, wake-ups; docs/processes.md, "Performance").
 //!
 //! A run fails (exit code 1) when the node's log has an alarm, a rejected command or a job that
 //! ended in error, when the node's telemetry showed an axis with an alarm or in ErrorStop, or
