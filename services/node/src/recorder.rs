@@ -70,7 +70,7 @@ impl Lost {
 }
 
 /// The recorder's turn when the cyclic thread does not wake it (ms): each turn is a wake-up
-/// of a sleeping thread (about 40 µs of CPU on the project's VM, as much as a cycle's), so
+/// of a sleeping thread (20 to 35 µs of CPU on the project's 2-CPU VM, bench axes), so
 /// the recorder sleeps long and the cyclic thread wakes it when its channels fill
 /// (docs/processes.md, "Performance").
 pub(crate) const IDLE_TURN_MS: u64 = 20;
