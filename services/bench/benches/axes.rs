@@ -5,7 +5,11 @@
 //! moves back and forth, gear followers of `master` (MC_GearIn, ratios 1/2, 1 and 3/2) and cam
 //! followers of `master` (MC_CamIn on the cross cutter's cam, application mode 2, phases spread
 //! over the cam). The cell and a script are generated into a temporary directory, validated
-//! with `tandem_config`, and run with [`tandem_node::run`] for a fixed engine time.
+//! with `tandem_config`, and run with [`tandem_node::run`] for a fixed engine time. Before
+//! the node, the engine alone runs the same cell and script twice: back to back (a tight
+//! loop), and sleeping to each 1 ms cycle as the node does, so that the node's own cost
+//! (process − the sleeping engine) is told apart from the cost of running once per
+//! millisecond (cold caches, wake-ups; docs/processes.md, "Performance").
 //!
 //! A run fails (exit code 1) when the node's log has an alarm, a rejected command or a job that
 //! ended in error, when the node's telemetry showed an axis with an alarm or in ErrorStop, or
@@ -20,6 +24,19 @@ use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tandem_bench::{cargo_bench_flag, mib, rss, thread_ticks, Steal};
+
+/// Per thread of this process: (tid, name, CPU time in ns from `/proc/self/task/<tid>/schedstat`,
+/// exact where `thread_ticks` counts 10 ms ticks); a thread whose file cannot be read is left out.
+fn thread_cpu_ns() -> Vec<(u32, String, u64)> {
+    thread_ticks()
+        .into_iter()
+        .filter_map(|(tid, name, _)| {
+            let stat = std::fs::read_to_string(format!("/proc/self/task/{tid}/schedstat")).ok()?;
+            let ns = stat.split_whitespace().next()?.parse::<u64>().ok()?;
+            Some((tid, name, ns))
+        })
+        .collect()
+}
 use tandem_node::{Options, Report};
 use tandem_protocol::ipc as tipc;
 use tandem_protocol::wire::STATE_NAMES;
@@ -242,8 +259,8 @@ struct Seen {
     problems: Vec<(u32, u32, u32)>,
     /// The last snapshot: (axis, state, sync_function) per axis.
     last: Vec<(u32, u32, u32)>,
-    /// Per thread of the process: (tid, name, CPU ticks at the first snapshot or when first
-    /// seen after it, CPU ticks at the last look).
+    /// Per thread of the process: (tid, name, CPU ns at the first snapshot or 0 when first
+    /// seen after it, CPU ns at the last look).
     threads: Vec<(u32, String, u64, u64)>,
 }
 
@@ -251,7 +268,7 @@ impl Seen {
     /// Notes the threads' CPU time; threads first seen after the first snapshot start at 0.
     fn look_at_threads(&mut self) {
         let first = self.threads.is_empty();
-        for (tid, name, ticks) in thread_ticks() {
+        for (tid, name, ticks) in thread_cpu_ns() {
             match self.threads.iter_mut().find(|t| t.0 == tid) {
                 Some(t) => t.3 = ticks,
                 None => self
@@ -273,12 +290,12 @@ impl Seen {
                 } else {
                     name.clone()
                 };
-                (name, b.saturating_sub(*a) * 10)
+                (name, b.saturating_sub(*a))
             })
             .collect();
-        v.sort_by_key(|(name, ms)| (!name.starts_with("cyclic"), u64::MAX - ms));
+        v.sort_by_key(|(name, ns)| (!name.starts_with("cyclic"), u64::MAX - ns));
         v.iter()
-            .map(|(name, ms)| format!("{name} {ms}"))
+            .map(|(name, ns)| format!("{name} {:.1}", *ns as f64 / 1e6))
             .collect::<Vec<_>>()
             .join(", ")
     }
@@ -353,6 +370,10 @@ struct Outcome {
     steal: f64,
     /// The engine alone on the same cell and script.
     engine: EngineOnly,
+    /// The engine alone, sleeping to each cycle's start and reading the statuses every
+    /// [`TELEMETRY_EVERY`] cycles as the node does: what a cycle costs without the node's own
+    /// work (IPC, telemetry, recording, its other threads).
+    asleep: EngineOnly,
 }
 
 /// The engine alone on the same cell and script: `Executive::step` of the node's objects in a
@@ -368,6 +389,9 @@ struct EngineOnly {
     p50_us: f64,
     /// The thread's CPU time per cycle (µs).
     cpu_us: f64,
+    /// The thread's CPU time per cycle over the whole loop (µs): with `sleep`, the wake-ups'
+    /// cost too.
+    loop_cpu_us: f64,
 }
 
 impl EngineOnly {
@@ -391,6 +415,9 @@ struct EngineRun {
     /// Before each cycle, evict the caches (write a buffer larger than the last-level cache),
     /// outside the measured time: the engine as a node finds its state after sleeping, at worst.
     cold: bool,
+    /// Sleep to each cycle's start on the real clock (1 ms grid) as the node does, so that the
+    /// engine finds the caches, TLB and branch predictors as a sleeping node finds them.
+    sleep: bool,
 }
 
 /// Bytes written to evict the caches (twice the machine's 32 MiB L3).
@@ -420,8 +447,15 @@ fn engine_only(
         Vec::new()
     };
     let (mut cpu, mut wall) = (0, 0);
+    // Cycle 0 on the next ms boundary, 2 ms from now (when sleeping).
+    let epoch = (rt::now_ns() + 2 * cycle_ns) / cycle_ns * cycle_ns;
+    let loop0 = rt::thread_cpu_ns();
     for k in 0..cycles {
         let t = k * cycle_ns;
+        if run.sleep {
+            // An overrun runs the next cycle at once, as the node does below its rejoin bound.
+            rt::sleep_until(epoch + t);
+        }
         for (i, x) in evict.iter_mut().enumerate().step_by(64) {
             *x = x.wrapping_add(i as u8);
         }
@@ -454,6 +488,7 @@ fn engine_only(
         mean_us: wall as f64 / n / 1e3,
         p50_us: hist.quantile_us(0.5),
         cpu_us: cpu as f64 / n / 1e3,
+        loop_cpu_us: (rt::thread_cpu_ns() - loop0) as f64 / n / 1e3,
     })
 }
 
@@ -478,6 +513,7 @@ fn engine_alone(n: usize, seconds: f64, dir: &Path, cold: bool) -> Result<(), St
     let run = EngineRun {
         read_status: Some(TELEMETRY_EVERY),
         cold,
+        sleep: false,
     };
     let e = engine_only(&cell_path, &script_path, seconds, run)?;
     println!(
@@ -538,6 +574,22 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         engine.p50_us,
         engine.cpu_us,
         engine.percent()
+    );
+    let asleep_run = EngineRun {
+        read_status: Some(TELEMETRY_EVERY),
+        cold: false,
+        sleep: true,
+    };
+    let asleep = engine_only(&cell_path, &script_path, seconds, asleep_run)?;
+    eprintln!(
+        "tandem-bench-axes: {n} axes, engine only, sleeping to each 1 ms cycle: step {:.1} µs \
+         mean, {:.0} µs p50, CPU {:.1} µs per cycle ({:.1} % of a core), {:.1} µs with the \
+         wake-ups",
+        asleep.mean_us,
+        asleep.p50_us,
+        asleep.cpu_us,
+        asleep.percent(),
+        asleep.loop_cpu_us
     );
 
     let stop = Arc::new(AtomicBool::new(false));
@@ -658,6 +710,7 @@ fn run_one(n: usize, seconds: f64, dir: &Path, with_log: bool) -> Result<Outcome
         threads,
         steal,
         engine,
+        asleep,
     })
 }
 
@@ -673,13 +726,14 @@ fn verdict(ok: bool) -> &'static str {
 fn print_engine_table(outcomes: &[Outcome]) {
     println!();
     println!(
-        "{:>5} | {:>14} | {:>14} {:>14} | {:>36} | {:>11}",
+        "{:>5} | {:>14} | {:>13} | {:>14} {:>14} | {:>36} | {:>17}",
         "axes",
         "engine CPU",
+        "asleep µs",
         "cyclic CPU",
         "process CPU",
         "stages µs: recv/cmds/step/publ/rec",
-        "node/engine"
+        "node/engine/asleep"
     );
     for o in outcomes {
         let r = &o.report;
@@ -690,10 +744,12 @@ fn print_engine_table(outcomes: &[Outcome]) {
         let process = per(r.cpu_ns);
         let st = &r.stages;
         println!(
-            "{:>5} | {:>6.1} µs {:>4.1}% | {:>6.1} µs {:>4.1}% {:>6.1} µs {:>4.1}% | {:>6.1}/{:>5.1}/{:>6.1}/{:>5.1}/{:>6.1} | {:>5.2} {:>5.2}",
+            "{:>5} | {:>6.1} µs {:>4.1}% | {:>6.1} {:>6.1} | {:>6.1} µs {:>4.1}% {:>6.1} µs {:>4.1}% | {:>6.1}/{:>5.1}/{:>6.1}/{:>5.1}/{:>6.1} | {:>5.2} {:>5.2} {:>5.2}",
             o.n,
             o.engine.cpu_us,
             o.engine.percent(),
+            o.asleep.cpu_us,
+            o.asleep.loop_cpu_us,
             cyclic,
             pct(cyclic),
             process,
@@ -705,14 +761,18 @@ fn print_engine_table(outcomes: &[Outcome]) {
             per(st.record_ns),
             tandem_bench::ratio(cyclic, o.engine.cpu_us),
             tandem_bench::ratio(process, o.engine.cpu_us),
+            tandem_bench::ratio(process, o.asleep.loop_cpu_us),
         );
     }
     println!(
         "engine CPU: the engine alone (Executive::step of the same cell and script in a tight \
-         loop, this thread's CPU time per cycle); cyclic CPU: the node's cyclic thread; process \
-         CPU: the whole process (every thread of the node and this bench's telemetry watcher), \
-         both per cycle run and in % of a core at 1 ms; stages: wall time per cycle of the \
-         node's stages; node/engine: cyclic / engine and process / engine."
+         loop, this thread's CPU time per cycle); asleep: the engine alone sleeping to each 1 ms \
+         cycle as the node does and reading the statuses every {TELEMETRY_EVERY}th cycle, CPU per \
+         cycle of its steps, then of its whole loop (the wake-ups too); cyclic CPU: the node's \
+         cyclic thread; process CPU: the whole process (every thread of the node and this \
+         bench's telemetry watcher), both per cycle run and in % of a core at 1 ms; stages: wall \
+         time per cycle of the node's stages; node/engine/asleep: cyclic / engine, process / \
+         engine and process / asleep loop (the node's own share)."
     );
 }
 
@@ -771,8 +831,7 @@ fn print_table(outcomes: &[Outcome], seconds: f64, with_log: bool) {
     print_engine_table(outcomes);
     for o in outcomes {
         println!(
-            "{:>5} axes, CPU ms per thread (10 ms ticks, from the first to the last telemetry \
-             look): {}",
+            "{:>5} axes, CPU ms per thread (from the first to the last telemetry look): {}",
             o.n, o.threads
         );
     }

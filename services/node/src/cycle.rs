@@ -52,6 +52,8 @@ pub(crate) struct Links {
     pub(crate) rows: Option<RowPool>,
     /// What the recorder could not write to the disk (copied into the health).
     pub(crate) lost: std::sync::Arc<crate::recorder::Lost>,
+    /// Wakes the recorder before its channels fill (it sleeps its idle turns).
+    pub(crate) wake: crate::recorder::Wake,
 }
 
 /// Where the node's cycles lie on the cell clock.
@@ -415,11 +417,17 @@ impl<'c> NodeCycle<'c> {
     /// next cycle, so the newest is always stored in the end.
     fn hand_over_adjustments(&mut self) {
         let (diag, dropped) = (&self.links.diag, &mut self.health.diag_dropped);
+        let mut any = false;
         self.exec.take_adjustments(|c| {
             let sent = diag.try_send(Record::Retain(c)).is_ok();
             *dropped += u64::from(!sent);
+            any |= sent;
             sent
         });
+        if any {
+            // Retained data is stored at once, not at the recorder's next idle turn.
+            self.links.wake.now();
+        }
     }
 
     /// After the last cycle (off the cyclic path): hands over what the last cycles could not,
@@ -447,6 +455,7 @@ impl<'c> NodeCycle<'c> {
             {
                 self.health.diag_dropped += 1;
             }
+            self.links.wake.records(1);
         }
     }
 
@@ -473,6 +482,7 @@ impl<'c> NodeCycle<'c> {
             {
                 self.health.diag_dropped += 1;
             }
+            self.links.wake.records(1);
         }
     }
 
@@ -494,6 +504,7 @@ impl<'c> NodeCycle<'c> {
         }
         if let Some(pool) = &self.links.rows {
             self.health.trace_dropped += u64::from(!row(pool, t, &self.owned, self.exec.status()));
+            self.links.wake.rows(1);
         }
         let end = rt::now_ns();
         let compute = end - wake;

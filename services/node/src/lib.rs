@@ -127,6 +127,8 @@ pub fn run(o: &Options) -> Result<Report, NodeError> {
     let result = cyclic(&cell, n, o, start, owned, links);
     stop.store(true, Ordering::SeqCst);
     for (name, t) in threads {
+        // The recorder may be parked for its idle turn: it sees `stop` at once.
+        t.thread().unpark();
         if t.join().is_err() {
             error!(thread = name, "the thread panicked");
         }
@@ -238,9 +240,12 @@ fn start_threads(
         lost: Arc::clone(&lost),
     };
     let (c, s) = (Arc::clone(cell), Arc::clone(stop));
-    threads.push(spawn("recorder", move || recorder_thread(&c, &plan, &s))?);
+    let recorder = spawn("recorder", move || recorder_thread(&c, &plan, &s))?;
+    let wake = recorder::Wake::new(recorder.1.thread().clone());
+    threads.push(recorder);
     let links = Links {
         lost,
+        wake,
         commands: cmd_rx,
         done: done_tx,
         diag: diag_tx,

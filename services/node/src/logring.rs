@@ -11,7 +11,8 @@ use tandem_protocol::wire::{Event, Text};
 pub(crate) const LOG_LINES: usize = 128;
 
 /// Records the channel to the recorder thread holds (about 20 cycles of a full log
-/// ring; the recorder drains it every 5 ms).
+/// ring; the cyclic thread wakes the recorder when it handed over a quarter of it,
+/// `recorder::Wake`).
 pub(crate) const DIAG_RECORDS: usize = 4096;
 
 /// The cyclic thread's log: lines formatted into fixed buffers, published after the step.

@@ -4,7 +4,8 @@
 //! waits for the disk.
 //!
 //! Nothing is lost silently and no row or line is ever partly written (docs/processes.md,
-//! "Recording on a full disk"): each loop turn (every 5 ms) formats the rows and lines it
+//! "Recording on a full disk"): each loop turn (every [`IDLE_TURN_MS`] ms, or sooner when
+//! the cyclic thread [`Wake`]s it) formats the rows and lines it
 //! drained into one reused buffer per file ([`Sink`]) and writes it unbuffered at the file's
 //! committed length, the end of its last whole row. When a write fails (a full disk: ENOSPC,
 //! or any other error), the rows that reached the disk whole are kept, a row written in part
@@ -15,7 +16,7 @@
 //! kept). Losing and resuming are each a `warn` event with the counts.
 
 use crate::cycle::Row;
-use crate::logring::{DiagRecord, Record};
+use crate::logring::{DiagRecord, Record, DIAG_RECORDS};
 use crate::retain::Retainer;
 use std::fs::File;
 use std::io;
@@ -65,6 +66,69 @@ impl Lost {
     pub(crate) fn copy_into(&self, h: &mut NodeHealth) {
         h.trace_rows_lost = self.rows.load(Ordering::Relaxed);
         h.log_lines_lost = self.lines.load(Ordering::Relaxed);
+    }
+}
+
+/// The recorder's turn when the cyclic thread does not wake it (ms): each turn is a wake-up
+/// of a sleeping thread (20 to 35 µs of CPU on the project's 2-CPU VM, bench axes), so
+/// the recorder sleeps long and the cyclic thread wakes it when its channels fill
+/// (docs/processes.md, "Performance").
+pub(crate) const IDLE_TURN_MS: u64 = 20;
+
+/// Diagnostic records handed over since the last wake-up at which the cyclic thread wakes
+/// the recorder: a quarter of the channel ([`DIAG_RECORDS`]), so that the recorder drains it
+/// long before it is full (a full log ring and job events are at most 384 records a cycle).
+const WAKE_RECORDS: u32 = (DIAG_RECORDS / 4) as u32;
+
+/// Trace rows handed over since the last wake-up at which the cyclic thread wakes the
+/// recorder: a quarter of the smallest row pool.
+const WAKE_ROWS: u32 = (crate::TRACE_ROWS_MIN / 4) as u32;
+
+/// The cyclic thread's side of the recorder's sleep: counts what it handed over and wakes
+/// the recorder ([`std::thread::Thread::unpark`]: an atomic swap, a futex wake only when the
+/// recorder sleeps; no lock, no allocation) when that could fill a channel before the
+/// recorder's next idle turn, or at once for retained data.
+#[derive(Debug)]
+pub(crate) struct Wake {
+    recorder: std::thread::Thread,
+    /// Records handed over since the last wake-up.
+    records: u32,
+    /// Trace rows handed over since the last wake-up.
+    rows: u32,
+}
+
+impl Wake {
+    /// The waker of the recorder thread `recorder`.
+    pub(crate) fn new(recorder: std::thread::Thread) -> Self {
+        Self {
+            recorder,
+            records: 0,
+            rows: 0,
+        }
+    }
+
+    /// `n` more diagnostic records handed over.
+    pub(crate) fn records(&mut self, n: u32) {
+        self.records = self.records.saturating_add(n);
+        if self.records >= WAKE_RECORDS {
+            self.now();
+        }
+    }
+
+    /// `n` more trace rows handed over.
+    pub(crate) fn rows(&mut self, n: u32) {
+        self.rows = self.rows.saturating_add(n);
+        if self.rows >= WAKE_ROWS {
+            self.now();
+        }
+    }
+
+    /// Wakes the recorder now: it drains everything handed over before it runs, so the counts
+    /// start again (a bound on what its channels hold).
+    pub(crate) fn now(&mut self) {
+        self.recorder.unpark();
+        self.records = 0;
+        self.rows = 0;
     }
 }
 
@@ -394,7 +458,9 @@ fn record(cell: &Cell, plan: &RecorderPlan, stop: &AtomicBool) {
         if stopping {
             break;
         }
-        std::thread::sleep(Duration::from_millis(5));
+        // Woken early by the cyclic thread ([`Wake`]) or at `stop`; a spurious wake-up is an
+        // early turn.
+        std::thread::park_timeout(Duration::from_millis(IDLE_TURN_MS));
     }
     for s in [trace.as_ref(), log.as_ref()].into_iter().flatten() {
         s.end();
@@ -443,6 +509,31 @@ mod tests {
                 .resize(usize::try_from(len).unwrap(), 0);
             Ok(())
         }
+    }
+
+    /// The cyclic thread wakes the recorder when it handed over a quarter of the diagnostic
+    /// channel or of the smallest row pool since the last wake-up, and counts again from
+    /// there; below that the recorder's idle turn drains the channels.
+    #[test]
+    fn the_recorder_is_woken_at_a_quarter_of_its_channels() {
+        assert_eq!(WAKE_RECORDS, 1024);
+        assert_eq!(WAKE_ROWS, 64);
+        let mut w = Wake::new(std::thread::current());
+        w.records(WAKE_RECORDS - 1);
+        w.rows(WAKE_ROWS - 1);
+        assert_eq!((w.records, w.rows), (WAKE_RECORDS - 1, WAKE_ROWS - 1));
+        w.records(1);
+        assert_eq!(
+            (w.records, w.rows),
+            (0, 0),
+            "woken: both counts start again"
+        );
+        w.rows(WAKE_ROWS - 1);
+        w.rows(1);
+        assert_eq!(w.rows, 0);
+        w.records(3);
+        w.now();
+        assert_eq!(w.records, 0);
     }
 
     fn sink(disk: &Rc<Disk>) -> Sink<Rc<Disk>> {
