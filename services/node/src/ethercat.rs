@@ -1233,7 +1233,8 @@ async fn serve<DC>(
     loop {
         match group.tx_rx(md).await {
             Ok(r) if r.all_op() => break,
-            Ok(_) if Instant::now() < deadline => {}
+            // A frame lost on the way (a faulty segment) is tried again until the deadline.
+            Ok(_) | Err(_) if Instant::now() < deadline => {}
             Ok(_) => {
                 return ends.refuse(EthercatError::Start {
                     interface: plan.interface.clone(),

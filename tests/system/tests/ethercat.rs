@@ -36,13 +36,19 @@ fn netns(tag: &str) -> VethNetns {
 /// Starts `tandem-ecat-sim --devices <devices> --loopback` on `ecs` with a 2 ms cycle and waits
 /// (10 s at most) for it to say it runs `n` SubDevices.
 fn start_sim(ns: &VethNetns, devices: &str, n: usize) -> Background {
+    start_sim_with(ns, devices, n, &[])
+}
+
+/// As [`start_sim`], with `extra` arguments.
+fn start_sim_with(ns: &VethNetns, devices: &str, n: usize, extra: &[&str]) -> Background {
     // SCHED_FIFO as the node's threads (see `cell`): on this shared host a starved emulator
     // answers late as much as a starved node asks late.
     let mut c = ns.exec(Path::new("chrt"));
     c.args(["-f", "40"])
         .arg(bin("tandem-ecat-sim"))
         .args(["--interface", "ecs", "--devices", devices])
-        .args(["--cycle-us", "2000", "--loopback"]);
+        .args(["--cycle-us", "2000", "--loopback"])
+        .args(extra);
     let (sim, line) = Background::start(&mut c, Duration::from_secs(10), "tandem-ecat-sim");
     assert!(line.contains(&format!("{n} SubDevice(s) on ecs")), "{line}");
     sim
@@ -437,5 +443,94 @@ fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
     eprintln!(
         "{end}\n{third}\nalarm {cycles} cycles after the last complete exchange ({late} late)"
     );
+    remove_dir(&dir);
+}
+
+/// The node's stop line's count after `what` (`"missed exchanges"`): the number before it.
+fn count_before(end: &str, what: &str) -> u64 {
+    end.split(what)
+        .next()
+        .and_then(|r| r.rsplit(", ").next())
+        .and_then(|r| r.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no count before `{what}` in {end}"))
+}
+
+#[test]
+fn one_percent_of_frames_dropped_is_counted_and_the_motion_goes_on_without_a_jump() {
+    let ns = netns("d");
+    let dir = fresh_dir(&format!("tandem-ethercat-d-{}", std::process::id()));
+    let drops = dir.join("drops.log");
+    let drops_arg = drops.to_str().unwrap().to_string();
+    let _sim = start_sim_with(
+        &ns,
+        "drive,dio",
+        2,
+        &["--drop", "0.01", "--seed", "13", "--drop-log", &drops_arg],
+    );
+    let cell = cell(&dir, "\n[axes.slide]", OTHER_AXIS);
+    let script = dir.join("script.toml");
+    std::fs::write(&script, LONG_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let up = Spawned::start(
+        tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+            .arg("--script")
+            .arg(&script),
+    );
+    let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
+    assert!(status.success(), "tandem up failed: {status}\n{up_log}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // Both moves complete without an alarm.
+    assert!(log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
+    assert!(log.contains("other MC_MoveAbsolute job 3: Done"), "{log}");
+    assert!(!log.contains("alarm"), "{log}");
+    let end = up_log
+        .lines()
+        .find(|l| l.contains("EtherCAT segment:"))
+        .unwrap_or_else(|| panic!("no end line:\n{up_log}"));
+    assert!(end.contains(", 0 alarms;"), "{end}");
+    // Every frame the emulator dropped is a miss of the node. The emulator drops from OP on,
+    // so a drop may also hit one of the node's few frames between OP and its first cyclic
+    // exchange (retried there, not a miss), and a frame the starved emulator answers later
+    // than 3/4 of a cycle is a miss it did not drop: one either way is allowed.
+    let dropped = std::fs::read_to_string(&drops).unwrap().lines().count() as u64;
+    let misses = count_before(end, " missed exchanges");
+    let exchanges = count_before(end, " exchanges, ");
+    eprintln!("{end}\nthe emulator dropped {dropped} frames");
+    assert!(dropped >= 10, "1 % of some 3,000 frames: {dropped}");
+    assert!(misses > 0, "the drops are not counted: {end}");
+    assert!(
+        misses.abs_diff(dropped) <= 1,
+        "{dropped} frames dropped, {misses} misses counted: {end}"
+    );
+    assert!(exchanges + misses >= 2900, "{end}");
+    // No jump in the axis' setpoints: their second difference within what its acceleration
+    // limit allows in a cycle (max_acceleration 3000 mm/s², 2 ms).
+    let x: Vec<f64> = column(&rec.join("drives.csv"), "slide.position")
+        .iter()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let bound = 3000.0 * 0.002 * 0.002 + 1e-9;
+    for (k, w) in x.windows(3).enumerate() {
+        let d2 = (w[2] - 2.0 * w[1] + w[0]).abs();
+        assert!(
+            d2 <= bound,
+            "setpoint jump at row {k}: {d2} mm > {bound} mm"
+        );
+    }
+    // And the actual values follow without a jump either: the following error stays within
+    // the limit although the drive's feedback was missing in the dropped cycles.
+    let fe = column(&rec.join("drives.csv"), "slide.following_error")
+        .iter()
+        .map(|v| v.parse::<f64>().unwrap().abs())
+        .fold(0.0f64, f64::max);
+    assert!(fe < 1.0, "following error up to {fe} mm");
+    let actual: f64 = column(&rec.join("drives.csv"), "slide.actual_position")
+        .last()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((actual - 400.0).abs() < 0.01, "actual position {actual}");
+    eprintln!("max |following error| {fe:.4} mm with drops");
     remove_dir(&dir);
 }
