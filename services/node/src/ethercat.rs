@@ -42,7 +42,7 @@ use std::sync::Arc;
 use std::task::{Context, Poll};
 use std::time::{Duration, Instant};
 use tandem_config::{Cell, EthercatIdentity, EthercatRole};
-use tandem_motion::plant::cia402::{DriveCommand, DriveFeedback};
+use tandem_motion::plant::cia402::{controlword, DriveCommand, DriveFeedback};
 use tandem_runtime::exec::{Executive, Secs};
 use tracing::{info, warn};
 
@@ -576,6 +576,9 @@ struct Image {
     verdict: Verdict,
     /// Its round trip (ns).
     round_trip_ns: u64,
+    /// MC_Reset of a lost segment: the "ethercat" thread brings the segment up again (from
+    /// INIT to OP) before this image's exchange.
+    reinit: bool,
 }
 
 /// Counters of the segment, reported at the end.
@@ -596,6 +599,8 @@ pub struct SegmentCounts {
     pub most_in_a_row: u32,
     /// The most late cycles in a row.
     pub most_late_in_a_row: u32,
+    /// Re-inits of the segment MC_Reset asked for, and those that brought it back to OP.
+    pub reinits: (u32, u32),
     /// Round trips of the exchanges, in buckets of 10 µs (the last one: 10 ms and more).
     pub round_trip_10us: [u32; 1001],
 }
@@ -609,6 +614,7 @@ impl Default for SegmentCounts {
             alarms: 0,
             most_in_a_row: 0,
             most_late_in_a_row: 0,
+            reinits: (0, 0),
             round_trip_10us: [0; 1001],
         }
     }
@@ -648,6 +654,8 @@ pub struct Link {
     last_complete: i64,
     /// In alarm for a stall of the "ethercat" thread ([`LATE_TO_ALARM_NS`]).
     stalled: bool,
+    /// A re-init (MC_Reset of the lost segment) was handed over and is not back yet.
+    reinit_pending: bool,
     /// The drives on the segment: device and last feedback (extrapolated over misses).
     drives: Vec<(usize, DriveFeedback)>,
     /// The node's cycle (ns).
@@ -668,7 +676,7 @@ impl Link {
             // The first boundary: nothing was exchanged before it; the first outputs go out.
             self.started = true;
             if let Some(image) = self.image.take() {
-                self.send(image, exec);
+                self.send(t, image, exec, log);
             }
             return;
         }
@@ -684,16 +692,33 @@ impl Link {
             // Still here from a cycle in which the "ethercat" thread held the previous image:
             // the handover waited, which is lateness of our own, not a miss.
             self.late(exec);
-            self.send(image, exec);
+            self.send(t, image, exec, log);
             return;
         }
         self.late_in_a_row = 0;
+        if self.reinit_pending {
+            self.reinit_pending = false;
+            let back = image.verdict == Verdict::Complete;
+            self.counts.reinits.1 += u32::from(back);
+            // As the other log lines.
+            let _ = writeln!(
+                log,
+                "t={} EtherCAT {}: {}",
+                Secs(t),
+                self.interface,
+                if back {
+                    "back in OP after MC_Reset"
+                } else {
+                    "not back in OP after MC_Reset (the node's log says why)"
+                }
+            );
+        }
         if image.verdict == Verdict::Complete {
             self.complete(t, &mut image, exec, log);
         } else {
             self.miss(t, image.verdict, exec, log);
         }
-        self.send(image, exec);
+        self.send(t, image, exec, log);
     }
 
     /// A complete exchange: its inputs into `exec`.
@@ -740,10 +765,12 @@ impl Link {
 
     /// The RxPDO of the last step into `image`, handed to the "ethercat" thread (kept for the
     /// next cycle if it still holds the previous one).
-    fn send(&mut self, mut image: Box<Image>, exec: &Executive<'_>) {
+    fn send(&mut self, t: i64, mut image: Box<Image>, exec: &Executive<'_>, log: &mut impl Write) {
+        let mut fault_reset = false;
         for p in &mut image.parts {
             if p.map.is_some() {
                 p.command = exec.drive_command(p.device).copied().unwrap_or_default();
+                fault_reset |= p.command.controlword & controlword::FAULT_RESET != 0;
             } else {
                 // The levels the last step left on its output channels (bit c - 1: channel c).
                 p.outputs = exec
@@ -752,6 +779,20 @@ impl Link {
             }
         }
         image.verdict = Verdict::Pending;
+        // MC_Reset of an axis on the lost segment sends its drive a fault reset (0x6040 bit
+        // 7): the segment is brought up again with it, on the "ethercat" thread.
+        if fault_reset && self.in_alarm() && !self.reinit_pending {
+            image.reinit = true;
+            self.reinit_pending = true;
+            self.counts.reinits.0 += 1;
+            // As the other log lines.
+            let _ = writeln!(
+                log,
+                "t={} EtherCAT {}: MC_Reset: bringing the segment up again",
+                Secs(t),
+                self.interface
+            );
+        }
         match self.to_bus.try_send(image) {
             Ok(()) => {}
             Err(TrySendError::Full(i) | TrySendError::Disconnected(i)) => self.image = Some(i),
@@ -762,6 +803,11 @@ impl Link {
     /// segment): counted as `ecat_late`, the drives' positions extrapolated; only a stall of
     /// [`LATE_TO_ALARM_NS`] in a row is an alarm.
     fn late(&mut self, exec: &mut Executive<'_>) {
+        if self.reinit_pending {
+            // The segment is being brought up again: still lost, and no lateness of ours.
+            self.lost(exec);
+            return;
+        }
         self.counts.late += 1;
         self.late_since_complete = self.late_since_complete.saturating_add(1);
         self.late_in_a_row = self.late_in_a_row.saturating_add(1);
@@ -821,6 +867,11 @@ impl Link {
         }
     }
 
+    /// The segment is in alarm (lost or stalled).
+    fn in_alarm(&self) -> bool {
+        self.in_a_row >= MISSES_TO_ALARM || self.stalled
+    }
+
     /// Each drive on the segment shows a fault with [`LOST_CODE`].
     fn lost(&self, exec: &mut Executive<'_>) {
         let lost = DriveFeedback {
@@ -842,7 +893,7 @@ impl Link {
             misses = c.misses,
             ecat_late = c.late,
             alarms = c.alarms,
-            "EtherCAT segment: {} exchanges, {} missed exchanges (at most {} in a row), ecat_late {} cycles (at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us; {} answers after their verdict",
+            "EtherCAT segment: {} exchanges, {} missed exchanges (at most {} in a row), ecat_late {} cycles (at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us; {} answers after their verdict; {} re-inits after MC_Reset, {} back in OP",
             c.exchanges,
             c.misses,
             c.most_in_a_row,
@@ -853,6 +904,8 @@ impl Link {
             c.round_trip_quantile_us(0.99),
             c.round_trip_quantile_us(1.0),
             self.watch.stray.load(Ordering::Relaxed),
+            c.reinits.0,
+            c.reinits.1,
         );
     }
 }
@@ -936,6 +989,7 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
         late_since_complete: 0,
         last_complete: 0,
         stalled: false,
+        reinit_pending: false,
         drives,
         cycle_ns: cell.nodes.get(n).map_or(1, |x| x.cycle_ns),
         started: false,
@@ -1059,8 +1113,77 @@ impl Ends<'_> {
 type OpGroup<DC> =
     SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, subdevice_group::Op, DC>;
 
-/// The MainDevice's work: start (see [`open`]), then the exchanges.
+/// How [`serve`] (and the bring-up before it) ended.
+enum Served {
+    /// The cyclic thread's end of the channel went.
+    End,
+    /// MC_Reset asked to bring the segment up again; the image to exchange once it is.
+    Reinit(Box<Image>),
+    /// The segment could not be brought to OP.
+    Failed(EthercatError),
+}
+
+/// The MainDevice's work: start (see [`open`]), then the exchanges; after MC_Reset of a lost
+/// segment it is brought up again from INIT (ethercrab's `init_single_group` on the same
+/// MainDevice: it counts, resets and addresses the SubDevices anew), here on the "ethercat"
+/// thread while the cyclic thread carries on, its drives shown lost until the image is back.
 async fn run_bus(plan: &Plan, md: &MainDevice<'_>, ends: &Ends<'_>) {
+    let mut held: Option<Box<Image>> = None;
+    loop {
+        let again = held.is_some();
+        match bring_up(plan, md, ends, &mut held).await {
+            Served::End => return,
+            Served::Reinit(image) => held = Some(image),
+            Served::Failed(e) if !again => return ends.refuse(e),
+            Served::Failed(e) => {
+                warn!(
+                    "EtherCAT segment on `{}` not back in OP: {e}",
+                    plan.interface
+                );
+                let Some(mut image) = held.take() else {
+                    return;
+                };
+                image.verdict = Verdict::Failed;
+                image.reinit = false;
+                if ends.bus_out.send(image).is_err() {
+                    return;
+                }
+                match wait_for_reinit(ends) {
+                    Some(image) => held = Some(image),
+                    None => return,
+                }
+            }
+        }
+    }
+}
+
+/// Without a segment in OP: every image handed over fails at once, until one asks for a
+/// re-init (returned) or the cyclic thread's end goes (`None`).
+fn wait_for_reinit(ends: &Ends<'_>) -> Option<Box<Image>> {
+    loop {
+        let mut image = match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
+            Ok(i) => i,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => return None,
+        };
+        if image.reinit {
+            return Some(image);
+        }
+        image.verdict = Verdict::Failed;
+        if ends.bus_out.send(image).is_err() {
+            return None;
+        }
+    }
+}
+
+/// The segment from INIT to OP (the bus checked, the mappings read, SYNC0), then [`serve`];
+/// `held` is the image of a re-init.
+async fn bring_up(
+    plan: &Plan,
+    md: &MainDevice<'_>,
+    ends: &Ends<'_>,
+    held: &mut Option<Box<Image>>,
+) -> Served {
     let fail = |what: &str, e: ethercrab::error::Error| EthercatError::Start {
         interface: plan.interface.clone(),
         reason: format!("{what}: {e}"),
@@ -1070,11 +1193,11 @@ async fn run_bus(plan: &Plan, md: &MainDevice<'_>, ends: &Ends<'_>) {
         .await
     {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("no segment found", e)),
+        Err(e) => return Served::Failed(fail("no segment found", e)),
     };
     let parts = match check_and_map(plan, md, &group).await {
         Ok(p) => p,
-        Err(e) => return ends.refuse(e),
+        Err(e) => return Served::Failed(e),
     };
     // SYNC0 on every SubDevice with DC, every node cycle.
     let mut dc = 0usize;
@@ -1087,13 +1210,12 @@ async fn run_bus(plan: &Plan, md: &MainDevice<'_>, ends: &Ends<'_>) {
     if dc == 0 {
         let group = match group.into_safe_op(md).await {
             Ok(g) => g,
-            Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+            Err(e) => return Served::Failed(fail("SAFE-OP refused", e)),
         };
-        match group.request_into_op(md).await {
-            Ok(g) => serve(plan, md, &g, parts, ends).await,
-            Err(e) => ends.refuse(fail("OP refused", e)),
-        }
-        return;
+        return match group.request_into_op(md).await {
+            Ok(g) => serve(plan, md, &g, parts, held, ends).await,
+            Err(e) => Served::Failed(fail("OP refused", e)),
+        };
     }
     let conf = DcConfiguration {
         // Inferred: time for the SubDevices to take the configuration before the first pulse.
@@ -1103,22 +1225,22 @@ async fn run_bus(plan: &Plan, md: &MainDevice<'_>, ends: &Ends<'_>) {
     };
     let group = match group.into_pre_op_pdi(md).await {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("process data mapping", e)),
+        Err(e) => return Served::Failed(fail("process data mapping", e)),
     };
     let group = match group.configure_dc_sync(md, conf).await {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("SYNC0 configuration", e)),
+        Err(e) => return Served::Failed(fail("SYNC0 configuration", e)),
     };
     let group = match group.into_safe_op(md).await {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+        Err(e) => return Served::Failed(fail("SAFE-OP refused", e)),
     };
     match group.request_into_op(md).await {
         Ok(g) => {
             log_dc(plan, md, &g, dc).await;
-            serve(plan, md, &g, parts, ends).await;
+            serve(plan, md, &g, parts, held, ends).await
         }
-        Err(e) => ends.refuse(fail("OP refused", e)),
+        Err(e) => Served::Failed(fail("OP refused", e)),
     }
 }
 
@@ -1220,15 +1342,17 @@ where
     }
 }
 
-/// In OP: reports the segment ready, then one exchange per image handed over until the
-/// cyclic thread's end of the channel goes.
+/// In OP: reports the segment ready (or, after a re-init, exchanges the `held` image with the
+/// mappings read anew), then one exchange per image handed over until the cyclic thread's end
+/// of the channel goes or an image asks for a re-init.
 async fn serve<DC>(
     plan: &Plan,
     md: &MainDevice<'_>,
     group: &OpGroup<DC>,
     parts: Vec<Part>,
+    held: &mut Option<Box<Image>>,
     ends: &Ends<'_>,
-) {
+) -> Served {
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         match group.tx_rx(md).await {
@@ -1236,13 +1360,13 @@ async fn serve<DC>(
             // A frame lost on the way (a faulty segment) is tried again until the deadline.
             Ok(_) | Err(_) if Instant::now() < deadline => {}
             Ok(_) => {
-                return ends.refuse(EthercatError::Start {
+                return Served::Failed(EthercatError::Start {
                     interface: plan.interface.clone(),
                     reason: "not all SubDevices in OP within 10 s".into(),
                 })
             }
             Err(e) => {
-                return ends.refuse(EthercatError::Start {
+                return Served::Failed(EthercatError::Start {
                     interface: plan.interface.clone(),
                     reason: format!("exchange on the way to OP: {e}"),
                 })
@@ -1259,20 +1383,41 @@ async fn serve<DC>(
             u16::from(!io.inputs().is_empty()) + 2 * u16::from(!io.outputs().is_empty())
         })
         .sum();
-    let image = Box::new(Image {
-        parts,
-        verdict: Verdict::Pending,
-        round_trip_ns: 0,
-    });
-    if ends.ready.send(Ok(image)).is_err() {
-        return;
-    }
+    let mut next = match held.take() {
+        Some(mut image) => {
+            // Back after MC_Reset: the same SubDevices (checked), their mappings read anew.
+            for (p, n) in image.parts.iter_mut().zip(parts) {
+                p.map = n.map;
+            }
+            image.reinit = false;
+            info!(interface = %plan.interface, "EtherCAT segment back in OP");
+            Some(image)
+        }
+        None => {
+            let image = Box::new(Image {
+                parts,
+                verdict: Verdict::Pending,
+                round_trip_ns: 0,
+                reinit: false,
+            });
+            if ends.ready.send(Ok(image)).is_err() {
+                return Served::End;
+            }
+            None
+        }
+    };
     loop {
-        let mut image = match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
-            Ok(i) => i,
-            Err(RecvTimeoutError::Timeout) => continue,
-            Err(RecvTimeoutError::Disconnected) => return,
+        let mut image = match next.take() {
+            Some(i) => i,
+            None => match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
+                Ok(i) => i,
+                Err(RecvTimeoutError::Timeout) => continue,
+                Err(RecvTimeoutError::Disconnected) => return Served::End,
+            },
         };
+        if image.reinit {
+            return Served::Reinit(image);
+        }
         for (p, sd) in image.parts.iter().zip(group.iter(md)) {
             let mut out = sd.outputs_raw_mut();
             match &p.map {
@@ -1300,7 +1445,7 @@ async fn serve<DC>(
             }
         }
         if ends.bus_out.send(image).is_err() {
-            return;
+            return Served::End;
         }
     }
 }
@@ -1489,12 +1634,14 @@ mod tests {
                 parts: vec![part],
                 verdict: Verdict::Pending,
                 round_trip_ns: 0,
+                reinit: false,
             })),
             in_a_row: 0,
             late_in_a_row: 0,
             late_since_complete: 0,
             last_complete: 0,
             stalled: false,
+            reinit_pending: false,
             drives: vec![(drive, DriveFeedback::default())],
             cycle_ns: 2_000_000,
             started: false,

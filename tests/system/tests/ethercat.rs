@@ -534,3 +534,143 @@ fn one_percent_of_frames_dropped_is_counted_and_the_motion_goes_on_without_a_jum
     eprintln!("max |following error| {fe:.4} mm with drops");
     remove_dir(&dir);
 }
+
+/// The slide moves, the test kills the emulator (alarm 421), starts it again, and the script
+/// resets the axis, powers it and moves it again.
+const RESET_SCRIPT: &str = r#"
+[sim]
+duration = 9.0
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Home"
+mode = 0
+position = 0.0
+
+[[at]]
+t = 0.1
+axis = "slide"
+instruction = "MC_MoveAbsolute"
+position = 400.0
+
+[[at]]
+t = 5.0
+axis = "slide"
+instruction = "MC_Reset"
+
+[[at]]
+t = 6.0
+axis = "slide"
+instruction = "MC_Power"
+
+[[at]]
+t = 6.5
+axis = "slide"
+instruction = "MC_MoveAbsolute"
+position = 50.0
+"#;
+
+#[test]
+fn mc_reset_brings_a_lost_segment_back_to_op_and_the_axis_moves_again() {
+    let ns = netns("r");
+    let sim = start_sim(&ns, "drive,dio", 2);
+    let dir = fresh_dir(&format!("tandem-ethercat-r-{}", std::process::id()));
+    // The fault reset waits for the drive to leave fault while the segment is brought up
+    // again from INIT (SII, CoE mappings, DC): more than the example's 0.5 s.
+    let cell = cell(&dir, "enable_timeout = 0.5", "enable_timeout = 3.0");
+    let script = dir.join("script.toml");
+    std::fs::write(&script, RESET_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let mut up = tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+        .arg("--script")
+        .arg(&script)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn tandem up");
+    let (tx, rx) = mpsc::channel::<String>();
+    for pipe in [
+        Box::new(up.stdout.take().unwrap()) as Box<dyn std::io::Read + Send>,
+        Box::new(up.stderr.take().unwrap()),
+    ] {
+        let tx = tx.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+                // The test may have stopped reading; the line is then of no use.
+                let _ = tx.send(line);
+            }
+        });
+    }
+    drop(tx);
+    let mut said = String::new();
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    while !said.contains("EtherCAT segment in OP") {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let line = rx
+            .recv_timeout(left)
+            .unwrap_or_else(|_| panic!("no OP within 60 s:\n{said}"));
+        said.push_str(&line);
+        said.push('\n');
+    }
+    // The node's clock starts at the next whole second: the kill falls at 1.5 to 2.5 s of
+    // node time, the restart right after it, both well before MC_Reset at 5 s.
+    std::thread::sleep(Duration::from_millis(2500));
+    drop(sim);
+    std::thread::sleep(Duration::from_millis(300));
+    let _sim = start_sim(&ns, "drive,dio", 2);
+    let status = tandem_testkit::process::wait_for(&mut up, Duration::from_secs(60), "tandem up");
+    while let Ok(line) = rx.recv_timeout(Duration::from_secs(5)) {
+        said.push_str(&line);
+        said.push('\n');
+    }
+    assert!(status.success(), "tandem up failed: {status}\n{said}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // Lost: alarm 421 with 0x8130, the first move aborted.
+    assert!(
+        log.contains("slide alarm 421 DriveFault (supplement 33072"),
+        "{log}"
+    );
+    assert!(!log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
+    // MC_Reset is done, its fault reset brings the segment back to OP on the EtherCAT thread;
+    // MC_Power (Enable still TRUE, the same instance: job 1) enables the fresh drive, and
+    // the new move completes, in this order.
+    let at = |what: &str, from: usize| -> usize {
+        log[from..]
+            .find(what)
+            .map(|i| i + from)
+            .unwrap_or_else(|| panic!("no `{what}` after byte {from} in\n{log}"))
+    };
+    let alarm = at("slide alarm 421", 0);
+    let reset = at("slide MC_Reset job 4: Done", alarm);
+    let again = at(
+        "EtherCAT ecm: MC_Reset: bringing the segment up again",
+        reset,
+    );
+    let back = at("EtherCAT ecm: back in OP after MC_Reset", again);
+    let power = at("slide MC_Power job 1: Status TRUE", back);
+    at("slide MC_MoveAbsolute job 5: Done", power);
+    assert_eq!(log.matches("slide alarm").count(), 1, "{log}");
+    let end = said
+        .lines()
+        .find(|l| l.contains("EtherCAT segment:"))
+        .unwrap_or_else(|| panic!("no end line:\n{said}"));
+    assert!(end.contains(", 1 alarms;"), "{end}");
+    assert!(
+        end.contains("1 re-inits after MC_Reset, 1 back in OP"),
+        "{end}"
+    );
+    let actual: f64 = column(&rec.join("drives.csv"), "slide.actual_position")
+        .last()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((actual - 50.0).abs() < 0.01, "actual position {actual}");
+    eprintln!("{end}");
+    remove_dir(&dir);
+}
