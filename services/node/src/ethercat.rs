@@ -1796,6 +1796,93 @@ mod tests {
     }
 
     #[test]
+    fn mc_reset_of_the_lost_segment_asks_the_ethercat_thread_to_bring_it_up_again() {
+        use tandem_motion::objects::action::Action;
+        use tandem_motion::objects::axis::{Command, StartMode, StopMode};
+        with_link(|link, exec, bus_in, bus_out, _| {
+            let mut log = Vec::new();
+            let power = Action::Command(Command::Power {
+                enable: true,
+                start_mode: StartMode::PositionControlled,
+                stop_mode: StopMode::Emergency,
+            });
+            let r = exec.apply(0, "slide", "MC_Power", power, &mut log).unwrap();
+            assert!(r.is_ok(), "{r:?}");
+            let mut image = first_exchange(link, exec, bus_in, bus_out, &mut log);
+            exec.step(2_000_000, &mut log).unwrap();
+            // A fault reset while the segment is fine is the drive's own business.
+            assert!(!image.reinit);
+            let mut k = 2i64;
+            for _ in 0..3 {
+                image.verdict = Verdict::NoAnswer;
+                bus_out.send(image).unwrap();
+                link.exchange(k * 2_000_000, exec, &mut log);
+                exec.step(k * 2_000_000, &mut log).unwrap();
+                k += 1;
+                image = bus_in.try_recv().unwrap();
+                assert!(!image.reinit);
+            }
+            assert_eq!(link.counts.alarms, 1);
+            // MC_Reset: the axis' drive connection sends the fault reset (0x6040 bit 7), and
+            // the image that carries it asks for the re-init.
+            let t = k * 2_000_000;
+            let r = exec
+                .apply(
+                    t,
+                    "slide",
+                    "MC_Reset",
+                    Action::Command(Command::Reset { restart: false }),
+                    &mut log,
+                )
+                .unwrap();
+            assert!(r.is_ok(), "{r:?}");
+            exec.step(t, &mut log).unwrap();
+            // The drive connection sends the pulse within a cycle or two.
+            let mut t = t;
+            for _ in 0..3 {
+                t += 2_000_000;
+                image.verdict = Verdict::NoAnswer;
+                bus_out.send(image).unwrap();
+                link.exchange(t, exec, &mut log);
+                image = bus_in.try_recv().unwrap();
+                if image.reinit {
+                    break;
+                }
+                exec.step(t, &mut log).unwrap();
+            }
+            assert!(image.reinit, "{}", String::from_utf8_lossy(&log));
+            assert_eq!(link.counts.reinits, (1, 0));
+            // While the segment is brought up, the cycles are not late and the drive shows
+            // the loss; the image back complete is the segment back in OP.
+            let late = link.counts.late;
+            for n in 2..10 {
+                link.exchange(t + n * 2_000_000, exec, &mut log);
+                assert_eq!(
+                    exec.drive_feedback(image.parts[0].device)
+                        .unwrap()
+                        .error_code,
+                    LOST_CODE
+                );
+            }
+            assert_eq!(link.counts.late, late);
+            image.reinit = false;
+            image.verdict = Verdict::Complete;
+            bus_out.send(image).unwrap();
+            link.exchange(t + 10 * 2_000_000, exec, &mut log);
+            assert_eq!(link.counts.reinits, (1, 1));
+            let log = String::from_utf8(log).unwrap();
+            assert!(
+                log.contains("EtherCAT ecm: MC_Reset: bringing the segment up again"),
+                "{log}"
+            );
+            assert!(
+                log.contains("EtherCAT ecm: back in OP after MC_Reset"),
+                "{log}"
+            );
+        });
+    }
+
+    #[test]
     fn a_working_counter_error_is_a_miss_and_the_command_goes_out_anyway() {
         with_link(|link, exec, bus_in, bus_out, _| {
             let mut log = Vec::new();

@@ -27,6 +27,20 @@ use tandem_testkit::process::{run, text, Spawned};
 use tandem_testkit::scratch::{fresh_dir, remove_dir};
 use tandem_testkit::workspace::{bin, root};
 
+/// The tests take turns: each runs a node and an emulator at SCHED_FIFO 40, and several of
+/// them at once on the 2-core host starve each other (measured: up to 8 late cycles in a row,
+/// the drive without setpoints for 16 ms, a following-error alarm in the dropped-frames test),
+/// which is no property of one node and its segment. The other processes of the host run
+/// below SCHED_FIFO and load it as they do.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// This test's turn (a test that failed before it gave it up all the same).
+fn turn() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// The namespace `tec<tag><pid>` with the veth pair `ecm` (the node's end) / `ecs` (the
 /// emulator's).
 fn netns(tag: &str) -> VethNetns {
@@ -117,6 +131,7 @@ velocity = 20.0
 
 #[test]
 fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_limit() {
+    let _turn = turn();
     let ns = netns("m");
     let _sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-{}", std::process::id()));
@@ -225,6 +240,7 @@ fn node(ns: &VethNetns, cell: &Path) -> (Option<i32>, String) {
 
 #[test]
 fn a_bus_that_differs_from_the_cell_file_refuses_to_start_naming_the_first_mismatch() {
+    let _turn = turn();
     let ns = netns("x");
     let dir = fresh_dir(&format!("tandem-ethercat-x-{}", std::process::id()));
     {
@@ -323,6 +339,7 @@ position = 450.0
 
 #[test]
 fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
+    let _turn = turn();
     let ns = netns("k");
     let sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-k-{}", std::process::id()));
@@ -458,6 +475,7 @@ fn count_before(end: &str, what: &str) -> u64 {
 
 #[test]
 fn one_percent_of_frames_dropped_is_counted_and_the_motion_goes_on_without_a_jump() {
+    let _turn = turn();
     let ns = netns("d");
     let dir = fresh_dir(&format!("tandem-ethercat-d-{}", std::process::id()));
     let drops = dir.join("drops.log");
@@ -580,6 +598,7 @@ position = 50.0
 
 #[test]
 fn mc_reset_brings_a_lost_segment_back_to_op_and_the_axis_moves_again() {
+    let _turn = turn();
     let ns = netns("r");
     let sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-r-{}", std::process::id()));
