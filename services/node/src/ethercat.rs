@@ -599,6 +599,9 @@ pub struct SegmentCounts {
     pub most_in_a_row: u32,
     /// The most late cycles in a row.
     pub most_late_in_a_row: u32,
+    /// Late cycles whose frame had not even gone out: the "ethercat" or "ethercat-io" thread
+    /// had not run since the handover (the rest waited for an answer or the verdict).
+    pub late_unsent: u64,
     /// Re-inits of the segment MC_Reset asked for, and those that brought it back to OP.
     pub reinits: (u32, u32),
     /// Round trips of the exchanges, in buckets of 10 µs (the last one: 10 ms and more).
@@ -614,6 +617,7 @@ impl Default for SegmentCounts {
             alarms: 0,
             most_in_a_row: 0,
             most_late_in_a_row: 0,
+            late_unsent: 0,
             reinits: (0, 0),
             round_trip_10us: [0; 1001],
         }
@@ -664,6 +668,8 @@ pub struct Link {
     started: bool,
     /// What the "ethercat-io" thread saw.
     watch: Arc<IoWatch>,
+    /// Frames sent by the "ethercat-io" thread when the last image was handed over.
+    sent_at_handover: u64,
     /// The counters.
     pub counts: Box<SegmentCounts>,
 }
@@ -779,6 +785,7 @@ impl Link {
             }
         }
         image.verdict = Verdict::Pending;
+        self.sent_at_handover = self.watch.sent.load(Ordering::Acquire);
         // MC_Reset of an axis on the lost segment sends its drive a fault reset (0x6040 bit
         // 7): the segment is brought up again with it, on the "ethercat" thread.
         if fault_reset && self.in_alarm() && !self.reinit_pending {
@@ -809,6 +816,9 @@ impl Link {
             return;
         }
         self.counts.late += 1;
+        if self.watch.sent.load(Ordering::Acquire) == self.sent_at_handover {
+            self.counts.late_unsent += 1;
+        }
         self.late_since_complete = self.late_since_complete.saturating_add(1);
         self.late_in_a_row = self.late_in_a_row.saturating_add(1);
         self.counts.most_late_in_a_row = self.counts.most_late_in_a_row.max(self.late_in_a_row);
@@ -893,11 +903,12 @@ impl Link {
             misses = c.misses,
             ecat_late = c.late,
             alarms = c.alarms,
-            "EtherCAT segment: {} exchanges, {} missed exchanges (at most {} in a row), ecat_late {} cycles (at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us; {} answers after their verdict; {} re-inits after MC_Reset, {} back in OP",
+            "EtherCAT segment: {} exchanges, {} missed exchanges (at most {} in a row), ecat_late {} cycles ({} before the frame went out, at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us; {} answers after their verdict; {} re-inits after MC_Reset, {} back in OP",
             c.exchanges,
             c.misses,
             c.most_in_a_row,
             c.late,
+            c.late_unsent,
             c.most_late_in_a_row,
             c.alarms,
             c.round_trip_quantile_us(0.5),
@@ -994,6 +1005,7 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
         cycle_ns: cell.nodes.get(n).map_or(1, |x| x.cycle_ns),
         started: false,
         watch,
+        sent_at_handover: 0,
         counts: Box::default(),
     }))
 }
@@ -1646,6 +1658,7 @@ mod tests {
             cycle_ns: 2_000_000,
             started: false,
             watch: Arc::default(),
+            sent_at_handover: 0,
             counts: Box::default(),
         };
         f(&mut link, &mut exec, &bus_in, &bus_out, drive);
