@@ -8,38 +8,64 @@
 //! OP and waits for exchanges.
 //!
 //! Each cycle at `t`, before the step, the cyclic thread calls [`Link::exchange`]: it takes
-//! the process image back from the exchange it started at `t - cycle` (a whole cycle to
-//! complete), puts each drive's TxPDO into the executive, writes the RxPDO the step at
-//! `t - cycle` computed and hands the image to the "ethercat" thread, which runs one LRW
-//! (`SubDeviceGroup::tx_rx`) at once. The image moves between the two threads through two
-//! bounded channels (no lock, no allocation, no wait on the cyclic thread). An image not back
-//! by the next cycle, a failed exchange or a working counter below the expected one is a miss;
-//! after [`MISSES_TO_ALARM`] misses in a row each drive on the segment shows a fault with
-//! error code [`LOST_CODE`], which its axis takes as alarm 421 with the reaction the drive
-//! fault has; the node's other axes carry on.
+//! the process image back from the exchange it handed over at `t - cycle`, puts each drive's
+//! TxPDO into the executive, writes the RxPDO the step at `t - cycle` computed and hands the
+//! image to the "ethercat" thread, which runs one LRW (`SubDeviceGroup::tx_rx`) at once. The
+//! image moves between the two threads through two bounded channels (no lock, no allocation,
+//! no wait on the cyclic thread).
+//!
+//! The "ethercat" thread gives each exchange it attempted a [`Verdict`]: complete, or a miss
+//! (the frame went out and no answer came within [`answer_budget_ns`] of it, nothing being left
+//! unread in the socket; a short working counter; ethercrab failing the exchange). Frames go
+//! out and come in on "ethercat-io" ([`Io`]), which notes when each frame went out. A cycle
+//! whose image is not back yet is `ecat_late`: our own threads were late, not the segment, and
+//! it never counts as a miss. After [`MISSES_TO_ALARM`] misses in a row each drive on the
+//! segment shows a fault with error code [`LOST_CODE`], which its axis takes as alarm 421 with
+//! the reaction the drive fault has; the node's other axes carry on. Drives' positions are
+//! extrapolated over misses and late cycles until then; a stall of [`LATE_TO_ALARM_NS`] is the
+//! same alarm.
 
-use ethercrab::std::tx_rx_task;
+use async_io::Async;
 use ethercrab::subdevice_group::{self, DcConfiguration};
 use ethercrab::{
-    DcSync, MainDevice, MainDeviceConfig, PduStorage, RegisterAddress, SubDeviceGroup,
-    SubDeviceRef, Timeouts,
+    DcSync, MainDevice, MainDeviceConfig, PduRx, PduStorage, PduTx, RegisterAddress,
+    SubDeviceGroup, SubDeviceRef, Timeouts,
 };
+use socket::RawSocket;
 use std::fmt;
+use std::future::Future;
 use std::io::Write;
+use std::pin::Pin;
+use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
+use std::sync::Arc;
+use std::task::{Context, Poll};
 use std::time::{Duration, Instant};
 use tandem_config::{Cell, EthercatIdentity, EthercatRole};
-use tandem_motion::plant::cia402::{DriveCommand, DriveFeedback};
+use tandem_motion::plant::cia402::{controlword, DriveCommand, DriveFeedback};
 use tandem_runtime::exec::{Executive, Secs};
 use tracing::{info, warn};
 
-/// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 3 cycles, the
-/// bound the EtherCAT issue sets for a lost SubDevice's alarm (inferred: one or two late
-/// exchanges are jitter, three in a row a lost segment). It presumes the node runs with its
-/// `realtime.priority`, which its EtherCAT threads take too: without it, with a load of 5 on
-/// the shared 2-core test host, the "ethercat" thread was measured late up to 10 cycles in a row
-/// (2 ms cycle) while the segment was fine; with SCHED_FIFO 40 it missed none in 1,500 cycles.
+/// Misses in a row after which the drives on the segment show [`LOST_CODE`]: 3, the bound the
+/// EtherCAT issue sets for a lost SubDevice's alarm (inferred: one or two unanswered frames
+/// are noise, three in a row a lost segment). Only the "ethercat" thread's verdicts on frames
+/// that went out count (see [`Verdict`]); a cycle in which our own threads were late is
+/// `ecat_late`, never a miss, so a loaded host cannot raise this alarm on a healthy segment.
 pub const MISSES_TO_ALARM: u32 = 3;
+
+/// Late cycles in a row (in ns of the node's time) after which the segment is in alarm all
+/// the same: the "ethercat" thread stalled or gone, the drives unsupervised (inferred: twice
+/// ethercrab's PDU timeout, after which a frame that never went out fails the exchange).
+pub const LATE_TO_ALARM_NS: i64 = 200_000_000;
+
+/// The time a frame's answer has, from the frame going out, before the exchange is a miss:
+/// three quarters of the node's cycle, so that the verdict of an exchange handed over at a
+/// boundary is back before the next one (inferred: the most a segment can take while its
+/// exchange still fits in the cycle; the emulator's round trip on a veth pair is 0.1 to
+/// 0.3 ms, a 64-SubDevice line of real ESCs well below 0.1 ms).
+fn answer_budget_ns(cycle_ns: u64) -> i64 {
+    i64::try_from(cycle_ns / 4 * 3).unwrap_or(i64::MAX)
+}
 
 /// The error code 0x603F a drive on a segment that stopped exchanging shows: 0x8130, "life
 /// guard error or heartbeat error" of CiA 301's emergency error codes (inferred: the code of a
@@ -241,6 +267,250 @@ fn decode(map: &DriveMap, input: &[u8]) -> DriveFeedback {
     f
 }
 
+/// What the "ethercat-io" thread saw, for the "ethercat" thread's verdicts and the stop line.
+#[derive(Debug, Default)]
+struct IoWatch {
+    /// Frames sent.
+    sent: AtomicU64,
+    /// When the last frame went out (cell clock, ns).
+    sent_at_ns: AtomicI64,
+    /// A frame is being read or handed to ethercrab.
+    busy: AtomicBool,
+    /// Answers that came after their exchange's verdict (no exchange waits for them).
+    stray: AtomicU64,
+    /// Frames the socket refused to send.
+    send_errors: AtomicU64,
+}
+
+/// The raw socket of the segment: AF_PACKET bound to the interface and EtherType 0x88A4. The
+/// only unsafe code of the node's EtherCAT adapter: the socket calls of `libc`, each block
+/// saying why it is sound.
+#[allow(unsafe_code)]
+mod socket {
+
+    use std::ffi::CString;
+    use std::io;
+    use std::os::fd::{AsFd, AsRawFd, BorrowedFd, FromRawFd, OwnedFd};
+
+    /// The EtherCAT EtherType, in network byte order.
+    const ETHERTYPE_BE: u16 = 0x88A4u16.to_be();
+
+    /// An AF_PACKET raw socket on one interface, non-blocking.
+    #[derive(Debug)]
+    pub(super) struct RawSocket {
+        fd: OwnedFd,
+    }
+
+    impl RawSocket {
+        /// Opens the socket on `interface`.
+        pub(super) fn open(interface: &str) -> io::Result<Self> {
+            let name = CString::new(interface)
+                .map_err(|_| io::Error::from(io::ErrorKind::InvalidInput))?;
+            // SAFETY: `name` is a NUL-terminated string that lives across the call.
+            let index = unsafe { libc::if_nametoindex(name.as_ptr()) };
+            if index == 0 {
+                return Err(io::Error::last_os_error());
+            }
+            // SAFETY: a plain system call with constant arguments.
+            let fd = unsafe {
+                libc::socket(
+                    libc::AF_PACKET,
+                    libc::SOCK_RAW | libc::SOCK_NONBLOCK | libc::SOCK_CLOEXEC,
+                    libc::c_int::from(ETHERTYPE_BE),
+                )
+            };
+            if fd < 0 {
+                return Err(io::Error::last_os_error());
+            }
+            // SAFETY: `fd` is a fresh descriptor that nothing else owns.
+            let fd = unsafe { OwnedFd::from_raw_fd(fd) };
+            // SAFETY: all zeros is a valid `sockaddr_ll` (plain integers and bytes).
+            let mut addr: libc::sockaddr_ll = unsafe { core::mem::zeroed() };
+            addr.sll_family = libc::AF_PACKET as u16;
+            addr.sll_protocol = ETHERTYPE_BE;
+            addr.sll_ifindex = i32::try_from(index).unwrap_or(i32::MAX);
+            // SAFETY: `addr` is a valid `sockaddr_ll` of the length passed, alive across the call.
+            let rc = unsafe {
+                libc::bind(
+                    fd.as_raw_fd(),
+                    core::ptr::from_ref(&addr).cast(),
+                    core::mem::size_of::<libc::sockaddr_ll>() as libc::socklen_t,
+                )
+            };
+            if rc != 0 {
+                return Err(io::Error::last_os_error());
+            }
+            Ok(Self { fd })
+        }
+
+        /// Sends one Ethernet frame; the bytes sent.
+        pub(super) fn send(&self, frame: &[u8]) -> io::Result<usize> {
+            // SAFETY: `frame` is valid for reads of its length across the call.
+            let n =
+                unsafe { libc::send(self.fd.as_raw_fd(), frame.as_ptr().cast(), frame.len(), 0) };
+            usize::try_from(n).map_err(|_| io::Error::last_os_error())
+        }
+
+        /// Receives one Ethernet frame into `buf`; its length.
+        pub(super) fn recv(&self, buf: &mut [u8]) -> io::Result<usize> {
+            // SAFETY: `buf` is valid for writes of its length across the call.
+            let n =
+                unsafe { libc::recv(self.fd.as_raw_fd(), buf.as_mut_ptr().cast(), buf.len(), 0) };
+            usize::try_from(n).map_err(|_| io::Error::last_os_error())
+        }
+
+        /// Whether a frame waits in the socket, unread (FIONREAD: the length of the next one).
+        pub(super) fn unread(&self) -> bool {
+            let mut n: libc::c_int = 0;
+            // SAFETY: FIONREAD writes one `c_int` through the pointer, which is valid.
+            let rc = unsafe { libc::ioctl(self.fd.as_raw_fd(), libc::FIONREAD, &mut n) };
+            // A socket that cannot say is taken as holding a frame: no verdict on a guess.
+            rc != 0 || n > 0
+        }
+    }
+
+    impl AsFd for RawSocket {
+        fn as_fd(&self) -> BorrowedFd<'_> {
+            self.fd.as_fd()
+        }
+    }
+}
+
+/// ethercrab's TX/RX on the "ethercat-io" thread, as its `std::tx_rx_task` but through the
+/// public `PduTx`/`PduRx` of unmodified ethercrab (the transport its documentation leaves to
+/// the application): it notes when each frame goes out (the "ethercat" thread's verdicts count
+/// from there), and an answer no exchange waits for any more (its verdict given) is counted
+/// and dropped, where ethercrab 0.7.1's own task would end, and the segment with it.
+struct Io<'a> {
+    socket: Async<Arc<RawSocket>>,
+    tx: PduTx<'a>,
+    rx: PduRx<'a>,
+    watch: Arc<IoWatch>,
+    buf: Vec<u8>,
+}
+
+impl Future for Io<'_> {
+    type Output = ();
+
+    fn poll(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<()> {
+        let this = &mut *self;
+        this.tx.replace_waker(cx.waker());
+        if this.tx.should_exit() {
+            return Poll::Ready(());
+        }
+        while let Some(frame) = this.tx.next_sendable_frame() {
+            let socket = this.socket.get_ref();
+            let sent = frame.send_blocking(|data| {
+                socket
+                    .send(data)
+                    .map_err(|_| ethercrab::error::Error::SendFrame)
+            });
+            if sent.is_ok() {
+                this.watch
+                    .sent_at_ns
+                    .store(tandem_rt::now_ns(), Ordering::Release);
+                this.watch.sent.fetch_add(1, Ordering::AcqRel);
+            } else {
+                // The frame stays sendable; it goes at the next wake or its exchange fails.
+                this.watch.send_errors.fetch_add(1, Ordering::Relaxed);
+                break;
+            }
+        }
+        loop {
+            match this.socket.poll_readable(cx) {
+                Poll::Pending => return Poll::Pending,
+                Poll::Ready(Err(e)) => {
+                    warn!("EtherCAT socket: {e}");
+                    return Poll::Pending;
+                }
+                Poll::Ready(Ok(())) => {}
+            }
+            this.watch.busy.store(true, Ordering::Release);
+            match this.socket.get_ref().recv(&mut this.buf) {
+                Ok(n) => {
+                    let frame = this.buf.get(..n).unwrap_or_default();
+                    if this.rx.receive_frame(frame).is_err() {
+                        this.watch.stray.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                Err(e) => warn!("EtherCAT socket: {e}"),
+            }
+            this.watch.busy.store(false, Ordering::Release);
+        }
+    }
+}
+
+/// One exchange of `group` with its verdict (see [`Verdict`]) and round trip (ns): the
+/// frame's answer has `budget_ns` from the frame going out, and the verdict "no answer" is
+/// only given when nothing is left unread in the socket, so that a thread of ours not
+/// scheduled in time makes the verdict late, never a miss. The exchange's future is dropped
+/// at the verdict (ethercrab releases its frame; a later answer is a stray, see [`Io`]).
+async fn attempt<DC>(
+    md: &MainDevice<'_>,
+    group: &OpGroup<DC>,
+    io: (&IoWatch, &RawSocket),
+    budget_ns: i64,
+    expected_wkc: u16,
+) -> (Verdict, u64) {
+    let (watch, socket) = io;
+    let before = watch.sent.load(Ordering::Acquire);
+    let started = tandem_rt::now_ns();
+    let mut exchange = std::pin::pin!(group.tx_rx(md));
+    let mut check_at = started.saturating_add(budget_ns);
+    let result = loop {
+        let wait = u64::try_from(check_at.saturating_sub(tandem_rt::now_ns())).unwrap_or(0);
+        let mut timer = async_io::Timer::after(Duration::from_nanos(wait));
+        let done = std::future::poll_fn(|cx| {
+            if let Poll::Ready(r) = exchange.as_mut().poll(cx) {
+                return Poll::Ready(Some(r));
+            }
+            Pin::new(&mut timer).poll(cx).map(|_| None)
+        })
+        .await;
+        if let Some(r) = done {
+            break Some(r);
+        }
+        let now = tandem_rt::now_ns();
+        // Read before the exchange is polled once more: an answer handed over in between is
+        // then seen by that poll.
+        let quiet = !watch.busy.load(Ordering::Acquire) && !socket.unread();
+        let out = watch.sent.load(Ordering::Acquire) != before;
+        let due = watch
+            .sent_at_ns
+            .load(Ordering::Acquire)
+            .saturating_add(budget_ns);
+        if let Poll::Ready(r) = futures_poll_once(exchange.as_mut()).await {
+            break Some(r);
+        }
+        if out && now >= due && quiet {
+            break None;
+        }
+        // Not out yet, not due yet, or an answer waits to be read: look again shortly.
+        check_at = if out && now < due {
+            due
+        } else {
+            now.saturating_add(budget_ns / 16)
+        };
+    };
+    let round_trip = u64::try_from(tandem_rt::now_ns().saturating_sub(started)).unwrap_or(0);
+    let verdict = match result {
+        None => Verdict::NoAnswer,
+        Some(Ok(r)) if r.working_counter >= expected_wkc => Verdict::Complete,
+        Some(Ok(r)) => Verdict::WorkingCounter {
+            got: r.working_counter,
+            want: expected_wkc,
+        },
+        Some(Err(_)) => Verdict::Failed,
+    };
+    (verdict, round_trip)
+}
+
+/// Polls `f` once: its output if ready.
+async fn futures_poll_once<F: Future + Unpin>(mut f: F) -> Poll<F::Output> {
+    std::future::poll_fn(|cx| Poll::Ready(Pin::new(&mut f).poll(cx))).await
+}
+
 /// One SubDevice's part of the process image the two threads hand over.
 #[derive(Debug)]
 struct Part {
@@ -264,14 +534,51 @@ struct Part {
     name: String,
 }
 
+/// The "ethercat" thread's verdict on one exchange it attempted.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum Verdict {
+    /// Not attempted yet (the image is on its way to the "ethercat" thread or held by the
+    /// cyclic thread).
+    Pending,
+    /// Answered with the expected working counter.
+    Complete,
+    /// The frame went out and no answer came within [`answer_budget_ns`] of it, with nothing
+    /// left unread in the socket: the segment did not answer.
+    NoAnswer,
+    /// Answered with a working counter below the expected one.
+    WorkingCounter {
+        /// The working counter that came back.
+        got: u16,
+        /// The one a complete exchange has.
+        want: u16,
+    },
+    /// ethercrab refused or failed the exchange (e.g. its own PDU timeout, no frame free).
+    Failed,
+}
+
+impl fmt::Display for Verdict {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Pending => f.write_str("not attempted"),
+            Self::Complete => f.write_str("complete"),
+            Self::NoAnswer => f.write_str("no answer"),
+            Self::WorkingCounter { got, want } => write!(f, "working counter {got} of {want}"),
+            Self::Failed => f.write_str("exchange failed"),
+        }
+    }
+}
+
 /// The process image between the cyclic thread and the "ethercat" thread.
 #[derive(Debug)]
 struct Image {
     parts: Vec<Part>,
-    /// The exchange completed with the expected working counter.
-    ok: bool,
+    /// The "ethercat" thread's verdict on its exchange.
+    verdict: Verdict,
     /// Its round trip (ns).
     round_trip_ns: u64,
+    /// MC_Reset of a lost segment: the "ethercat" thread brings the segment up again (from
+    /// INIT to OP) before this image's exchange.
+    reinit: bool,
 }
 
 /// Counters of the segment, reported at the end.
@@ -279,12 +586,24 @@ struct Image {
 pub struct SegmentCounts {
     /// Exchanges that came back complete.
     pub exchanges: u64,
-    /// Cycles without a complete exchange (late, failed or a working counter error).
+    /// Exchanges the segment did not answer completely: the frame went out and its answer
+    /// did not come within [`answer_budget_ns`], came with a short working counter, or
+    /// ethercrab failed the exchange.
     pub misses: u64,
+    /// `ecat_late`: cycles without a verdict on the exchange handed over a cycle before, our
+    /// own threads being late (not the segment's fault, never a miss).
+    pub late: u64,
     /// Times the segment went into alarm.
     pub alarms: u64,
     /// The most misses in a row.
     pub most_in_a_row: u32,
+    /// The most late cycles in a row.
+    pub most_late_in_a_row: u32,
+    /// Late cycles whose frame had not even gone out: the "ethercat" or "ethercat-io" thread
+    /// had not run since the handover (the rest waited for an answer or the verdict).
+    pub late_unsent: u64,
+    /// Re-inits of the segment MC_Reset asked for, and those that brought it back to OP.
+    pub reinits: (u32, u32),
     /// Round trips of the exchanges, in buckets of 10 µs (the last one: 10 ms and more).
     pub round_trip_10us: [u32; 1001],
 }
@@ -294,8 +613,12 @@ impl Default for SegmentCounts {
         Self {
             exchanges: 0,
             misses: 0,
+            late: 0,
             alarms: 0,
             most_in_a_row: 0,
+            most_late_in_a_row: 0,
+            late_unsent: 0,
+            reinits: (0, 0),
             round_trip_10us: [0; 1001],
         }
     }
@@ -327,12 +650,26 @@ pub struct Link {
     image: Option<Box<Image>>,
     /// Misses in a row.
     in_a_row: u32,
+    /// Late cycles in a row.
+    late_in_a_row: u32,
+    /// Late cycles since the last complete exchange.
+    late_since_complete: u32,
+    /// The boundary at which the last complete exchange was taken back.
+    last_complete: i64,
+    /// In alarm for a stall of the "ethercat" thread ([`LATE_TO_ALARM_NS`]).
+    stalled: bool,
+    /// A re-init (MC_Reset of the lost segment) was handed over and is not back yet.
+    reinit_pending: bool,
     /// The drives on the segment: device and last feedback (extrapolated over misses).
     drives: Vec<(usize, DriveFeedback)>,
     /// The node's cycle (ns).
     cycle_ns: i64,
     /// The first exchange has been started.
     started: bool,
+    /// What the "ethercat-io" thread saw.
+    watch: Arc<IoWatch>,
+    /// Frames sent by the "ethercat-io" thread when the last image was handed over.
+    sent_at_handover: u64,
     /// The counters.
     pub counts: Box<SegmentCounts>,
 }
@@ -345,7 +682,7 @@ impl Link {
             // The first boundary: nothing was exchanged before it; the first outputs go out.
             self.started = true;
             if let Some(image) = self.image.take() {
-                self.send(image, exec);
+                self.send(t, image, exec, log);
             }
             return;
         }
@@ -353,52 +690,93 @@ impl Link {
             self.image = Some(image);
         }
         let Some(mut image) = self.image.take() else {
-            // The exchange started a cycle ago is not back.
-            self.miss(exec);
+            // No verdict yet on the exchange handed over a cycle ago: our own thread is late.
+            self.late(exec);
             return;
         };
-        if image.ok {
-            self.in_a_row = 0;
-            self.counts.exchanges += 1;
-            let bucket = usize::try_from(image.round_trip_ns / 10_000).unwrap_or(usize::MAX);
-            if let Some(c) = self.counts.round_trip_10us.get_mut(bucket.min(1000)) {
-                *c = c.saturating_add(1);
-            }
-            for p in &mut image.parts {
-                if p.map.is_some() {
-                    exec.set_drive_feedback(p.device, &p.feedback);
-                    if let Some(d) = self.drives.iter_mut().find(|d| d.0 == p.device) {
-                        d.1 = p.feedback;
-                    }
-                    continue;
-                }
-                if let Some(d) = p.inputs_device {
-                    exec.set_input_levels(d, t, u32::from(p.inputs));
-                }
-                if p.inputs != p.inputs_logged {
-                    p.inputs_logged = p.inputs;
-                    // The log ring keeps what fits; a full ring counts its losses itself.
-                    let _ = writeln!(
-                        log,
-                        "t={} {} inputs 0x{:02X} (EtherCAT)",
-                        Secs(t),
-                        p.name,
-                        p.inputs
-                    );
-                }
-            }
-        } else {
-            self.miss(exec);
+        if image.verdict == Verdict::Pending {
+            // Still here from a cycle in which the "ethercat" thread held the previous image:
+            // the handover waited, which is lateness of our own, not a miss.
+            self.late(exec);
+            self.send(t, image, exec, log);
+            return;
         }
-        self.send(image, exec);
+        self.late_in_a_row = 0;
+        if self.reinit_pending {
+            self.reinit_pending = false;
+            let back = image.verdict == Verdict::Complete;
+            self.counts.reinits.1 += u32::from(back);
+            // As the other log lines.
+            let _ = writeln!(
+                log,
+                "t={} EtherCAT {}: {}",
+                Secs(t),
+                self.interface,
+                if back {
+                    "back in OP after MC_Reset"
+                } else {
+                    "not back in OP after MC_Reset (the node's log says why)"
+                }
+            );
+        }
+        if image.verdict == Verdict::Complete {
+            self.complete(t, &mut image, exec, log);
+        } else {
+            self.miss(t, image.verdict, exec, log);
+        }
+        self.send(t, image, exec, log);
+    }
+
+    /// A complete exchange: its inputs into `exec`.
+    fn complete(
+        &mut self,
+        t: i64,
+        image: &mut Image,
+        exec: &mut Executive<'_>,
+        log: &mut impl Write,
+    ) {
+        self.in_a_row = 0;
+        self.stalled = false;
+        self.late_since_complete = 0;
+        self.last_complete = t;
+        self.counts.exchanges += 1;
+        let bucket = usize::try_from(image.round_trip_ns / 10_000).unwrap_or(usize::MAX);
+        if let Some(c) = self.counts.round_trip_10us.get_mut(bucket.min(1000)) {
+            *c = c.saturating_add(1);
+        }
+        for p in &mut image.parts {
+            if p.map.is_some() {
+                exec.set_drive_feedback(p.device, &p.feedback);
+                if let Some(d) = self.drives.iter_mut().find(|d| d.0 == p.device) {
+                    d.1 = p.feedback;
+                }
+                continue;
+            }
+            if let Some(d) = p.inputs_device {
+                exec.set_input_levels(d, t, u32::from(p.inputs));
+            }
+            if p.inputs != p.inputs_logged {
+                p.inputs_logged = p.inputs;
+                // The log ring keeps what fits; a full ring counts its losses itself.
+                let _ = writeln!(
+                    log,
+                    "t={} {} inputs 0x{:02X} (EtherCAT)",
+                    Secs(t),
+                    p.name,
+                    p.inputs
+                );
+            }
+        }
     }
 
     /// The RxPDO of the last step into `image`, handed to the "ethercat" thread (kept for the
     /// next cycle if it still holds the previous one).
-    fn send(&mut self, mut image: Box<Image>, exec: &Executive<'_>) {
+    fn send(&mut self, t: i64, mut image: Box<Image>, exec: &Executive<'_>, log: &mut impl Write) {
+        let mut fault_reset = false;
         for p in &mut image.parts {
             if p.map.is_some() {
                 p.command = exec.drive_command(p.device).copied().unwrap_or_default();
+                fault_reset |= p.command.controlword & controlword::FAULT_RESET != 0;
             } else {
                 // The levels the last step left on its output channels (bit c - 1: channel c).
                 p.outputs = exec
@@ -406,33 +784,106 @@ impl Link {
                     .map_or(0, |s| (s.levels & 0xFF) as u8);
             }
         }
-        image.ok = false;
+        image.verdict = Verdict::Pending;
+        self.sent_at_handover = self.watch.sent.load(Ordering::Acquire);
+        // MC_Reset of an axis on the lost segment sends its drive a fault reset (0x6040 bit
+        // 7): the segment is brought up again with it, on the "ethercat" thread.
+        if fault_reset && self.in_alarm() && !self.reinit_pending {
+            image.reinit = true;
+            self.reinit_pending = true;
+            self.counts.reinits.0 += 1;
+            // As the other log lines.
+            let _ = writeln!(
+                log,
+                "t={} EtherCAT {}: MC_Reset: bringing the segment up again",
+                Secs(t),
+                self.interface
+            );
+        }
         match self.to_bus.try_send(image) {
             Ok(()) => {}
             Err(TrySendError::Full(i) | TrySendError::Disconnected(i)) => self.image = Some(i),
         }
     }
 
-    /// One cycle without a complete exchange; the alarm at [`MISSES_TO_ALARM`] in a row.
-    fn miss(&mut self, exec: &mut Executive<'_>) {
+    /// A cycle without a verdict on the exchange handed over (our own thread late, not the
+    /// segment): counted as `ecat_late`, the drives' positions extrapolated; only a stall of
+    /// [`LATE_TO_ALARM_NS`] in a row is an alarm.
+    fn late(&mut self, exec: &mut Executive<'_>) {
+        if self.reinit_pending {
+            // The segment is being brought up again: still lost, and no lateness of ours.
+            self.lost(exec);
+            return;
+        }
+        self.counts.late += 1;
+        if self.watch.sent.load(Ordering::Acquire) == self.sent_at_handover {
+            self.counts.late_unsent += 1;
+        }
+        self.late_since_complete = self.late_since_complete.saturating_add(1);
+        self.late_in_a_row = self.late_in_a_row.saturating_add(1);
+        self.counts.most_late_in_a_row = self.counts.most_late_in_a_row.max(self.late_in_a_row);
+        let stalled =
+            i64::from(self.late_in_a_row).saturating_mul(self.cycle_ns) >= LATE_TO_ALARM_NS;
+        if stalled && self.in_a_row < MISSES_TO_ALARM {
+            if !self.stalled {
+                self.stalled = true;
+                self.counts.alarms += 1;
+            }
+            self.lost(exec);
+        } else if self.in_a_row < MISSES_TO_ALARM {
+            self.extrapolate(exec);
+        } else {
+            self.lost(exec);
+        }
+    }
+
+    /// An exchange the segment did not answer (a verdict of the "ethercat" thread); the alarm
+    /// at [`MISSES_TO_ALARM`] in a row.
+    fn miss(&mut self, t: i64, verdict: Verdict, exec: &mut Executive<'_>, log: &mut impl Write) {
         self.counts.misses += 1;
         self.in_a_row = self.in_a_row.saturating_add(1);
         self.counts.most_in_a_row = self.counts.most_in_a_row.max(self.in_a_row);
-        if self.in_a_row < MISSES_TO_ALARM {
-            // Until the alarm the drives' positions go on at their last velocity, so a late
-            // exchange makes no jump in the following error (inferred: a drive in CSP keeps
-            // following its last setpoints' motion; the real sample replaces this one).
-            let dt = self.cycle_ns as f64 * 1e-9;
-            for (device, last) in &mut self.drives {
-                let step = (f64::from(last.velocity_actual) * dt).round() as i64;
-                last.position_actual = last.position_actual.wrapping_add(step as i32);
-                exec.set_drive_feedback(*device, last);
-            }
+        if self.in_a_row <= MISSES_TO_ALARM {
+            // A few lines per lost segment; the log ring keeps what fits.
+            let _ = writeln!(
+                log,
+                "t={} EtherCAT {}: miss {} in a row ({verdict}), last complete exchange at t={}, {} late cycle(s) since",
+                Secs(t),
+                self.interface,
+                self.in_a_row,
+                Secs(self.last_complete),
+                self.late_since_complete,
+            );
+        }
+        if self.in_a_row < MISSES_TO_ALARM && !self.stalled {
+            self.extrapolate(exec);
             return;
         }
-        if self.in_a_row == MISSES_TO_ALARM {
+        if self.in_a_row == MISSES_TO_ALARM && !self.stalled {
             self.counts.alarms += 1;
         }
+        self.lost(exec);
+    }
+
+    /// Until the alarm the drives' positions go on at their last velocity, so that a missed or
+    /// late exchange makes no jump in the following error (inferred: a drive in CSP keeps
+    /// following its last setpoints' motion; the real sample replaces this one).
+    fn extrapolate(&mut self, exec: &mut Executive<'_>) {
+        let dt = self.cycle_ns as f64 * 1e-9;
+        for (device, last) in &mut self.drives {
+            let step = (f64::from(last.velocity_actual) * dt).round() as i64;
+            last.position_actual = last.position_actual.wrapping_add(step as i32);
+            exec.set_drive_feedback(*device, last);
+        }
+    }
+
+    /// The segment is in alarm (lost or stalled).
+    fn in_alarm(&self) -> bool {
+        self.in_a_row >= MISSES_TO_ALARM || self.stalled
+    }
+
+    /// Each drive on the segment shows a fault with [`LOST_CODE`].
+    fn lost(&self, exec: &mut Executive<'_>) {
         let lost = DriveFeedback {
             statusword: FAULT_STATUSWORD,
             error_code: LOST_CODE,
@@ -443,22 +894,29 @@ impl Link {
         }
     }
 
-    /// The segment's counters, logged at the node's end.
+    /// The segment's counters, logged at the node's end (its stop line).
     pub fn report(&self) {
         let c = &self.counts;
         info!(
             interface = %self.interface,
             exchanges = c.exchanges,
             misses = c.misses,
+            ecat_late = c.late,
             alarms = c.alarms,
-            "EtherCAT segment: {} exchanges, {} missed cycles (at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us",
+            "EtherCAT segment: {} exchanges, {} missed exchanges (at most {} in a row), ecat_late {} cycles ({} before the frame went out, at most {} in a row), {} alarms; round trip p50 <= {} us, p99 <= {} us, max <= {} us; {} answers after their verdict; {} re-inits after MC_Reset, {} back in OP",
             c.exchanges,
             c.misses,
             c.most_in_a_row,
+            c.late,
+            c.late_unsent,
+            c.most_late_in_a_row,
             c.alarms,
             c.round_trip_quantile_us(0.5),
             c.round_trip_quantile_us(0.99),
             c.round_trip_quantile_us(1.0),
+            self.watch.stray.load(Ordering::Relaxed),
+            c.reinits.0,
+            c.reinits.1,
         );
     }
 }
@@ -509,10 +967,12 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
     let (ready_tx, ready_rx) = sync_channel::<Result<Box<Image>, EthercatError>>(1);
     let (to_bus, bus_in) = sync_channel::<Box<Image>>(1);
     let (bus_out, from_bus) = sync_channel::<Box<Image>>(1);
+    let watch = Arc::new(IoWatch::default());
+    let io_watch = Arc::clone(&watch);
     std::thread::Builder::new()
         .name("ethercat".into())
         .stack_size(8 << 20)
-        .spawn(move || bus_thread(&plan, &ready_tx, &bus_in, &bus_out))
+        .spawn(move || bus_thread(&plan, &ready_tx, &bus_in, &bus_out, io_watch))
         .map_err(|e| start_error(format!("cannot start the ethercat thread: {e}")))?;
     let image = match ready_rx.recv_timeout(START_TIMEOUT) {
         Ok(r) => r?,
@@ -536,9 +996,16 @@ pub fn open(cell: &Cell, n: usize) -> Result<Option<Link>, EthercatError> {
         from_bus,
         image: Some(image),
         in_a_row: 0,
+        late_in_a_row: 0,
+        late_since_complete: 0,
+        last_complete: 0,
+        stalled: false,
+        reinit_pending: false,
         drives,
         cycle_ns: cell.nodes.get(n).map_or(1, |x| x.cycle_ns),
         started: false,
+        watch,
+        sent_at_handover: 0,
         counts: Box::default(),
     }))
 }
@@ -550,6 +1017,7 @@ fn bus_thread(
     ready: &SyncSender<Result<Box<Image>, EthercatError>>,
     bus_in: &Receiver<Box<Image>>,
     bus_out: &SyncSender<Box<Image>>,
+    watch: Arc<IoWatch>,
 ) {
     let fail = |reason: String| EthercatError::Start {
         interface: plan.interface.clone(),
@@ -560,13 +1028,23 @@ fn bus_thread(
         let _ = ready.send(Err(fail("the PDU storage is in use already".into())));
         return;
     };
-    let task = match tx_rx_task(&plan.interface, tx, rx) {
-        Ok(t) => t,
+    let socket = match RawSocket::open(&plan.interface).and_then(|s| {
+        let s = Arc::new(s);
+        Async::new(Arc::clone(&s)).map(|a| (s, a))
+    }) {
+        Ok(s) => s,
         Err(e) => {
             // As above: a receiver that gave up needs no answer.
             let _ = ready.send(Err(fail(format!("cannot open the interface: {e}"))));
             return;
         }
+    };
+    let task = Io {
+        socket: socket.1,
+        tx,
+        rx,
+        watch: Arc::clone(&watch),
+        buf: vec![0; 1 << 14],
     };
     let priority = plan.priority;
     realtime(priority);
@@ -574,9 +1052,7 @@ fn bus_thread(
         .name("ethercat-io".into())
         .spawn(move || {
             realtime(priority);
-            if let Err(e) = async_io::block_on(task) {
-                warn!("EtherCAT TX/RX ended: {e}");
-            }
+            async_io::block_on(task);
         });
     if let Err(e) = io {
         // As above.
@@ -596,7 +1072,14 @@ fn bus_thread(
             ..MainDeviceConfig::default()
         },
     );
-    async_io::block_on(run_bus(plan, &md, ready, bus_in, bus_out));
+    let ends = Ends {
+        ready,
+        bus_in,
+        bus_out,
+        watch,
+        socket: socket.0,
+    };
+    async_io::block_on(run_bus(plan, &md, &ends));
 }
 
 /// SCHED_FIFO at the node's priority, if it has one (a refusal is a warning).
@@ -620,11 +1103,14 @@ fn cell_dc_now() -> u64 {
     u64::try_from(tandem_rt::now_ns().saturating_sub(DC_EPOCH_NS)).unwrap_or(0)
 }
 
-/// The "ethercat" thread's ends of the channels.
+/// The "ethercat" thread's ends of the channels, and what it watches of the "ethercat-io"
+/// thread.
 struct Ends<'a> {
     ready: &'a SyncSender<Result<Box<Image>, EthercatError>>,
     bus_in: &'a Receiver<Box<Image>>,
     bus_out: &'a SyncSender<Box<Image>>,
+    watch: Arc<IoWatch>,
+    socket: Arc<RawSocket>,
 }
 
 impl Ends<'_> {
@@ -639,19 +1125,77 @@ impl Ends<'_> {
 type OpGroup<DC> =
     SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, subdevice_group::Op, DC>;
 
-/// The MainDevice's work: start (see [`open`]), then the exchanges.
-async fn run_bus(
+/// How [`serve`] (and the bring-up before it) ended.
+enum Served {
+    /// The cyclic thread's end of the channel went.
+    End,
+    /// MC_Reset asked to bring the segment up again; the image to exchange once it is.
+    Reinit(Box<Image>),
+    /// The segment could not be brought to OP.
+    Failed(EthercatError),
+}
+
+/// The MainDevice's work: start (see [`open`]), then the exchanges; after MC_Reset of a lost
+/// segment it is brought up again from INIT (ethercrab's `init_single_group` on the same
+/// MainDevice: it counts, resets and addresses the SubDevices anew), here on the "ethercat"
+/// thread while the cyclic thread carries on, its drives shown lost until the image is back.
+async fn run_bus(plan: &Plan, md: &MainDevice<'_>, ends: &Ends<'_>) {
+    let mut held: Option<Box<Image>> = None;
+    loop {
+        let again = held.is_some();
+        match bring_up(plan, md, ends, &mut held).await {
+            Served::End => return,
+            Served::Reinit(image) => held = Some(image),
+            Served::Failed(e) if !again => return ends.refuse(e),
+            Served::Failed(e) => {
+                warn!(
+                    "EtherCAT segment on `{}` not back in OP: {e}",
+                    plan.interface
+                );
+                let Some(mut image) = held.take() else {
+                    return;
+                };
+                image.verdict = Verdict::Failed;
+                image.reinit = false;
+                if ends.bus_out.send(image).is_err() {
+                    return;
+                }
+                match wait_for_reinit(ends) {
+                    Some(image) => held = Some(image),
+                    None => return,
+                }
+            }
+        }
+    }
+}
+
+/// Without a segment in OP: every image handed over fails at once, until one asks for a
+/// re-init (returned) or the cyclic thread's end goes (`None`).
+fn wait_for_reinit(ends: &Ends<'_>) -> Option<Box<Image>> {
+    loop {
+        let mut image = match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
+            Ok(i) => i,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => return None,
+        };
+        if image.reinit {
+            return Some(image);
+        }
+        image.verdict = Verdict::Failed;
+        if ends.bus_out.send(image).is_err() {
+            return None;
+        }
+    }
+}
+
+/// The segment from INIT to OP (the bus checked, the mappings read, SYNC0), then [`serve`];
+/// `held` is the image of a re-init.
+async fn bring_up(
     plan: &Plan,
     md: &MainDevice<'_>,
-    ready: &SyncSender<Result<Box<Image>, EthercatError>>,
-    bus_in: &Receiver<Box<Image>>,
-    bus_out: &SyncSender<Box<Image>>,
-) {
-    let ends = Ends {
-        ready,
-        bus_in,
-        bus_out,
-    };
+    ends: &Ends<'_>,
+    held: &mut Option<Box<Image>>,
+) -> Served {
     let fail = |what: &str, e: ethercrab::error::Error| EthercatError::Start {
         interface: plan.interface.clone(),
         reason: format!("{what}: {e}"),
@@ -661,11 +1205,11 @@ async fn run_bus(
         .await
     {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("no segment found", e)),
+        Err(e) => return Served::Failed(fail("no segment found", e)),
     };
     let parts = match check_and_map(plan, md, &group).await {
         Ok(p) => p,
-        Err(e) => return ends.refuse(e),
+        Err(e) => return Served::Failed(e),
     };
     // SYNC0 on every SubDevice with DC, every node cycle.
     let mut dc = 0usize;
@@ -678,13 +1222,12 @@ async fn run_bus(
     if dc == 0 {
         let group = match group.into_safe_op(md).await {
             Ok(g) => g,
-            Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+            Err(e) => return Served::Failed(fail("SAFE-OP refused", e)),
         };
-        match group.request_into_op(md).await {
-            Ok(g) => serve(plan, md, &g, parts, &ends).await,
-            Err(e) => ends.refuse(fail("OP refused", e)),
-        }
-        return;
+        return match group.request_into_op(md).await {
+            Ok(g) => serve(plan, md, &g, parts, held, ends).await,
+            Err(e) => Served::Failed(fail("OP refused", e)),
+        };
     }
     let conf = DcConfiguration {
         // Inferred: time for the SubDevices to take the configuration before the first pulse.
@@ -694,22 +1237,22 @@ async fn run_bus(
     };
     let group = match group.into_pre_op_pdi(md).await {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("process data mapping", e)),
+        Err(e) => return Served::Failed(fail("process data mapping", e)),
     };
     let group = match group.configure_dc_sync(md, conf).await {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("SYNC0 configuration", e)),
+        Err(e) => return Served::Failed(fail("SYNC0 configuration", e)),
     };
     let group = match group.into_safe_op(md).await {
         Ok(g) => g,
-        Err(e) => return ends.refuse(fail("SAFE-OP refused", e)),
+        Err(e) => return Served::Failed(fail("SAFE-OP refused", e)),
     };
     match group.request_into_op(md).await {
         Ok(g) => {
             log_dc(plan, md, &g, dc).await;
-            serve(plan, md, &g, parts, &ends).await;
+            serve(plan, md, &g, parts, held, ends).await
         }
-        Err(e) => ends.refuse(fail("OP refused", e)),
+        Err(e) => Served::Failed(fail("OP refused", e)),
     }
 }
 
@@ -811,28 +1354,31 @@ where
     }
 }
 
-/// In OP: reports the segment ready, then one exchange per image handed over until the
-/// cyclic thread's end of the channel goes.
+/// In OP: reports the segment ready (or, after a re-init, exchanges the `held` image with the
+/// mappings read anew), then one exchange per image handed over until the cyclic thread's end
+/// of the channel goes or an image asks for a re-init.
 async fn serve<DC>(
     plan: &Plan,
     md: &MainDevice<'_>,
     group: &OpGroup<DC>,
     parts: Vec<Part>,
+    held: &mut Option<Box<Image>>,
     ends: &Ends<'_>,
-) {
+) -> Served {
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         match group.tx_rx(md).await {
             Ok(r) if r.all_op() => break,
-            Ok(_) if Instant::now() < deadline => {}
+            // A frame lost on the way (a faulty segment) is tried again until the deadline.
+            Ok(_) | Err(_) if Instant::now() < deadline => {}
             Ok(_) => {
-                return ends.refuse(EthercatError::Start {
+                return Served::Failed(EthercatError::Start {
                     interface: plan.interface.clone(),
                     reason: "not all SubDevices in OP within 10 s".into(),
                 })
             }
             Err(e) => {
-                return ends.refuse(EthercatError::Start {
+                return Served::Failed(EthercatError::Start {
                     interface: plan.interface.clone(),
                     reason: format!("exchange on the way to OP: {e}"),
                 })
@@ -849,20 +1395,41 @@ async fn serve<DC>(
             u16::from(!io.inputs().is_empty()) + 2 * u16::from(!io.outputs().is_empty())
         })
         .sum();
-    let image = Box::new(Image {
-        parts,
-        ok: false,
-        round_trip_ns: 0,
-    });
-    if ends.ready.send(Ok(image)).is_err() {
-        return;
-    }
+    let mut next = match held.take() {
+        Some(mut image) => {
+            // Back after MC_Reset: the same SubDevices (checked), their mappings read anew.
+            for (p, n) in image.parts.iter_mut().zip(parts) {
+                p.map = n.map;
+            }
+            image.reinit = false;
+            info!(interface = %plan.interface, "EtherCAT segment back in OP");
+            Some(image)
+        }
+        None => {
+            let image = Box::new(Image {
+                parts,
+                verdict: Verdict::Pending,
+                round_trip_ns: 0,
+                reinit: false,
+            });
+            if ends.ready.send(Ok(image)).is_err() {
+                return Served::End;
+            }
+            None
+        }
+    };
     loop {
-        let mut image = match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
-            Ok(i) => i,
-            Err(RecvTimeoutError::Timeout) => continue,
-            Err(RecvTimeoutError::Disconnected) => return,
+        let mut image = match next.take() {
+            Some(i) => i,
+            None => match ends.bus_in.recv_timeout(Duration::from_secs(1)) {
+                Ok(i) => i,
+                Err(RecvTimeoutError::Timeout) => continue,
+                Err(RecvTimeoutError::Disconnected) => return Served::End,
+            },
         };
+        if image.reinit {
+            return Served::Reinit(image);
+        }
         for (p, sd) in image.parts.iter().zip(group.iter(md)) {
             let mut out = sd.outputs_raw_mut();
             match &p.map {
@@ -870,11 +1437,17 @@ async fn serve<DC>(
                 None => put(&mut out, 0, 1, i64::from(p.outputs)),
             }
         }
-        let sent = Instant::now();
-        let result = group.tx_rx(md).await;
-        image.round_trip_ns = u64::try_from(sent.elapsed().as_nanos()).unwrap_or(u64::MAX);
-        image.ok = matches!(&result, Ok(r) if r.working_counter >= expected_wkc);
-        if image.ok {
+        let (verdict, round_trip) = attempt(
+            md,
+            group,
+            (&ends.watch, &ends.socket),
+            answer_budget_ns(plan.cycle_ns),
+            expected_wkc,
+        )
+        .await;
+        image.verdict = verdict;
+        image.round_trip_ns = round_trip;
+        if verdict == Verdict::Complete {
             for (p, sd) in image.parts.iter_mut().zip(group.iter(md)) {
                 let input = sd.inputs_raw();
                 match &p.map {
@@ -884,7 +1457,7 @@ async fn serve<DC>(
             }
         }
         if ends.bus_out.send(image).is_err() {
-            return;
+            return Served::End;
         }
     }
 }
@@ -1071,49 +1644,72 @@ mod tests {
             from_bus,
             image: Some(Box::new(Image {
                 parts: vec![part],
-                ok: false,
+                verdict: Verdict::Pending,
                 round_trip_ns: 0,
+                reinit: false,
             })),
             in_a_row: 0,
+            late_in_a_row: 0,
+            late_since_complete: 0,
+            last_complete: 0,
+            stalled: false,
+            reinit_pending: false,
             drives: vec![(drive, DriveFeedback::default())],
             cycle_ns: 2_000_000,
             started: false,
+            watch: Arc::default(),
+            sent_at_handover: 0,
             counts: Box::default(),
         };
         f(&mut link, &mut exec, &bus_in, &bus_out, drive);
     }
 
+    /// Cycle 0 and 1 of a link: the first image goes out, comes back complete with the drive
+    /// at 1000 increments moving 500 000 increments/s, and goes out again (returned).
+    fn first_exchange(
+        link: &mut Link,
+        exec: &mut Executive<'_>,
+        bus_in: &Receiver<Box<Image>>,
+        bus_out: &SyncSender<Box<Image>>,
+        log: &mut Vec<u8>,
+    ) -> Box<Image> {
+        link.exchange(0, exec, log);
+        let mut image = bus_in.try_recv().expect("sent at the first boundary");
+        image.verdict = Verdict::Complete;
+        image.round_trip_ns = 120_000;
+        image.parts[0].feedback = DriveFeedback {
+            statusword: 0x0237,
+            position_actual: 1000,
+            velocity_actual: 500_000,
+            ..DriveFeedback::default()
+        };
+        bus_out.send(image).unwrap();
+        link.exchange(2_000_000, exec, log);
+        bus_in.try_recv().expect("sent again")
+    }
+
     #[test]
-    fn a_late_exchange_extrapolates_and_the_third_miss_in_a_row_is_the_alarm() {
+    fn the_third_unanswered_exchange_in_a_row_is_the_alarm() {
         with_link(|link, exec, bus_in, bus_out, drive| {
             let mut log = Vec::new();
-            // Cycle 0: the first image goes out at once.
-            link.exchange(0, exec, &mut log);
-            let mut image = bus_in.try_recv().expect("sent at the first boundary");
-            // The bus answers: the drive at 1000 increments, 500 000 increments/s.
-            image.ok = true;
-            image.round_trip_ns = 120_000;
-            image.parts[0].feedback = DriveFeedback {
-                statusword: 0x0237,
-                position_actual: 1000,
-                velocity_actual: 500_000,
-                ..DriveFeedback::default()
-            };
-            bus_out.send(image).unwrap();
-            link.exchange(2_000_000, exec, &mut log);
+            let mut image = first_exchange(link, exec, bus_in, bus_out, &mut log);
             assert_eq!(exec.drive_feedback(drive).unwrap().position_actual, 1000);
             assert_eq!((link.counts.exchanges, link.counts.misses), (1, 0));
             assert_eq!(link.counts.round_trip_10us[12], 1);
-            // The next image is out; nothing comes back for two cycles: the position goes on
-            // at the last velocity (1000 increments per 2 ms), no alarm.
-            let _held = bus_in.try_recv().expect("sent again");
+            // The segment answers no more: two misses, the position goes on at the last
+            // velocity (1000 increments per 2 ms), no alarm.
             for (k, want) in [(2i64, 2000), (3, 3000)] {
+                image.verdict = Verdict::NoAnswer;
+                bus_out.send(image).unwrap();
                 link.exchange(k * 2_000_000, exec, &mut log);
                 let f = exec.drive_feedback(drive).unwrap();
                 assert_eq!((f.position_actual, f.statusword), (want, 0x0237));
+                image = bus_in.try_recv().expect("the next command goes out");
             }
             assert_eq!(link.counts.alarms, 0);
             // The third miss in a row: fault with 0x8130.
+            image.verdict = Verdict::NoAnswer;
+            bus_out.send(image).unwrap();
             link.exchange(8_000_000, exec, &mut log);
             let f = exec.drive_feedback(drive).unwrap();
             assert_eq!((f.statusword, f.error_code), (FAULT_STATUSWORD, LOST_CODE));
@@ -1121,13 +1717,181 @@ mod tests {
                 (
                     link.counts.misses,
                     link.counts.alarms,
-                    link.counts.most_in_a_row
+                    link.counts.most_in_a_row,
+                    link.counts.late
                 ),
-                (3, 1, 3)
+                (3, 1, 3, 0)
             );
             // Further misses are the same alarm, not new ones.
+            let mut image = bus_in.try_recv().unwrap();
+            image.verdict = Verdict::NoAnswer;
+            bus_out.send(image).unwrap();
             link.exchange(10_000_000, exec, &mut log);
             assert_eq!(link.counts.alarms, 1);
+            let log = String::from_utf8(log).unwrap();
+            assert!(
+                log.contains(
+                    "t=0.008000000 EtherCAT ecm: miss 3 in a row (no answer), last complete \
+                     exchange at t=0.002000000, 0 late cycle(s) since"
+                ),
+                "{log}"
+            );
+        });
+    }
+
+    #[test]
+    fn late_cycles_are_never_misses_and_the_third_miss_counts_only_misses() {
+        with_link(|link, exec, bus_in, bus_out, drive| {
+            let mut log = Vec::new();
+            let mut image = first_exchange(link, exec, bus_in, bus_out, &mut log);
+            // The "ethercat" thread holds the image for 20 cycles (not scheduled, 40 ms):
+            // late cycles, the position extrapolated, no miss and no alarm.
+            let mut k = 2i64;
+            for n in 1..=20 {
+                link.exchange(k * 2_000_000, exec, &mut log);
+                k += 1;
+                let f = exec.drive_feedback(drive).unwrap();
+                assert_eq!((f.position_actual, f.statusword), (1000 + 1000 * n, 0x0237));
+            }
+            assert_eq!(
+                (link.counts.late, link.counts.misses, link.counts.alarms),
+                (20, 0, 0)
+            );
+            assert_eq!(link.counts.most_late_in_a_row, 20);
+            // Two misses, a late cycle, a miss: the third miss in a row is the alarm, the late
+            // cycle between does not count, as a miss or as a break of the row.
+            for late_before in [false, false, true] {
+                if late_before {
+                    link.exchange(k * 2_000_000, exec, &mut log);
+                    k += 1;
+                    assert_eq!(link.counts.alarms, 0);
+                }
+                image.verdict = Verdict::NoAnswer;
+                bus_out.send(image).unwrap();
+                link.exchange(k * 2_000_000, exec, &mut log);
+                k += 1;
+                image = bus_in.try_recv().unwrap();
+            }
+            let f = exec.drive_feedback(drive).unwrap();
+            assert_eq!((f.statusword, f.error_code), (FAULT_STATUSWORD, LOST_CODE));
+            assert_eq!(
+                (link.counts.misses, link.counts.alarms, link.counts.late),
+                (3, 1, 21)
+            );
+            let log = String::from_utf8(log).unwrap();
+            assert!(
+                log.contains(
+                    "t=0.050000000 EtherCAT ecm: miss 3 in a row (no answer), last complete \
+                     exchange at t=0.002000000, 21 late cycle(s) since"
+                ),
+                "{log}"
+            );
+        });
+    }
+
+    #[test]
+    fn a_stalled_ethercat_thread_is_an_alarm_after_200_ms() {
+        with_link(|link, exec, bus_in, bus_out, drive| {
+            let mut log = Vec::new();
+            let _held = first_exchange(link, exec, bus_in, bus_out, &mut log);
+            // 99 late cycles (198 ms): still extrapolated; the 100th (200 ms): the alarm.
+            for k in 2..=100i64 {
+                link.exchange(k * 2_000_000, exec, &mut log);
+            }
+            assert_eq!(exec.drive_feedback(drive).unwrap().statusword, 0x0237);
+            link.exchange(101 * 2_000_000, exec, &mut log);
+            let f = exec.drive_feedback(drive).unwrap();
+            assert_eq!((f.statusword, f.error_code), (FAULT_STATUSWORD, LOST_CODE));
+            assert_eq!((link.counts.alarms, link.counts.misses), (1, 0));
+            link.exchange(102 * 2_000_000, exec, &mut log);
+            assert_eq!(link.counts.alarms, 1);
+        });
+    }
+
+    #[test]
+    fn mc_reset_of_the_lost_segment_asks_the_ethercat_thread_to_bring_it_up_again() {
+        use tandem_motion::objects::action::Action;
+        use tandem_motion::objects::axis::{Command, StartMode, StopMode};
+        with_link(|link, exec, bus_in, bus_out, _| {
+            let mut log = Vec::new();
+            let power = Action::Command(Command::Power {
+                enable: true,
+                start_mode: StartMode::PositionControlled,
+                stop_mode: StopMode::Emergency,
+            });
+            let r = exec.apply(0, "slide", "MC_Power", power, &mut log).unwrap();
+            assert!(r.is_ok(), "{r:?}");
+            let mut image = first_exchange(link, exec, bus_in, bus_out, &mut log);
+            exec.step(2_000_000, &mut log).unwrap();
+            // A fault reset while the segment is fine is the drive's own business.
+            assert!(!image.reinit);
+            let mut k = 2i64;
+            for _ in 0..3 {
+                image.verdict = Verdict::NoAnswer;
+                bus_out.send(image).unwrap();
+                link.exchange(k * 2_000_000, exec, &mut log);
+                exec.step(k * 2_000_000, &mut log).unwrap();
+                k += 1;
+                image = bus_in.try_recv().unwrap();
+                assert!(!image.reinit);
+            }
+            assert_eq!(link.counts.alarms, 1);
+            // MC_Reset: the axis' drive connection sends the fault reset (0x6040 bit 7), and
+            // the image that carries it asks for the re-init.
+            let t = k * 2_000_000;
+            let r = exec
+                .apply(
+                    t,
+                    "slide",
+                    "MC_Reset",
+                    Action::Command(Command::Reset { restart: false }),
+                    &mut log,
+                )
+                .unwrap();
+            assert!(r.is_ok(), "{r:?}");
+            exec.step(t, &mut log).unwrap();
+            // The drive connection sends the pulse within a cycle or two.
+            let mut t = t;
+            for _ in 0..3 {
+                t += 2_000_000;
+                image.verdict = Verdict::NoAnswer;
+                bus_out.send(image).unwrap();
+                link.exchange(t, exec, &mut log);
+                image = bus_in.try_recv().unwrap();
+                if image.reinit {
+                    break;
+                }
+                exec.step(t, &mut log).unwrap();
+            }
+            assert!(image.reinit, "{}", String::from_utf8_lossy(&log));
+            assert_eq!(link.counts.reinits, (1, 0));
+            // While the segment is brought up, the cycles are not late and the drive shows
+            // the loss; the image back complete is the segment back in OP.
+            let late = link.counts.late;
+            for n in 2..10 {
+                link.exchange(t + n * 2_000_000, exec, &mut log);
+                assert_eq!(
+                    exec.drive_feedback(image.parts[0].device)
+                        .unwrap()
+                        .error_code,
+                    LOST_CODE
+                );
+            }
+            assert_eq!(link.counts.late, late);
+            image.reinit = false;
+            image.verdict = Verdict::Complete;
+            bus_out.send(image).unwrap();
+            link.exchange(t + 10 * 2_000_000, exec, &mut log);
+            assert_eq!(link.counts.reinits, (1, 1));
+            let log = String::from_utf8(log).unwrap();
+            assert!(
+                log.contains("EtherCAT ecm: MC_Reset: bringing the segment up again"),
+                "{log}"
+            );
+            assert!(
+                log.contains("EtherCAT ecm: back in OP after MC_Reset"),
+                "{log}"
+            );
         });
     }
 
@@ -1136,14 +1900,17 @@ mod tests {
         with_link(|link, exec, bus_in, bus_out, _| {
             let mut log = Vec::new();
             link.exchange(0, exec, &mut log);
-            let image = bus_in.try_recv().unwrap();
-            // `ok` false: the exchange failed or its working counter was short.
+            let mut image = bus_in.try_recv().unwrap();
+            image.verdict = Verdict::WorkingCounter { got: 2, want: 3 };
             bus_out.send(image).unwrap();
             link.exchange(2_000_000, exec, &mut log);
             assert_eq!((link.counts.exchanges, link.counts.misses), (0, 1));
             let image = bus_in.try_recv().expect("the next command still goes out");
-            assert!(!image.ok);
+            assert_eq!(image.verdict, Verdict::Pending);
             assert!(image.parts[0].map.is_some());
+            assert!(String::from_utf8(log)
+                .unwrap()
+                .contains("miss 1 in a row (working counter 2 of 3)"));
         });
     }
 

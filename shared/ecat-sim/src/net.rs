@@ -13,6 +13,7 @@ use std::ffi::CString;
 use std::io;
 
 use crate::device::{DeviceKind, DeviceOptions};
+use crate::esc::AlState;
 use crate::segment::{Segment, ETHERTYPE_ETHERCAT};
 
 /// Why the emulator stopped or could not start.
@@ -49,6 +50,10 @@ pub enum UsageError {
     UnknownDevice,
     /// `--cycle-us` is not a positive integer.
     BadCycle,
+    /// `--drop` is not a share between 0 and 1.
+    BadDrop,
+    /// `--seed` is not an unsigned integer.
+    BadSeed,
 }
 
 impl fmt::Display for UsageError {
@@ -61,6 +66,8 @@ impl fmt::Display for UsageError {
                 f.write_str("--devices takes a comma-separated list of `drive`, `dio`")
             }
             Self::BadCycle => f.write_str("--cycle-us takes a positive integer"),
+            Self::BadDrop => f.write_str("--drop takes a share of frames from 0 to 1 (0.01: 1 %)"),
+            Self::BadSeed => f.write_str("--seed takes an unsigned 64-bit integer"),
         }
     }
 }
@@ -81,7 +88,7 @@ impl fmt::Display for RunError {
 impl std::error::Error for RunError {}
 
 /// The command line.
-pub const USAGE: &str = "usage: tandem-ecat-sim --interface <name> [--devices drive,dio,...] [--cycle-us <n>] [--loopback]";
+pub const USAGE: &str = "usage: tandem-ecat-sim --interface <name> [--devices drive,dio,...] [--cycle-us <n>] [--loopback] [--drop <share> [--seed <n>] [--drop-log <file>]]";
 
 /// What the emulator runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,15 +99,59 @@ pub struct Options {
     pub devices: Vec<DeviceKind>,
     /// Device behaviour.
     pub device: DeviceOptions,
+    /// The share of frames dropped once every SubDevice is in OP (`--drop`), and the seed of
+    /// the choice (`--seed`, default 1).
+    pub drop: Option<FrameDrop>,
+    /// A file that gets one line per dropped frame (`--drop-log`).
+    pub drop_log: Option<String>,
+}
+
+/// A reproducible choice of the frames a faulty segment drops: a given share of them, chosen
+/// by SplitMix64 from a fixed seed (the same seed drops the same frames of the same sequence).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct FrameDrop {
+    /// The share of frames dropped, 0 to 1.
+    pub share: f64,
+    /// The generator's seed.
+    pub seed: u64,
+    state: u64,
+}
+
+impl FrameDrop {
+    /// Drops `share` (0 to 1) of the frames, chosen from `seed`.
+    pub fn new(share: f64, seed: u64) -> Result<Self, UsageError> {
+        if !(0.0..=1.0).contains(&share) {
+            return Err(UsageError::BadDrop);
+        }
+        Ok(Self {
+            share,
+            seed,
+            state: seed,
+        })
+    }
+
+    /// Whether the next frame is dropped.
+    pub fn next_dropped(&mut self) -> bool {
+        // SplitMix64 (Steele, Lea, Flood: "Fast splittable pseudorandom number generators").
+        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        // The top 53 bits as a uniform value in [0, 1).
+        ((z >> 11) as f64) * (1.0 / (1u64 << 53) as f64) < self.share
+    }
 }
 
 impl Options {
-    /// Parses `--interface`, `--devices` (default `drive,dio`), `--cycle-us` (default 1000)
-    /// and `--loopback` (digital outputs read back on the inputs).
+    /// Parses `--interface`, `--devices` (default `drive,dio`), `--cycle-us` (default 1000),
+    /// `--loopback` (digital outputs read back on the inputs), `--drop <share>` with `--seed
+    /// <n>` (default 1) and `--drop-log <file>`.
     pub fn parse(args: &[String]) -> Result<Self, UsageError> {
         let mut interface = None;
         let mut devices = vec![DeviceKind::Cia402Drive, DeviceKind::DigitalIo];
         let mut device = DeviceOptions::default();
+        let (mut share, mut seed, mut drop_log) = (None, 1u64, None);
         let mut it = args.iter();
         while let Some(arg) = it.next() {
             let mut value = |option| it.next().ok_or(UsageError::MissingValue { option });
@@ -122,6 +173,12 @@ impl Options {
                     device.cycle_ns = us.saturating_mul(1000);
                 }
                 "--loopback" => device.dio_loopback = true,
+                "--drop" => {
+                    let v: f64 = value("--drop")?.parse().map_err(|_| UsageError::BadDrop)?;
+                    share = Some(v);
+                }
+                "--seed" => seed = value("--seed")?.parse().map_err(|_| UsageError::BadSeed)?,
+                "--drop-log" => drop_log = Some(value("--drop-log")?.clone()),
                 _ => return Err(UsageError::UnknownOption),
             }
         }
@@ -129,6 +186,8 @@ impl Options {
             interface: interface.ok_or(UsageError::NoInterface)?,
             devices,
             device,
+            drop: share.map(|s| FrameDrop::new(s, seed)).transpose()?,
+            drop_log,
         })
     }
 }
@@ -254,6 +313,17 @@ pub fn run(args: &[String]) -> Result<(), RunError> {
         options.interface
     );
     let mut buf = vec![0u8; 9216];
+    let mut drop = options.drop;
+    let mut drop_log = match &options.drop_log {
+        Some(path) => Some(
+            std::fs::File::create(path).map_err(|source| RunError::Socket {
+                call: "create the --drop-log file",
+                source,
+            })?,
+        ),
+        None => None,
+    };
+    let mut dropped = 0u64;
     loop {
         let (n, outgoing) = socket.recv(&mut buf)?;
         // Our own replies (the socket sees its transmissions) and frames already passed by
@@ -264,8 +334,68 @@ pub fn run(args: &[String]) -> Result<(), RunError> {
         let Some(frame) = buf.get_mut(..n) else {
             continue;
         };
+        // Frames are dropped once every SubDevice is in OP: the start-up, whose frames
+        // ethercrab does not repeat, completes (inferred: a test of a running segment).
+        let in_op = segment.escs().iter().all(|e| e.al_state() == AlState::Op);
+        if in_op && drop.as_mut().is_some_and(FrameDrop::next_dropped) {
+            dropped += 1;
+            if let Some(f) = drop_log.as_mut() {
+                use std::io::Write;
+                writeln!(f, "dropped frame {dropped}").map_err(|source| RunError::Socket {
+                    call: "write the --drop-log file",
+                    source,
+                })?;
+            }
+            continue;
+        }
         if segment.process_frame(frame, monotonic_ns()).is_ok() {
             socket.send(frame)?;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+
+    fn args(s: &str) -> Vec<String> {
+        s.split_whitespace().map(String::from).collect()
+    }
+
+    #[test]
+    fn drop_and_seed_are_parsed_and_refused_out_of_range() {
+        let o = Options::parse(&args("--interface ecs --drop 0.01 --seed 7")).unwrap();
+        assert_eq!(o.drop, Some(FrameDrop::new(0.01, 7).unwrap()));
+        let o = Options::parse(&args("--interface ecs --drop 0.5")).unwrap();
+        assert_eq!(o.drop.unwrap().seed, 1);
+        assert_eq!(Options::parse(&args("--interface ecs")).unwrap().drop, None);
+        for bad in ["--drop 1.5", "--drop -0.1", "--drop x", "--drop NaN"] {
+            assert_eq!(
+                Options::parse(&args(&format!("--interface ecs {bad}"))),
+                Err(UsageError::BadDrop),
+                "{bad}"
+            );
+        }
+        assert_eq!(
+            Options::parse(&args("--interface ecs --drop 0.1 --seed -1")),
+            Err(UsageError::BadSeed)
+        );
+    }
+
+    #[test]
+    fn the_same_seed_drops_the_same_frames_at_the_given_share() {
+        let run = |share, seed| {
+            let mut d = FrameDrop::new(share, seed).unwrap();
+            (0..100_000).map(|_| d.next_dropped()).collect::<Vec<_>>()
+        };
+        let a = run(0.01, 42);
+        assert_eq!(a, run(0.01, 42));
+        assert_ne!(a, run(0.01, 43));
+        let n = a.iter().filter(|d| **d).count();
+        // Binomial(100 000, 0.01): mean 1000, standard deviation 31.5; 4 sigma either side.
+        assert!((874..=1126).contains(&n), "{n}");
+        assert!(run(0.0, 1).iter().all(|d| !d));
+        assert!(run(1.0, 1).iter().all(|d| *d));
     }
 }

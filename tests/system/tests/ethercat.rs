@@ -10,7 +10,12 @@
 //! below its limit in every cycle; an output cam's switching on the terminal's output comes
 //! back on its looped-back input within 5 cycles, where it is an input signal: the positive
 //! limit switch of a second axis, which stops with alarm 531 in that step; a bus that differs from the cell file (a revision, a missing
-//! SubDevice) refuses to start with exit code 3, naming the position and both identities.
+//! SubDevice) refuses to start with exit code 3, naming the position and both identities; the
+//! emulator killed mid-motion: alarm 421 in the cycle of the third unanswered exchange after
+//! the last complete one, exactly 3 cycles after it plus the late cycles the node counted; 1 %
+//! of the frames dropped by the emulator: no alarm, every drop counted as a miss (within 1),
+//! the setpoints without a jump; the emulator killed and started again: MC_Reset brings the
+//! segment back to OP and the axis moves again.
 //!
 //! Every wait has a timeout.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -25,6 +30,20 @@ use tandem_testkit::process::{run, text, Spawned};
 use tandem_testkit::scratch::{fresh_dir, remove_dir};
 use tandem_testkit::workspace::{bin, root};
 
+/// The tests take turns: each runs a node and an emulator at SCHED_FIFO 40, and several of
+/// them at once on the 2-core host starve each other (measured: up to 8 late cycles in a row,
+/// the drive without setpoints for 16 ms, a following-error alarm in the dropped-frames test),
+/// which is no property of one node and its segment. The other processes of the host run
+/// below SCHED_FIFO and load it as they do.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// This test's turn (a test that failed before it gave it up all the same).
+fn turn() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// The namespace `tec<tag><pid>` with the veth pair `ecm` (the node's end) / `ecs` (the
 /// emulator's).
 fn netns(tag: &str) -> VethNetns {
@@ -34,13 +53,19 @@ fn netns(tag: &str) -> VethNetns {
 /// Starts `tandem-ecat-sim --devices <devices> --loopback` on `ecs` with a 2 ms cycle and waits
 /// (10 s at most) for it to say it runs `n` SubDevices.
 fn start_sim(ns: &VethNetns, devices: &str, n: usize) -> Background {
+    start_sim_with(ns, devices, n, &[])
+}
+
+/// As [`start_sim`], with `extra` arguments.
+fn start_sim_with(ns: &VethNetns, devices: &str, n: usize, extra: &[&str]) -> Background {
     // SCHED_FIFO as the node's threads (see `cell`): on this shared host a starved emulator
     // answers late as much as a starved node asks late.
     let mut c = ns.exec(Path::new("chrt"));
     c.args(["-f", "40"])
         .arg(bin("tandem-ecat-sim"))
         .args(["--interface", "ecs", "--devices", devices])
-        .args(["--cycle-us", "2000", "--loopback"]);
+        .args(["--cycle-us", "2000", "--loopback"])
+        .args(extra);
     let (sim, line) = Background::start(&mut c, Duration::from_secs(10), "tandem-ecat-sim");
     assert!(line.contains(&format!("{n} SubDevice(s) on ecs")), "{line}");
     sim
@@ -109,6 +134,7 @@ velocity = 20.0
 
 #[test]
 fn an_axis_on_an_ethercat_drive_reaches_its_target_within_its_following_error_limit() {
+    let _turn = turn();
     let ns = netns("m");
     let _sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-{}", std::process::id()));
@@ -217,6 +243,7 @@ fn node(ns: &VethNetns, cell: &Path) -> (Option<i32>, String) {
 
 #[test]
 fn a_bus_that_differs_from_the_cell_file_refuses_to_start_naming_the_first_mismatch() {
+    let _turn = turn();
     let ns = netns("x");
     let dir = fresh_dir(&format!("tandem-ethercat-x-{}", std::process::id()));
     {
@@ -315,6 +342,7 @@ position = 450.0
 
 #[test]
 fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
+    let _turn = turn();
     let ns = netns("k");
     let sim = start_sim(&ns, "drive,dio", 2);
     let dir = fresh_dir(&format!("tandem-ethercat-k-{}", std::process::id()));
@@ -377,31 +405,296 @@ fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
         .find(|l| l.contains("EtherCAT segment:"))
         .unwrap_or_else(|| panic!("no end line:\n{said}"));
     assert!(end.contains(", 1 alarms;"), "{end}");
-    // The alarm comes 3 missed cycles (MISSES_TO_ALARM) after the last complete exchange: the
-    // cycles before it are the complete exchanges, the first cycle (nothing to take back yet)
-    // and any late exchange before the kill.
-    let exchanges: i64 = end
-        .split("EtherCAT segment: ")
+    let time_at = |l: &str| -> f64 {
+        l.trim_start_matches("t=")
+            .split(' ')
+            .next()
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("{l}"))
+    };
+    // The alarm comes with the third unanswered exchange in a row (MISSES_TO_ALARM), all three
+    // after the last complete one, in the very cycle that takes the third verdict back. The
+    // cycles from the last complete exchange to the alarm are exactly the 3 misses plus the
+    // cycles our own threads were late (`ecat_late`, never a miss), which the node counts and
+    // logs: this asserts the design's bound exactly, whatever the load.
+    let miss_line = |n: u32| -> (f64, String) {
+        let l = log
+            .lines()
+            .find(|l| l.contains(&format!("EtherCAT ecm: miss {n} in a row")))
+            .unwrap_or_else(|| panic!("no miss {n} in\n{log}"));
+        (time_at(l), l.to_string())
+    };
+    let (t3, third) = miss_line(3);
+    let last_at = third
+        .split("last complete exchange at t=")
         .nth(1)
+        .and_then(|r| r.split(',').next())
+        .unwrap_or_else(|| panic!("{third}"));
+    let last: f64 = last_at.parse().unwrap_or_else(|_| panic!("{third}"));
+    let late: i64 = third
+        .split(", ")
+        .last()
         .and_then(|r| r.split(' ').next())
         .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("{end}"));
-    let alarm_at: f64 = log
+        .unwrap_or_else(|| panic!("{third}"));
+    for n in [1, 2] {
+        let (t, line) = miss_line(n);
+        assert!(t < t3, "{line}\n{third}");
+        assert!(
+            line.contains(&format!("last complete exchange at t={last_at},")),
+            "{line}\n{third}"
+        );
+    }
+    let alarm_at = log
         .lines()
         .find(|l| l.contains("slide alarm 421"))
-        .and_then(|l| l.trim_start_matches("t=").split(' ').next())
-        .and_then(|t| t.parse().ok())
+        .map(time_at)
         .unwrap();
-    let alarm_cycle = (alarm_at / 0.002).round() as i64;
-    let after = alarm_cycle - exchanges;
-    // Late exchanges before the kill depend on the machine's load (1 in 4 runs had 4 or 5 of
-    // them even at load 0.7, and failed a bound of 5): room for 8, each counted in the end
-    // line's missed cycles. That the third miss in a row is the alarm, exactly, is asserted by
-    // the node's unit test `a_late_exchange_extrapolates_and_the_third_miss_in_a_row_is_the_alarm`.
     assert!(
-        (3..=10).contains(&after),
-        "alarm at cycle {alarm_cycle}, {exchanges} exchanges before: {after} cycles after"
+        (alarm_at - t3).abs() < 1e-9,
+        "alarm at {alarm_at} s, third miss at {t3} s\n{log}"
     );
-    eprintln!("{end}\nalarm at cycle {alarm_cycle}, {after} cycles after {exchanges} exchanges");
+    let cycles = ((t3 - last) / 0.002).round() as i64;
+    assert_eq!(
+        cycles,
+        3 + late,
+        "alarm {cycles} cycles after the last complete exchange, {late} of them late:\n{third}"
+    );
+    eprintln!(
+        "{end}\n{third}\nalarm {cycles} cycles after the last complete exchange ({late} late)"
+    );
+    remove_dir(&dir);
+}
+
+/// The node's stop line's count after `what` (`"missed exchanges"`): the number before it.
+fn count_before(end: &str, what: &str) -> u64 {
+    end.split(what)
+        .next()
+        .and_then(|r| r.rsplit(", ").next())
+        .and_then(|r| r.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no count before `{what}` in {end}"))
+}
+
+#[test]
+fn one_percent_of_frames_dropped_is_counted_and_the_motion_goes_on_without_a_jump() {
+    let _turn = turn();
+    let ns = netns("d");
+    let dir = fresh_dir(&format!("tandem-ethercat-d-{}", std::process::id()));
+    let drops = dir.join("drops.log");
+    let drops_arg = drops.to_str().unwrap().to_string();
+    let _sim = start_sim_with(
+        &ns,
+        "drive,dio",
+        2,
+        &["--drop", "0.01", "--seed", "13", "--drop-log", &drops_arg],
+    );
+    let cell = cell(&dir, "\n[axes.slide]", OTHER_AXIS);
+    let script = dir.join("script.toml");
+    std::fs::write(&script, LONG_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let up = Spawned::start(
+        tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+            .arg("--script")
+            .arg(&script),
+    );
+    let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
+    assert!(status.success(), "tandem up failed: {status}\n{up_log}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // Both moves complete without an alarm.
+    assert!(log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
+    assert!(log.contains("other MC_MoveAbsolute job 3: Done"), "{log}");
+    assert!(!log.contains("alarm"), "{log}");
+    let end = up_log
+        .lines()
+        .find(|l| l.contains("EtherCAT segment:"))
+        .unwrap_or_else(|| panic!("no end line:\n{up_log}"));
+    assert!(end.contains(", 0 alarms;"), "{end}");
+    // Every frame the emulator dropped is a miss of the node. The emulator drops from OP on,
+    // so a drop may also hit one of the node's few frames between OP and its first cyclic
+    // exchange (retried there, not a miss), and a frame the starved emulator answers later
+    // than 3/4 of a cycle is a miss it did not drop: one either way is allowed.
+    let dropped = std::fs::read_to_string(&drops).unwrap().lines().count() as u64;
+    let misses = count_before(end, " missed exchanges");
+    let exchanges = count_before(end, " exchanges, ");
+    eprintln!("{end}\nthe emulator dropped {dropped} frames");
+    assert!(dropped >= 10, "1 % of some 3,000 frames: {dropped}");
+    assert!(misses > 0, "the drops are not counted: {end}");
+    assert!(
+        misses.abs_diff(dropped) <= 1,
+        "{dropped} frames dropped, {misses} misses counted: {end}"
+    );
+    assert!(exchanges + misses >= 2900, "{end}");
+    // No jump in the axis' setpoints: their second difference within what its acceleration
+    // limit allows in a cycle (max_acceleration 3000 mm/s², 2 ms).
+    let x: Vec<f64> = column(&rec.join("drives.csv"), "slide.position")
+        .iter()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let bound = 3000.0 * 0.002 * 0.002 + 1e-9;
+    for (k, w) in x.windows(3).enumerate() {
+        let d2 = (w[2] - 2.0 * w[1] + w[0]).abs();
+        assert!(
+            d2 <= bound,
+            "setpoint jump at row {k}: {d2} mm > {bound} mm"
+        );
+    }
+    // The following error stays within the axis' monitoring (no alarm, above); reported,
+    // not bounded tighter: a dropped frame withholds a setpoint from the drive for a cycle
+    // (0.2 mm at 100 mm/s), and when the test's own processes starve each other (the tests
+    // run in parallel on 2 cores) late cycles withhold more (1 mm was exceeded once with 5
+    // late cycles in a row, none of them a miss).
+    let fe = column(&rec.join("drives.csv"), "slide.following_error")
+        .iter()
+        .map(|v| v.parse::<f64>().unwrap().abs())
+        .fold(0.0f64, f64::max);
+    let actual: f64 = column(&rec.join("drives.csv"), "slide.actual_position")
+        .last()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((actual - 400.0).abs() < 0.01, "actual position {actual}");
+    eprintln!("max |following error| {fe:.4} mm with drops");
+    remove_dir(&dir);
+}
+
+/// The slide moves, the test kills the emulator (alarm 421), starts it again, and the script
+/// resets the axis, powers it and moves it again.
+const RESET_SCRIPT: &str = r#"
+[sim]
+duration = 9.0
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Home"
+mode = 0
+position = 0.0
+
+[[at]]
+t = 0.1
+axis = "slide"
+instruction = "MC_MoveAbsolute"
+position = 400.0
+
+[[at]]
+t = 5.0
+axis = "slide"
+instruction = "MC_Reset"
+
+[[at]]
+t = 6.0
+axis = "slide"
+instruction = "MC_Power"
+
+[[at]]
+t = 6.5
+axis = "slide"
+instruction = "MC_MoveAbsolute"
+position = 50.0
+"#;
+
+#[test]
+fn mc_reset_brings_a_lost_segment_back_to_op_and_the_axis_moves_again() {
+    let _turn = turn();
+    let ns = netns("r");
+    let sim = start_sim(&ns, "drive,dio", 2);
+    let dir = fresh_dir(&format!("tandem-ethercat-r-{}", std::process::id()));
+    // The fault reset waits for the drive to leave fault while the segment is brought up
+    // again from INIT (SII, CoE mappings, DC): more than the example's 0.5 s.
+    let cell = cell(&dir, "enable_timeout = 0.5", "enable_timeout = 3.0");
+    let script = dir.join("script.toml");
+    std::fs::write(&script, RESET_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let mut up = tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+        .arg("--script")
+        .arg(&script)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn tandem up");
+    let (tx, rx) = mpsc::channel::<String>();
+    for pipe in [
+        Box::new(up.stdout.take().unwrap()) as Box<dyn std::io::Read + Send>,
+        Box::new(up.stderr.take().unwrap()),
+    ] {
+        let tx = tx.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+                // The test may have stopped reading; the line is then of no use.
+                let _ = tx.send(line);
+            }
+        });
+    }
+    drop(tx);
+    let mut said = String::new();
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    while !said.contains("EtherCAT segment in OP") {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let line = rx
+            .recv_timeout(left)
+            .unwrap_or_else(|_| panic!("no OP within 60 s:\n{said}"));
+        said.push_str(&line);
+        said.push('\n');
+    }
+    // The node's clock starts at the next whole second: the kill falls at 1.5 to 2.5 s of
+    // node time, the restart right after it, both well before MC_Reset at 5 s.
+    std::thread::sleep(Duration::from_millis(2500));
+    drop(sim);
+    std::thread::sleep(Duration::from_millis(300));
+    let _sim = start_sim(&ns, "drive,dio", 2);
+    let status = tandem_testkit::process::wait_for(&mut up, Duration::from_secs(60), "tandem up");
+    while let Ok(line) = rx.recv_timeout(Duration::from_secs(5)) {
+        said.push_str(&line);
+        said.push('\n');
+    }
+    assert!(status.success(), "tandem up failed: {status}\n{said}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // Lost: alarm 421 with 0x8130, the first move aborted.
+    assert!(
+        log.contains("slide alarm 421 DriveFault (supplement 33072"),
+        "{log}"
+    );
+    assert!(!log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
+    // MC_Reset is done, its fault reset brings the segment back to OP on the EtherCAT thread;
+    // MC_Power (Enable still TRUE, the same instance: job 1) enables the fresh drive, and
+    // the new move completes, in this order.
+    let at = |what: &str, from: usize| -> usize {
+        log[from..]
+            .find(what)
+            .map(|i| i + from)
+            .unwrap_or_else(|| panic!("no `{what}` after byte {from} in\n{log}"))
+    };
+    let alarm = at("slide alarm 421", 0);
+    let reset = at("slide MC_Reset job 4: Done", alarm);
+    let again = at(
+        "EtherCAT ecm: MC_Reset: bringing the segment up again",
+        reset,
+    );
+    let back = at("EtherCAT ecm: back in OP after MC_Reset", again);
+    let power = at("slide MC_Power job 1: Status TRUE", back);
+    at("slide MC_MoveAbsolute job 5: Done", power);
+    assert_eq!(log.matches("slide alarm").count(), 1, "{log}");
+    let end = said
+        .lines()
+        .find(|l| l.contains("EtherCAT segment:"))
+        .unwrap_or_else(|| panic!("no end line:\n{said}"));
+    assert!(end.contains(", 1 alarms;"), "{end}");
+    assert!(
+        end.contains("1 re-inits after MC_Reset, 1 back in OP"),
+        "{end}"
+    );
+    let actual: f64 = column(&rec.join("drives.csv"), "slide.actual_position")
+        .last()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((actual - 50.0).abs() < 0.01, "actual position {actual}");
+    eprintln!("{end}");
     remove_dir(&dir);
 }
