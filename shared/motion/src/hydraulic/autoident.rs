@@ -1114,3 +1114,247 @@ fn check(p: &AutoIdentParams) -> Result<(), AutoIdentError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+    use super::*;
+
+    fn ok_params() -> AutoIdentParams {
+        AutoIdentParams {
+            low_end: 150.0,
+            high_end: 350.0,
+            ..AutoIdentParams::default()
+        }
+    }
+
+    /// Each refusal with its code; the identification keeps its parameters.
+    #[test]
+    fn bad_parameters_are_refused_with_their_codes_and_change_nothing() {
+        let good = ok_params();
+        let mut id = AutoIdent::new(good).unwrap();
+        type Edit = fn(&mut AutoIdentParams);
+        let cases: &[(Edit, u32, &str)] = &[
+            (|p| p.tbl_count = 20, 0x4A02, ""),
+            (|p| p.tbl_count = 1, 0x4A02, ""),
+            (|p| p.tbl_count = 101, 0x4A02, ""),
+            (|p| p.tbl_count = 0, 0x4A02, ""),
+            (
+                |p| p.end_of_travel_negativ_limit = 0.0,
+                0x0706,
+                "EndOfTravel_NegativLimit",
+            ),
+            (
+                |p| p.end_of_travel_positiv_limit = 10.5,
+                0x0706,
+                "EndOfTravel_PositivLimit",
+            ),
+            (
+                |p| p.end_of_travel_positiv_limit = f64::NAN,
+                0x0706,
+                "EndOfTravel_PositivLimit",
+            ),
+            (
+                |p| p.end_of_velocity_negativ_limit = -1.0,
+                0x0706,
+                "EndOfVelocity_NegativLimit",
+            ),
+            (
+                |p| p.end_of_velocity_positiv_limit = f64::INFINITY,
+                0x0706,
+                "EndOfVelocity_PositivLimit",
+            ),
+            (|p| p.ramp = -0.1, 0x0706, "ValveCharacteristicRamp"),
+            (
+                |p| p.settling = f64::NAN,
+                0x0706,
+                "ValveCharacteristicSettling",
+            ),
+            (|p| p.recovery = -1.0, 0x0706, "ValveCharacteristicRecovery"),
+            (
+                |p| p.min_cycle = -1.0,
+                0x0706,
+                "ValveCharacteristicMinCycle",
+            ),
+            (
+                |p| p.min_cycle = 201.0,
+                0x0706,
+                "ValveCharacteristicMinCycle",
+            ),
+            (
+                |p| p.standstill_velocity = 0.0,
+                0x0706,
+                "standstill_velocity",
+            ),
+            (|p| p.standstill_time = 0.0, 0x0706, "standstill_time"),
+            (|p| p.move_threshold = -0.1, 0x0706, "move_threshold"),
+            (|p| p.search_rate = 0.0, 0x0706, "search_rate"),
+            (|p| p.measure_timeout = 0.0, 0x0706, "measure_timeout"),
+            (|p| p.phase_timeout = f64::NAN, 0x0706, "phase_timeout"),
+            (
+                |p| p.low_end = f64::NAN,
+                0x0706,
+                "ValveCharacteristicLowEnd",
+            ),
+            (|p| p.high_end = 150.0, 0x0706, "ValveCharacteristicHighEnd"),
+            (
+                |p| {
+                    p.enable_end_of_travel = false;
+                    p.end_of_travel_positiv = -1.0;
+                },
+                0x0706,
+                "EndOfTravel_Positiv",
+            ),
+            (
+                |p| {
+                    p.enable_end_of_travel = false;
+                    p.end_of_travel_positiv = 300.0;
+                },
+                0x4FF2,
+                "",
+            ),
+        ];
+        for (i, (edit, code, name)) in cases.iter().enumerate() {
+            let mut p = good;
+            edit(&mut p);
+            let e = AutoIdent::new(p).unwrap_err();
+            assert_eq!(e.code().0, *code, "case {i}: {e}");
+            if let AutoIdentError::Param { name: n, .. } = e {
+                assert_eq!(n, *name, "case {i}");
+            }
+            assert!(!e.to_string().is_empty());
+            let again = id.set_params(p).unwrap_err();
+            assert_eq!(again.code(), e.code(), "case {i}");
+            assert_eq!(id.params(), &good, "case {i}: changed");
+        }
+        // Odd counts 3..=99 are taken.
+        for n in [3, 21, 99] {
+            assert!(AutoIdent::new(AutoIdentParams {
+                tbl_count: n,
+                ..good
+            })
+            .is_ok());
+        }
+        // While it runs, new parameters are refused (dwTcHydAdsErrBusy).
+        id.execute();
+        assert!(id.busy());
+        let e = id.set_params(good).unwrap_err();
+        assert_eq!(e.code().0, 0x0708);
+    }
+
+    /// The least-squares line's slope: exact for a line, the mean slope through noise.
+    #[test]
+    fn the_line_fit_gives_the_slope() {
+        let mut f = LineFit::default();
+        for i in 0..100 {
+            let t = 3.0 + f64::from(i) * 1e-3;
+            f.add(t, 12.5 + 40.0 * t + if i % 2 == 0 { 0.01 } else { -0.01 });
+        }
+        // ±0.01 mm alternating over 0.1 s tilts the line by at most 0.01 mm/s.
+        assert!((f.slope().unwrap() - 40.0).abs() < 1e-2, "{:?}", f.slope());
+        assert!((f.span() - 0.099).abs() < 1e-12);
+        let mut exact = LineFit::default();
+        for i in 0..500 {
+            let t = 7.0 + f64::from(i) * 1e-3;
+            exact.add(t, -3.0 - 250.0 * t);
+        }
+        assert!((exact.slope().unwrap() + 250.0).abs() < 1e-9);
+        let mut one = LineFit::default();
+        one.add(1.0, 1.0);
+        assert_eq!(one.slope(), None);
+    }
+
+    /// A falling point is raised above its neighbour and counted; the unmeasured points are
+    /// extrapolated from the last two.
+    #[test]
+    fn the_curve_is_corrected_and_extrapolated() {
+        let mut out = [0.0; HALF];
+        let mut vel = [0.0; HALF];
+        vel[..3].copy_from_slice(&[10.0, 30.0, 25.0]);
+        let w = complete_side(&mut out, &vel, 3, 5);
+        assert_eq!(w, 1);
+        assert_eq!(out[..2], [10.0, 30.0]);
+        assert!(out[2] > 30.0 && out[2] < 30.001);
+        // Extrapolated from the last two, 30 and just above it: growing, barely.
+        assert!(out[3] > out[2] && out[4] > out[3]);
+        let mut out = [0.0; HALF];
+        vel[..2].copy_from_slice(&[10.0, 30.0]);
+        assert_eq!(complete_side(&mut out, &vel, 2, 4), 0);
+        assert_eq!(out[..4], [10.0, 30.0, 50.0, 70.0]);
+        // One measured point: extrapolated from the zero point.
+        let mut out = [0.0; HALF];
+        complete_side(&mut out, &vel, 1, 3);
+        assert_eq!(out[..3], [10.0, 20.0, 30.0]);
+    }
+
+    /// An ideal axis: velocity 200 mm/s per unit of output beyond a 5 % overlap (offset
+    /// 0.01), stops at 0 and 500 mm.
+    fn ideal(u: f64) -> f64 {
+        let s = u + 0.01;
+        if s.abs() <= 0.05 {
+            0.0
+        } else {
+            200.0 * (s - 0.05f64.copysign(s))
+        }
+    }
+
+    fn run(p: AutoIdentParams) -> AutoIdent {
+        let mut id = AutoIdent::new(p).unwrap();
+        id.execute();
+        let (mut x, mut v, dt) = (250.0, 0.0, 1e-3);
+        let mut t = 0.0;
+        while id.busy() && t < 2000.0 {
+            let u = id.step(dt, x, v);
+            v = ideal(u);
+            let nx = (x + v * dt).clamp(0.0, 500.0);
+            v = (nx - x) / dt;
+            x = nx;
+            t += dt;
+        }
+        id
+    }
+
+    /// On an ideal linear axis, a velocity limit ends the positive measurement and the rest of
+    /// the curve is extrapolated exactly; a 5 V limit does the same for the negative side.
+    #[test]
+    fn limits_end_a_direction_and_the_rest_is_extrapolated() {
+        let id = run(AutoIdentParams {
+            end_of_velocity_positiv_limit: 60.0,
+            end_of_travel_negativ_limit: 5.0,
+            end_of_travel_positiv_limit: 10.0,
+            tbl_count: 11,
+            recovery: 0.1,
+            ..ok_params()
+        });
+        assert!(id.done(), "{:?}", id.error());
+        let r = id.result();
+        assert!((r.overlap_comp_p - 0.05).abs() < 0.002, "{r:?}");
+        assert!((r.zero_compensation + 0.1).abs() < 0.01, "{r:?}");
+        // Positive: 0.2 and 0.4 (… 0.2 → 30, 0.4 → 70 mm/s ≥ 60: stop); negative: up to -0.4
+        // (-0.6 is beyond 5 V): 2 + 2 points.
+        assert_eq!(r.measured_points, 4, "{r:?}");
+        let t = id.table().unwrap();
+        // Exact on a linear axis beyond the overlap: at output 1.0 (0.99 applied: beyond the
+        // zero compensation) the velocity is 200·(1.0 - 0.05) = 190.
+        assert!((r.ref_velo - 190.0).abs() < 1.0, "{}", r.ref_velo);
+        let (v_min, o_min) = t.points().next().unwrap();
+        assert_eq!(o_min, -1.0);
+        assert!((v_min * r.ref_velo + 190.0).abs() < 1.0, "{v_min}");
+        assert_eq!(r.monotonic_warnings, 0);
+    }
+
+    #[test]
+    fn step_numbers_follow_the_sequence() {
+        let mut id = AutoIdent::new(ok_params()).unwrap();
+        assert_eq!(id.step_number(), 0);
+        assert_eq!(id.step(1e-3, 0.0, 0.0), 0.0);
+        id.execute();
+        assert_eq!(id.step_number(), 10);
+        let u = id.step(1e-3, 250.0, 0.0);
+        assert!((u + 0.3).abs() < 1e-12, "{u}");
+        // A cycle time that is no time changes nothing.
+        assert_eq!(id.step(f64::NAN, 250.0, 0.0), u);
+        assert_eq!(id.step_number(), 10);
+    }
+}
