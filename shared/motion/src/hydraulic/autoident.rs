@@ -917,7 +917,7 @@ impl AutoIdent {
             self.curve
                 .velocity
                 .get_mut(s)
-                .and_then(|a| a.get_mut(k - 1)),
+                .and_then(|a| a.get_mut(k.saturating_sub(1))),
             self.curve.measured.get_mut(s),
         ) {
             *slot = v;
@@ -967,7 +967,7 @@ impl AutoIdent {
         self.r.measured_points = self.curve.measured.iter().map(|&n| n as u32).sum();
         let v_end = |s: usize| {
             v.get(s)
-                .and_then(|a| a.get(m - 1))
+                .and_then(|a| a.get(m.saturating_sub(1)))
                 .copied()
                 .unwrap_or(0.0)
                 .abs()
@@ -983,7 +983,7 @@ impl AutoIdent {
             } else {
                 dir * v
                     .get(s)
-                    .and_then(|a| a.get(k - 1))
+                    .and_then(|a| a.get(k.saturating_sub(1)))
                     .copied()
                     .unwrap_or(0.0)
                     .abs()
@@ -1003,7 +1003,7 @@ fn complete_side(out: &mut [f64; HALF], vel: &[f64; HALF], meas: usize, m: usize
     let mut prev = 0.0;
     for k in 1..=m {
         let val = if k <= meas {
-            vel.get(k - 1).copied().unwrap_or(0.0).abs()
+            vel.get(k.saturating_sub(1)).copied().unwrap_or(0.0).abs()
         } else {
             let (v1, v2) = extrapolation_base(out, k);
             v2 + (v2 - v1)
@@ -1015,7 +1015,7 @@ fn complete_side(out: &mut [f64; HALF], vel: &[f64; HALF], meas: usize, m: usize
         } else {
             val.max(prev + 1e-6 * (1.0 + prev))
         };
-        if let Some(o) = out.get_mut(k - 1) {
+        if let Some(o) = out.get_mut(k.saturating_sub(1)) {
             *o = val;
         }
         prev = val;
@@ -1032,7 +1032,7 @@ fn extrapolation_base(out: &[f64; HALF], k: usize) -> (f64, f64) {
             out.get(j - 1).copied().unwrap_or(0.0)
         }
     };
-    (at(k.saturating_sub(2)), at(k - 1))
+    (at(k.saturating_sub(2)), at(k.saturating_sub(1)))
 }
 
 /// The checks of [`AutoIdentParams`].
