@@ -12,6 +12,9 @@
 
 use tandem_motion::hydraulic::autoident::{AutoIdent, AutoIdentParams};
 use tandem_motion::plant::hydraulic::{CylinderParams, SimCylinder};
+use tandem_testkit::counting::measure;
+
+tandem_testkit::counting_allocator!();
 
 const DT: f64 = 1e-3;
 
@@ -63,30 +66,45 @@ fn model_velocity(u: f64) -> f64 {
     steady_velocity(u, if v >= 0.0 { 20.0 } else { 480.0 })
 }
 
-/// Runs the identification to its end; returns it and the simulated seconds it took.
+/// Runs the identification to its end; returns it and the simulated seconds it took. From
+/// `Execute` to the finished table nothing is allocated (counted).
 fn identify() -> (AutoIdent, f64) {
     let mut id = AutoIdent::new(params()).unwrap();
     let mut cyl = SimCylinder::new(cylinder(), 250.0).unwrap();
-    id.execute();
     let mut t = 0.0;
     let mut steps_seen = 0;
     let mut last_step = -1;
+    let counts = measure(|| run_to_end(&mut id, &mut cyl, &mut t, &mut steps_seen, &mut last_step));
+    assert_eq!(
+        counts.allocations, 0,
+        "allocations during the identification"
+    );
+    assert!(steps_seen > 50, "{steps_seen} steps");
+    assert_eq!(id.error(), None);
+    assert!(id.done());
+    (id, t)
+}
+
+fn run_to_end(
+    id: &mut AutoIdent,
+    cyl: &mut SimCylinder,
+    t: &mut f64,
+    steps_seen: &mut u32,
+    last_step: &mut i16,
+) {
+    id.execute();
     while id.busy() {
         let s = *cyl.state();
         let u = id.step(DT, s.position, s.velocity);
         assert!(u.abs() <= 1.0 + 1e-12, "output {u}");
         cyl.step(u, DT);
-        if id.step_number() != last_step {
-            last_step = id.step_number();
-            steps_seen += 1;
+        if id.step_number() != *last_step {
+            *last_step = id.step_number();
+            *steps_seen += 1;
         }
-        t += DT;
-        assert!(t < 2000.0, "still busy at step {}", id.step_number());
+        *t += DT;
+        assert!(*t < 2000.0, "still busy");
     }
-    assert!(steps_seen > 50, "{steps_seen} steps");
-    assert_eq!(id.error(), None);
-    assert!(id.done());
-    (id, t)
 }
 
 #[test]
