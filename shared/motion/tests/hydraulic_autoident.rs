@@ -2,7 +2,8 @@
 //! identification") run open loop at 1 ms against the simulated valve and cylinder, whose
 //! overlap, offset, bend and unequal edges are known: the issue's check "auto-identification
 //! recovers the model's overlap, offset and area ratio within 5 % and a curve whose inverse
-//! linearises the model within 5 % of full scale", and the end stops within 0.5 mm.
+//! linearises the model within 5 % of full scale", and the end stops within 0.5 mm; once without
+//! friction, once with 300 N of Coulomb friction.
 //!
 //! The model's values are derived independently of the identification: the overlap and offset
 //! from its parameters (the spool follows the output plus the offset; no edge opens within the
@@ -48,8 +49,8 @@ fn params() -> AutoIdentParams {
 
 /// The steady velocity (mm/s) at constant output `u` from `x`: the mean over 0.3..0.6 s (the
 /// oil column rings after the start).
-fn steady_velocity(u: f64, x: f64) -> f64 {
-    let mut c = SimCylinder::new(cylinder(), x).unwrap();
+fn steady_velocity(m: CylinderParams, u: f64, x: f64) -> f64 {
+    let mut c = SimCylinder::new(m, x).unwrap();
     let mut x1 = 0.0;
     for i in 1..=600 {
         let s = c.step(u, DT);
@@ -61,16 +62,16 @@ fn steady_velocity(u: f64, x: f64) -> f64 {
 }
 
 /// A steady velocity from the end of travel that gives room in its direction.
-fn model_velocity(u: f64) -> f64 {
-    let v = steady_velocity(u, 250.0);
-    steady_velocity(u, if v >= 0.0 { 20.0 } else { 480.0 })
+fn model_velocity(m: CylinderParams, u: f64) -> f64 {
+    let v = steady_velocity(m, u, 250.0);
+    steady_velocity(m, u, if v >= 0.0 { 20.0 } else { 480.0 })
 }
 
 /// Runs the identification to its end; returns it and the simulated seconds it took. From
 /// `Execute` to the finished table nothing is allocated (counted).
-fn identify() -> (AutoIdent, f64) {
+fn identify(m: CylinderParams) -> (AutoIdent, f64) {
     let mut id = AutoIdent::new(params()).unwrap();
-    let mut cyl = SimCylinder::new(cylinder(), 250.0).unwrap();
+    let mut cyl = SimCylinder::new(m, 250.0).unwrap();
     let mut t = 0.0;
     let mut steps_seen = 0;
     let mut last_step = -1;
@@ -109,9 +110,22 @@ fn run_to_end(
 
 #[test]
 fn auto_identification_recovers_the_models_parameters_and_linearises_it() {
-    let (id, t) = identify();
+    check_identification(cylinder());
+}
+
+/// The same with 300 N of Coulomb friction (stick-slip at breakaway): the pressure must build
+/// before the axis moves.
+#[test]
+fn with_coulomb_friction_too() {
+    check_identification(CylinderParams {
+        coulomb: 300.0,
+        ..cylinder()
+    });
+}
+
+fn check_identification(m: CylinderParams) {
+    let (id, t) = identify(m);
     let r = *id.result();
-    let m = cylinder();
     eprintln!("identified in {t:.1} s (simulated): {r:#?}");
 
     // End of travel: the stops at 0 and the stroke.
@@ -146,8 +160,8 @@ fn auto_identification_recovers_the_models_parameters_and_linearises_it() {
     );
 
     // Area ratio: the model's steady velocities at ±1 V beyond the true overlap and offset.
-    let v_p = model_velocity(0.1 + m.overlap - m.offset);
-    let v_m = model_velocity(-0.1 - m.overlap - m.offset);
+    let v_p = model_velocity(m, 0.1 + m.overlap - m.offset);
+    let v_m = model_velocity(m, -0.1 - m.overlap - m.offset);
     eprintln!("model at ±1 V: {v_p:.3} / {v_m:.3} mm/s");
     within(r.area_ratio, v_m.abs() / v_p.abs(), "fAreaRatio");
 
@@ -155,9 +169,9 @@ fn auto_identification_recovers_the_models_parameters_and_linearises_it() {
     // characteristic-curve linearisation forms it, applied open loop.
     let table = id.table().expect("a table");
     assert_eq!(table.len(), 21);
-    let full = model_velocity(1.0 - m.offset)
+    let full = model_velocity(m, 1.0 - m.offset)
         .abs()
-        .max(model_velocity(-1.0 - m.offset).abs());
+        .max(model_velocity(m, -1.0 - m.offset).abs());
     eprintln!(
         "fRefVelo identified {:.2}, model full scale {full:.2} mm/s",
         r.ref_velo
@@ -178,7 +192,7 @@ fn auto_identification_recovers_the_models_parameters_and_linearises_it() {
         }
         count += 1;
         let u = table.output(target, 0.0) + r.zero_compensation / 10.0;
-        let v = model_velocity(u);
+        let v = model_velocity(m, u);
         let err = (v - target * r.ref_velo).abs() / full;
         worst = worst.max(err);
         assert!(
