@@ -14,6 +14,7 @@
 //! - [`valve_table`]: the characteristic curve of a valve and cylinder, read from the library's
 //!   table file format and checked.
 
+pub mod autoident;
 pub mod controller;
 pub mod finish;
 pub mod generator;
