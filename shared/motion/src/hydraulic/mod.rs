@@ -2,7 +2,8 @@
 //! runs them: per cycle, actual values → enables → commands → generator → position controller →
 //! extra controllers → Finish → drive output (the library's 'Cyclic organisation').
 //!
-//! Built so far, pure and allocation-free, not yet an axis kind of its own:
+//! The stages, pure and allocation-free (a `kind = "hydraulic"` axis runs them through
+//! `objects::axis` and the analog connection, docs/hydraulics.md):
 //! - [`generator`]: the displacement-based set value generator `iTcMc_ProfileCtrlBased` (start
 //!   ramp, travel, square-root braking ramp to creep speed, creep, idle; stops);
 //! - [`time_ramp`]: the time-ramp generator `iTcMc_ProfileTimeRamp` for an axis without an
@@ -12,7 +13,12 @@
 //!   forward, area ratio, bend point, ramped overlap compensation, clamping output, offset) and
 //!   `MC_AxRtFinishLinear_BkPlcMc` (a characteristic curve);
 //! - [`valve_table`]: the characteristic curve of a valve and cylinder, read from the library's
-//!   table file format and checked.
+//!   table file format and checked;
+//! - [`controller`]: the position controller (`fLagAmp`) and Finish as one stage;
+//! - [`pressure`]: the pressures and force from two inputs (`MC_AxRtReadForceDiff_BkPlcMc`) and
+//!   the pressure or force controller (`MC_AxCtrlPressure_BkPlcMc`);
+//! - [`autoident`]: the automatic identification `MC_AxUtiAutoIdent_BkPlcMc` (end of travel,
+//!   overlap and offset, area ratio, characteristic curve).
 
 pub mod autoident;
 pub mod controller;
