@@ -152,6 +152,15 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         name: "MC_SetOverride",
         params: &[("velocity", None)],
     },
+    // The Beckhoff hydraulic library's MC_Power with the feed enables of the two directions.
+    InstructionSpec {
+        name: "MC_Power_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("enable_positive", Some(Value::Bool(true))),
+            ("enable_negative", Some(Value::Bool(true))),
+        ],
+    },
     // The Beckhoff hydraulic library's pressure or force controller (a hydraulic axis with
     // pressure inputs).
     InstructionSpec {
@@ -909,6 +918,11 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
         },
         "MC_SetOverride" => Command::SetOverride {
             velocity: a.num("velocity")?,
+        },
+        "MC_Power_BkPlcMc" => Command::HydPower {
+            enable: a.flag("enable")?,
+            enable_positive: a.flag("enable_positive")?,
+            enable_negative: a.flag("enable_negative")?,
         },
         "MC_AxCtrlPressure_BkPlcMc" => Command::PressureControl {
             enable: a.flag("enable")?,

@@ -62,13 +62,17 @@ impl<'c> Run<'c> {
         r
     }
 
-    fn cmd(&mut self, c: Command) {
+    fn apply_ok(&mut self, action: Action) {
         let t = self.k * MS;
         let r = self
             .exec
-            .apply_at(t, t, "ram", "test", Action::Command(c), &mut self.log)
+            .apply_at(t, t, "ram", "test", action, &mut self.log)
             .unwrap();
         assert!(r.is_ok(), "{r:?}\n{}", self.log());
+    }
+
+    fn cmd(&mut self, c: Command) {
+        self.apply_ok(Action::Command(c));
     }
 
     fn step(&mut self) {
@@ -416,4 +420,60 @@ fn pressure_control_is_refused_without_pressure_inputs_and_with_bad_parameters()
         assert_eq!(r.state(), AxisState::Standstill);
         assert!(r.hyd().pressure_control.is_none());
     }
+}
+
+/// MC_Power_BkPlcMc's feed enables: a positioning towards a direction without its enable is
+/// refused (16#80F6); a move whose enable drops pauses (iTcHydStateFeedStopPos) with the set
+/// velocity down to 0 and the ram standing, and ends at its target once the enable returns.
+#[test]
+fn a_missing_feed_enable_refuses_a_move_and_pauses_a_running_one() {
+    use tandem_motion::catalog::error_id::ErrorId;
+    let feed = |positive, negative| {
+        Action::Command(Command::HydPower {
+            enable: true,
+            enable_positive: positive,
+            enable_negative: negative,
+        })
+    };
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    r.apply_ok(feed(false, true));
+    let t = r.k * MS;
+    let mv = Action::Command(Command::MoveAbsolute {
+        position: 300.0,
+        dynamics: Dynamics {
+            velocity: 120.0,
+            acceleration: -1.0,
+            deceleration: -1.0,
+            jerk: -1.0,
+        },
+        direction: Direction::Shortest,
+    });
+    let out = r
+        .exec
+        .apply_at(t, t, "ram", "test", mv, &mut r.log)
+        .unwrap();
+    assert_eq!(out, Err(ErrorId::NoFeedEnable));
+    // Allowed again: the move starts; its enable drops in travel.
+    r.apply_ok(feed(true, true));
+    r.move_to(300.0, 120.0);
+    r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
+    r.apply_ok(feed(false, true));
+    r.until(1000, "paused", |r| {
+        r.hyd().state == HydState::FeedStop && r.exec.status()[0].velocity == 0.0
+    });
+    assert_eq!(
+        r.hyd().state.name(r.hyd().positive),
+        "iTcHydStateFeedStopPos"
+    );
+    for _ in 0..300 {
+        r.step();
+    }
+    let s = r.exec.status()[0];
+    assert!(s.actual_velocity.abs() < 1.0, "{s:?}");
+    assert!(s.motion_job.is_some(), "the move waits");
+    r.apply_ok(feed(true, true));
+    r.run_move(8000);
+    let s = r.exec.status()[0];
+    assert!((s.actual_position - 300.0).abs() < 0.2, "{s:?}");
 }

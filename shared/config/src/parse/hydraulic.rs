@@ -65,7 +65,10 @@ fn profile_key(name: &str) -> &'static str {
 pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldError> {
     let p = unchecked_profile(h);
     CtrlBasedGenerator::new(p.generator, 0.0).map_err(|e| {
-        let GeneratorError::Invalid { name, .. } = e;
+        let name = match e {
+            GeneratorError::Invalid { name, .. } => name,
+            GeneratorError::FeedEnable { .. } => "hydraulic",
+        };
         (
             profile_key(name),
             Problem::Invalid("out of its range (ST_TcHydAxParam)"),

@@ -197,6 +197,11 @@ error_ids! {
         /// inputs. The Beckhoff hydraulic library answers with `dwTcHydAdsErrIllegalValue`
         /// (16#0706); S7 has no such instruction.
         IllegalControllerParameter = 0x80F5 => "Tandem extension: hydraulic controller parameter out of range, or no pressure inputs (Beckhoff hydraulic library: 16#0706).",
+        /// **Tandem extension.** A positioning of a hydraulic axis in a direction whose feed
+        /// enable (`Enable_Positive` / `Enable_Negative` of MC_Power_BkPlcMc) is off. The
+        /// Beckhoff hydraulic library answers with `dwTcHydErrCdPosFdEna` (16#4358) or
+        /// `dwTcHydErrCdNegFdEna` (16#4357); S7 has no direction enables.
+        NoFeedEnable = 0x80F6 => "Tandem extension: move in a direction without its feed enable (Beckhoff hydraulic library: 16#4358 / 16#4357).",
         Unspecified = 0x8FFF => "Unspecified error.",
     }
 }
@@ -223,6 +228,7 @@ impl ErrorId {
                 | ErrorId::JobRejectedInErrorStop
                 | ErrorId::BufferModeNotAllowed
                 | ErrorId::IllegalControllerParameter
+                | ErrorId::NoFeedEnable
         )
     }
 }
@@ -304,13 +310,13 @@ mod tests {
             assert_eq!(ErrorId::from_code(code), None);
         }
         // 73 codes in S7-1500T Motion Control V4.0 function manual, A.9 'Error ID for Motion
-        // Control instructions', plus 6 tandem extensions.
+        // Control instructions', plus 7 tandem extensions.
         let reference = ErrorId::ALL
             .iter()
             .filter(|e| !e.is_tandem_extension())
             .count();
         assert_eq!(reference, 73);
-        assert_eq!(ErrorId::ALL.len(), 79);
+        assert_eq!(ErrorId::ALL.len(), 80);
     }
 
     #[test]

@@ -303,6 +303,10 @@ impl HydErrorCode {
     pub const ACC: Self = Self(0x4309);
     /// `dwTcHydErrCdDec`.
     pub const DEC: Self = Self(0x430A);
+    /// `dwTcHydErrCdNegFdEna`: a negative movement without the negative feed enable.
+    pub const NEG_FD_ENA: Self = Self(0x4357);
+    /// `dwTcHydErrCdPosFdEna`: a positive movement without the positive feed enable.
+    pub const POS_FD_ENA: Self = Self(0x4358);
     /// `dwTcHydErrCdSetVelo`.
     pub const SET_VELO: Self = Self(0x4359);
     /// `dwTcHydErrCdRefVelo`.

@@ -58,6 +58,10 @@ pub enum HydState {
     TcDec,
     /// `iTcHydStateEmergencyBreak`: an emergency stop with `fEmergencyRamp`.
     EmergencyBreak,
+    /// `iTcHydStateFeedStopPos` / `FeedStopNeg`: an intermediate stop with `fStopRamp` for a
+    /// missing feed enable of the direction (`Enable_Positive` / `Enable_Negative` of
+    /// MC_Power_BkPlcMc); the move waits, then goes on when the enable returns.
+    FeedStop,
 }
 
 impl HydState {
@@ -76,6 +80,8 @@ impl HydState {
             (Self::TcDec, true) => "iTcHydStateTcDecP",
             (Self::TcDec, false) => "iTcHydStateTcDecM",
             (Self::EmergencyBreak, _) => "iTcHydStateEmergencyBreak",
+            (Self::FeedStop, true) => "iTcHydStateFeedStopPos",
+            (Self::FeedStop, false) => "iTcHydStateFeedStopNeg",
         }
     }
 }
@@ -166,6 +172,11 @@ pub enum GeneratorError {
         /// Its value.
         value: f64,
     },
+    /// A move in a direction whose feed enable is missing (`positive`: the positive one).
+    FeedEnable {
+        /// The direction of the move.
+        positive: bool,
+    },
 }
 
 impl GeneratorError {
@@ -173,7 +184,11 @@ impl GeneratorError {
     /// velocity, `fMaxVelo`), `dwTcHydErrCdAcc`, `dwTcHydErrCdDec`, else
     /// `dwTcHydAdsErrIllegalValue`.
     pub fn code(&self) -> HydErrorCode {
-        let Self::Invalid { name, .. } = *self;
+        let name = match *self {
+            Self::Invalid { name, .. } => name,
+            Self::FeedEnable { positive: true } => return HydErrorCode::POS_FD_ENA,
+            Self::FeedEnable { positive: false } => return HydErrorCode::NEG_FD_ENA,
+        };
         match name {
             "fRefVelo" => HydErrorCode::REF_VELO,
             "Velocity" | "fMaxVelo" => HydErrorCode::SET_VELO,
@@ -186,8 +201,15 @@ impl GeneratorError {
 
 impl core::fmt::Display for GeneratorError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let Self::Invalid { name, value } = *self;
-        write!(f, "{name} = {value} is not valid here")
+        match *self {
+            Self::Invalid { name, value } => write!(f, "{name} = {value} is not valid here"),
+            Self::FeedEnable { positive } => write!(
+                f,
+                "no feed enable for the {} direction (Enable_{})",
+                if positive { "positive" } else { "negative" },
+                if positive { "Positive" } else { "Negative" }
+            ),
+        }
     }
 }
 
@@ -239,6 +261,8 @@ pub struct CtrlBasedGenerator {
     /// The deceleration of the running stop (`TcDec`, mm/s²): `fRefVelo / fStopRamp`, or the
     /// stop command's.
     stop_dec: f64,
+    /// The feed enables of the positive and the negative direction.
+    feed: [bool; 2],
     /// Automatic starts by `fReposDistance`.
     repositioned: u64,
 }
@@ -304,6 +328,7 @@ impl CtrlBasedGenerator {
             },
             reverse_pending: false,
             stop_dec: p.ref_velo / p.stop_ramp,
+            feed: [true; 2],
             repositioned: 0,
         })
     }
@@ -373,6 +398,9 @@ impl CtrlBasedGenerator {
             }
         };
         let positive = target >= actual;
+        if !self.feed_enabled(positive) && (target - actual).abs() > 0.0 {
+            return Err(GeneratorError::FeedEnable { positive });
+        }
         let approach = *self.approach(positive);
         let v = velocity
             .min(p.ref_velo)
@@ -401,6 +429,21 @@ impl CtrlBasedGenerator {
             self.position = actual;
         }
         Ok(())
+    }
+
+    /// The feed enables of the two directions (`Enable_Positive`, `Enable_Negative` of
+    /// MC_Power_BkPlcMc, the `dwTcHydDcDwFdPosEna` / `FdNegEna` bits). A move whose direction
+    /// loses its enable makes an intermediate stop with `fStopRamp` and waits
+    /// ([`HydState::FeedStop`]); it goes on, from the start ramp, when the enable returns. A
+    /// move started in a direction without enable is refused (`dwTcHydErrCdPosFdEna` /
+    /// `NegFdEna`; inferred: the library checks it at the start).
+    pub fn set_feed_enables(&mut self, positive: bool, negative: bool) {
+        self.feed = [positive, negative];
+    }
+
+    /// Whether direction `positive` has its feed enable.
+    fn feed_enabled(&self, positive: bool) -> bool {
+        self.feed[usize::from(!positive)]
     }
 
     /// A regular stop (`MC_Stop_BkPlcMc`): the set velocity ramps to 0 with `fStopRamp`.
@@ -482,6 +525,24 @@ impl CtrlBasedGenerator {
         let approach = *self.approach(self.positive);
         let speed = self.velocity.abs();
         let m = self.mv;
+        let moving = matches!(
+            self.state,
+            HydState::TcAcc | HydState::ConstVelo | HydState::PcDec | HydState::CreepVelo
+        );
+        if moving && !self.feed_enabled(self.positive) {
+            self.state = HydState::FeedStop;
+        }
+        if self.state == HydState::FeedStop {
+            if self.feed_enabled(self.positive) {
+                // The enable is back: the move goes on from the start ramp (from the velocity
+                // the intermediate stop had come down to; inferred).
+                self.state = HydState::TcAcc;
+            } else {
+                let s = (speed - self.p.ref_velo / self.p.stop_ramp * dt).max(0.0);
+                self.set(s * sign, dt);
+                return;
+            }
+        }
         match self.state {
             HydState::Idle => {
                 self.velocity = 0.0;
@@ -754,6 +815,44 @@ mod tests {
         assert_eq!((g.state(), g.target()), (HydState::Idle, 7.0));
         g.take_over(f64::NAN, 0.0);
         assert_eq!(g.target(), 7.0);
+    }
+
+    #[test]
+    fn a_missing_feed_enable_pauses_the_move_which_goes_on_when_it_returns() {
+        let mut g = CtrlBasedGenerator::new(params(), 0.0).unwrap();
+        g.move_absolute(1000.0, 100.0, 0.0, 0.0, 0.0).unwrap();
+        run(&mut g, 300);
+        assert_eq!(g.state(), HydState::ConstVelo);
+        // The negative enable does not matter for a positive move.
+        g.set_feed_enables(true, false);
+        run(&mut g, 10);
+        assert_eq!(g.state(), HydState::ConstVelo);
+        // Without the positive one: the stop ramp (500 mm/s², 100 mm/s in 0.2 s), then waiting.
+        g.set_feed_enables(false, false);
+        let out = run(&mut g, 600);
+        assert!(out.iter().all(|s| s.state == HydState::FeedStop));
+        assert_eq!(out[0].state.name(out[0].positive), "iTcHydStateFeedStopPos");
+        let stopped = out.iter().position(|s| s.velocity == 0.0).unwrap();
+        assert_eq!(stopped + 1, 200);
+        let held = out.last().unwrap().position;
+        assert!(out[stopped..].iter().all(|s| s.position == held));
+        for w in out.windows(2) {
+            assert!(within_dynamics(w), "{w:?}");
+        }
+        // The enable returns: the move goes on and ends at its target.
+        g.set_feed_enables(true, false);
+        let out = run(&mut g, 20_000);
+        assert_eq!(out[0].state, HydState::TcAcc);
+        let last = out.last().unwrap();
+        assert_eq!((last.state, last.position), (HydState::Idle, 1000.0));
+        // A move in the direction without enable is refused and changes nothing.
+        let e = g.move_absolute(0.0, 50.0, 0.0, 0.0, 1000.0).unwrap_err();
+        assert_eq!(e, GeneratorError::FeedEnable { positive: false });
+        assert_eq!(e.code(), HydErrorCode::NEG_FD_ENA);
+        assert_eq!((g.state(), g.target()), (HydState::Idle, 1000.0));
+        g.set_feed_enables(false, true);
+        let e = g.move_absolute(2000.0, 50.0, 0.0, 0.0, 1000.0).unwrap_err();
+        assert_eq!(e.code().0, 0x4358);
     }
 
     #[test]

@@ -425,6 +425,18 @@ pub enum Command {
         /// `VelocityDiff` (as `velocity`), `Acceleration`, `Deceleration`, `Jerk`.
         dynamics: Dynamics,
     },
+    /// `MC_Power_BkPlcMc` (Beckhoff TwinCAT PLC Hydraulic Positioning library): MC_Power of a
+    /// hydraulic axis (StartMode position controlled, StopMode emergency) with the feed
+    /// enables of the two directions.
+    #[doc(alias = "MC_Power_BkPlcMc")]
+    HydPower {
+        /// `Enable`.
+        enable: bool,
+        /// `Enable_Positive`: motion in the positive direction allowed.
+        enable_positive: bool,
+        /// `Enable_Negative`: motion in the negative direction allowed.
+        enable_negative: bool,
+    },
     /// The pressure or force controller of a hydraulic axis (Beckhoff TwinCAT PLC Hydraulic
     /// Positioning library, `MC_AxCtrlPressure_BkPlcMc` with `fSetPressure`): with `enable` it
     /// takes the control value from the generator and controls the actual pressure or force

@@ -444,8 +444,10 @@ impl AxisConfig {
             problem: AxisConfigProblem::HydraulicParameter,
         };
         crate::hydraulic::generator::CtrlBasedGenerator::new(h.generator, 0.0).map_err(|e| {
-            let crate::hydraulic::generator::GeneratorError::Invalid { name, .. } = e;
-            refused(name)
+            refused(match e {
+                crate::hydraulic::generator::GeneratorError::Invalid { name, .. } => name,
+                crate::hydraulic::generator::GeneratorError::FeedEnable { .. } => "hydraulic",
+            })
         })?;
         crate::hydraulic::monitor::TargetMonitor::new(h.monitor).map_err(|e| refused(e.name))?;
         Ok(())

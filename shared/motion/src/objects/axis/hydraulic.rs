@@ -41,6 +41,8 @@ pub(super) struct HydAxis {
     actual: Option<ActualForce>,
     /// The running MC_AxCtrlPressure_BkPlcMc job.
     pressure: Option<PressureJob>,
+    /// The feed enables of the positive and the negative direction (MC_Power_BkPlcMc).
+    feed: [bool; 2],
 }
 
 /// A running pressure or force control.
@@ -98,6 +100,7 @@ impl HydAxis {
             ref_velo: cfg.generator.ref_velo,
             actual: None,
             pressure: None,
+            feed: [true; 2],
         }))
     }
 }
@@ -209,6 +212,35 @@ impl Axis {
             Some(h) if h.pressure.is_some() => false,
             Some(h) if h.engaged => h.last.position_control,
             _ => true,
+        }
+    }
+
+    /// The feed enables of a hydraulic axis' two directions (MC_Power_BkPlcMc); refused
+    /// (16#8002) on an electric axis.
+    pub(super) fn hyd_set_feed_enables(
+        &mut self,
+        positive: bool,
+        negative: bool,
+    ) -> Result<(), ErrorId> {
+        let h = self.hyd.as_deref_mut().ok_or(ErrorId::IllegalObject)?;
+        h.feed = [positive, negative];
+        h.gen.set_feed_enables(positive, negative);
+        Ok(())
+    }
+
+    /// A positioning of a hydraulic axis to `target` needs the feed enable of its direction
+    /// (16#80F6 without; the library: dwTcHydErrCdPosFdEna / NegFdEna).
+    pub(super) fn hyd_check_feed(&self, target: f64) -> Result<(), ErrorId> {
+        match self.hyd.as_deref() {
+            Some(h) if target != self.actual_p => {
+                let positive = target > self.actual_p;
+                if h.feed[usize::from(!positive)] {
+                    Ok(())
+                } else {
+                    Err(ErrorId::NoFeedEnable)
+                }
+            }
+            _ => Ok(()),
         }
     }
 

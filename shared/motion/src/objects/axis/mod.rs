@@ -1044,6 +1044,14 @@ impl Axis {
             | Command::Offset { .. }
             | Command::Phasing { .. } => self.apply_sync(cmd),
             Command::SetOverride { velocity } => self.cmd_set_override(velocity),
+            Command::HydPower {
+                enable,
+                enable_positive,
+                enable_negative,
+            } => {
+                self.hyd_set_feed_enables(enable_positive, enable_negative)?;
+                Ok(self.cmd_power(enable, StartMode::PositionControlled, StopMode::Emergency))
+            }
             Command::PressureControl {
                 enable,
                 set_value,
@@ -1248,6 +1256,7 @@ impl Axis {
         self.fold_superimposed();
         self.force_position_control();
         let target = target(self, &r.limits);
+        self.hyd_check_feed(target)?;
         let lim = r.limits;
         Ok(self.start_main(
             instr,
