@@ -340,19 +340,18 @@ instruction = "MC_MoveAbsolute"
 position = 450.0
 "#;
 
-#[test]
-fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
-    let _turn = turn();
-    let ns = netns("k");
-    let sim = start_sim(&ns, "drive,dio", 2);
-    let dir = fresh_dir(&format!("tandem-ethercat-k-{}", std::process::id()));
-    let cell = cell(&dir, "\n[axes.slide]", OTHER_AXIS);
-    let script = dir.join("script.toml");
-    std::fs::write(&script, LONG_SCRIPT).unwrap();
-    let rec = dir.join("rec");
-    let mut up = tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+/// `tandem up` of `cell` with `script` in namespace `ns`, recording to `rec`: the process, its
+/// stdout and stderr lines as they come, and what it said until the segment was in OP (at most
+/// 60 s).
+fn up_until_op(
+    ns: &VethNetns,
+    cell: &Path,
+    script: &Path,
+    rec: &Path,
+) -> (std::process::Child, mpsc::Receiver<String>, String) {
+    let mut up = tandem_testkit::tandem::up(ns.exec(&bin("tandem")), cell, rec)
         .arg("--script")
-        .arg(&script)
+        .arg(script)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -381,14 +380,38 @@ fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
         said.push_str(&line);
         said.push('\n');
     }
-    // The node's clock starts at the next whole second; both axes move from 0.1 s to 4 s.
-    std::thread::sleep(Duration::from_millis(2500));
-    drop(sim);
-    let status = tandem_testkit::process::wait_for(&mut up, Duration::from_secs(60), "tandem up");
+    (up, rx, said)
+}
+
+/// Waits for `tandem up` to end (at most 60 s) and adds the rest of what it said to `said`.
+fn wait_and_read(
+    up: &mut std::process::Child,
+    rx: &mpsc::Receiver<String>,
+    said: &mut String,
+) -> std::process::ExitStatus {
+    let status = tandem_testkit::process::wait_for(up, Duration::from_secs(60), "tandem up");
     while let Ok(line) = rx.recv_timeout(Duration::from_secs(5)) {
         said.push_str(&line);
         said.push('\n');
     }
+    status
+}
+
+#[test]
+fn a_segment_lost_mid_motion_alarms_its_axis_and_the_other_axis_carries_on() {
+    let _turn = turn();
+    let ns = netns("k");
+    let sim = start_sim(&ns, "drive,dio", 2);
+    let dir = fresh_dir(&format!("tandem-ethercat-k-{}", std::process::id()));
+    let cell = cell(&dir, "\n[axes.slide]", OTHER_AXIS);
+    let script = dir.join("script.toml");
+    std::fs::write(&script, LONG_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let (mut up, rx, mut said) = up_until_op(&ns, &cell, &script, &rec);
+    // The node's clock starts at the next whole second; both axes move from 0.1 s to 4 s.
+    std::thread::sleep(Duration::from_millis(2500));
+    drop(sim);
+    let status = wait_and_read(&mut up, &rx, &mut said);
     assert!(status.success(), "tandem up failed: {status}\n{said}");
     let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
     // The axis on the segment: alarm 421 with 0x8130, its move aborted.
@@ -611,48 +634,14 @@ fn mc_reset_brings_a_lost_segment_back_to_op_and_the_axis_moves_again() {
     let script = dir.join("script.toml");
     std::fs::write(&script, RESET_SCRIPT).unwrap();
     let rec = dir.join("rec");
-    let mut up = tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
-        .arg("--script")
-        .arg(&script)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn tandem up");
-    let (tx, rx) = mpsc::channel::<String>();
-    for pipe in [
-        Box::new(up.stdout.take().unwrap()) as Box<dyn std::io::Read + Send>,
-        Box::new(up.stderr.take().unwrap()),
-    ] {
-        let tx = tx.clone();
-        std::thread::spawn(move || {
-            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
-                // The test may have stopped reading; the line is then of no use.
-                let _ = tx.send(line);
-            }
-        });
-    }
-    drop(tx);
-    let mut said = String::new();
-    let deadline = std::time::Instant::now() + Duration::from_secs(60);
-    while !said.contains("EtherCAT segment in OP") {
-        let left = deadline.saturating_duration_since(std::time::Instant::now());
-        let line = rx
-            .recv_timeout(left)
-            .unwrap_or_else(|_| panic!("no OP within 60 s:\n{said}"));
-        said.push_str(&line);
-        said.push('\n');
-    }
+    let (mut up, rx, mut said) = up_until_op(&ns, &cell, &script, &rec);
     // The node's clock starts at the next whole second: the kill falls at 1.5 to 2.5 s of
     // node time, the restart right after it, both well before MC_Reset at 5 s.
     std::thread::sleep(Duration::from_millis(2500));
     drop(sim);
     std::thread::sleep(Duration::from_millis(300));
     let _sim = start_sim(&ns, "drive,dio", 2);
-    let status = tandem_testkit::process::wait_for(&mut up, Duration::from_secs(60), "tandem up");
-    while let Ok(line) = rx.recv_timeout(Duration::from_secs(5)) {
-        said.push_str(&line);
-        said.push('\n');
-    }
+    let status = wait_and_read(&mut up, &rx, &mut said);
     assert!(status.success(), "tandem up failed: {status}\n{said}");
     let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
     // Lost: alarm 421 with 0x8130, the first move aborted.
