@@ -442,7 +442,7 @@ impl CtrlBasedGenerator {
     }
 
     /// Whether direction `positive` has its feed enable.
-    fn feed_enabled(&self, positive: bool) -> bool {
+    pub fn feed_enabled(&self, positive: bool) -> bool {
         self.feed[usize::from(!positive)]
     }
 

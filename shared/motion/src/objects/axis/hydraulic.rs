@@ -41,8 +41,6 @@ pub(super) struct HydAxis {
     actual: Option<ActualForce>,
     /// The running MC_AxCtrlPressure_BkPlcMc job.
     pressure: Option<PressureJob>,
-    /// The feed enables of the positive and the negative direction (MC_Power_BkPlcMc).
-    feed: [bool; 2],
 }
 
 /// A running pressure or force control.
@@ -100,7 +98,6 @@ impl HydAxis {
             ref_velo: cfg.generator.ref_velo,
             actual: None,
             pressure: None,
-            feed: [true; 2],
         }))
     }
 }
@@ -156,6 +153,9 @@ impl Axis {
     /// One cycle of the engaged generator from the actual position: the basic setpoint and the
     /// target window. Returns whether the generator computed the setpoint.
     pub(super) fn hyd_generate(&mut self) -> bool {
+        if self.hyd.is_none() {
+            return false;
+        }
         if self.hyd_pressure_generate() {
             return true;
         }
@@ -223,7 +223,6 @@ impl Axis {
         negative: bool,
     ) -> Result<(), ErrorId> {
         let h = self.hyd.as_deref_mut().ok_or(ErrorId::IllegalObject)?;
-        h.feed = [positive, negative];
         h.gen.set_feed_enables(positive, negative);
         Ok(())
     }
@@ -233,8 +232,7 @@ impl Axis {
     pub(super) fn hyd_check_feed(&self, target: f64) -> Result<(), ErrorId> {
         match self.hyd.as_deref() {
             Some(h) if target != self.actual_p => {
-                let positive = target > self.actual_p;
-                if h.feed[usize::from(!positive)] {
+                if h.gen.feed_enabled(target > self.actual_p) {
                     Ok(())
                 } else {
                     Err(ErrorId::NoFeedEnable)

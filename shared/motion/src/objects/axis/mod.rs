@@ -328,6 +328,9 @@ pub struct Axis {
     phasing: Option<sync::PhasingJob>,
     offset_job: Option<sync::PhasingJob>,
     main: Option<MotionJob>,
+    /// A hydraulic axis' generator and target window ([`AxisConfig::hydraulic`]): read every
+    /// cycle (`None` for an electric axis), so with the hot fields.
+    hyd: Option<Box<hydraulic::HydAxis>>,
     /// Leading values for this cycle: of the active and of the pending job's leader.
     lead: [Option<crate::objects::leading::LeadingValue>; 2],
     /// Whether `status` holds the status (so that a cycle need not look at it).
@@ -361,8 +364,6 @@ pub struct Axis {
     absolute: AbsoluteOffset,
     /// Jobs queued behind `main` (PLCopen BufferMode); read only when a job ends.
     queue: buffer::JobQueue,
-    /// A hydraulic axis' generator and target window ([`AxisConfig::hydraulic`]).
-    hyd: Option<Box<hydraulic::HydAxis>>,
 }
 
 fn sign(x: f64) -> f64 {
