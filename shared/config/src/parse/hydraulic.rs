@@ -205,29 +205,20 @@ pub(super) fn valve_cylinder(d: &DeviceSection) -> Result<SimValveCylinderParams
         bend_flow: get(|c| c.bend_flow, e.bend_flow),
         response_time: get(|c| c.response_time, e.response_time),
     };
-    cylinder
-        .check()
-        .map_err(|e| (e.name, Problem::Invalid("out of its range")))?;
     let p = SimValveCylinderParams {
         cylinder,
         ready_delay: d.ready_delay.unwrap_or(0.01),
         load: d.load.unwrap_or(0.0),
         pressure_range: d.pressure_range.unwrap_or(250.0),
     };
-    for (key, value) in [("ready_delay", p.ready_delay), ("load", p.load)] {
-        if !(value.is_finite() && (key == "load" || value >= 0.0)) {
-            return Err((
-                key,
-                Problem::Invalid("must be a finite number (ready_delay >= 0)"),
-            ));
-        }
-    }
-    if !(p.pressure_range.is_finite() && p.pressure_range > 0.0) {
-        return Err((
-            "pressure_range",
-            Problem::Invalid("must be a number above 0 (bar at 10 V)"),
-        ));
-    }
+    p.check().map_err(|e| {
+        let why = match e.name {
+            "ready_delay" => "must be a finite number >= 0 (s)",
+            "pressure_range" => "must be a number above 0 (bar at 10 V)",
+            _ => "out of its range",
+        };
+        (e.name, Problem::Invalid(why))
+    })?;
     Ok(p)
 }
 

@@ -420,21 +420,32 @@ pub struct SimValveCylinder {
     words_per_bar: f64,
 }
 
+impl SimValveCylinderParams {
+    /// Checks every parameter (the cylinder's, then `ready_delay` >= 0, `load` finite,
+    /// `pressure_range` > 0); the first one out of its range is named.
+    pub fn check(&self) -> Result<(), CylinderError> {
+        self.cylinder.check()?;
+        let ok = [
+            ("ready_delay", self.ready_delay, self.ready_delay >= 0.0),
+            ("load", self.load, true),
+            (
+                "pressure_range",
+                self.pressure_range,
+                self.pressure_range > 0.0,
+            ),
+        ];
+        match ok.into_iter().find(|(_, v, ok)| !(v.is_finite() && *ok)) {
+            Some((name, value, _)) => Err(CylinderError { name, value }),
+            None => Ok(()),
+        }
+    }
+}
+
 impl SimValveCylinder {
     /// The valve and cylinder at rest at position `x` (mm), the encoder read through
     /// `scaling`. Refuses parameters out of range, naming the first.
     pub fn new(p: SimValveCylinderParams, scaling: Scaling, x: f64) -> Result<Self, CylinderError> {
-        for (name, value) in [("ready_delay", p.ready_delay), ("load", p.load)] {
-            if !(value.is_finite() && (name == "load" || value >= 0.0)) {
-                return Err(CylinderError { name, value });
-            }
-        }
-        if !(p.pressure_range.is_finite() && p.pressure_range > 0.0) {
-            return Err(CylinderError {
-                name: "pressure_range",
-                value: p.pressure_range,
-            });
-        }
+        p.check()?;
         let mut cylinder = SimCylinder::new(p.cylinder, x)?;
         cylinder.set_load(p.load);
         Ok(Self {
