@@ -175,6 +175,19 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("force", Some(Value::Bool(true))),
         ],
     },
+    // The Beckhoff hydraulic library's automatic zero compensation (defaults as
+    // `AutoZeroParams::default`).
+    InstructionSpec {
+        name: "MC_AxCtrlAutoZero_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("enable_on_moving", Some(Value::Bool(false))),
+            ("offset_limit", Some(Value::Num(1.0))),
+            ("tn", Some(Value::Num(100.0))),
+            ("threshold", Some(Value::Num(0.1))),
+            ("filter", Some(Value::Num(0.1))),
+        ],
+    },
     InstructionSpec {
         name: "MC_MotionInPosition",
         params: &[
@@ -933,6 +946,16 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
             windup_limit: a.num("windup_limit")?,
             force: a.flag("force")?,
         },
+        "MC_AxCtrlAutoZero_BkPlcMc" => Command::AutoZero {
+            enable: a.flag("enable")?,
+            params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {
+                enable_on_moving: a.flag("enable_on_moving")?,
+                offset_limit: a.num("offset_limit")?,
+                tn: a.num("tn")?,
+                threshold: a.num("threshold")?,
+                filter: a.num("filter")?,
+            },
+        },
         "MC_MotionInPosition" => Command::MotionInPosition {
             enable: a.flag("enable")?,
             position: a.num("position")?,
@@ -968,6 +991,30 @@ mod tests {
             assert_eq!(find(n).map(|s| s.name), Some("MC_MoveAbsolute"));
         }
         assert!(find("MC_Fly").is_none());
+    }
+
+    #[test]
+    fn auto_zero_takes_the_library_inputs_with_defaults() {
+        let c = parse(
+            "MC_AxCtrlAutoZero_BkPlcMc",
+            &[
+                p("tn", Value::Num(20.0)),
+                p("enable_on_moving", Value::Bool(true)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::AutoZero {
+                enable: true,
+                params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {
+                    enable_on_moving: true,
+                    tn: 20.0,
+                    ..Default::default()
+                },
+            }
+        );
     }
 
     #[test]

@@ -233,6 +233,9 @@ pub struct HydraulicSection {
     pub fEmergencyRamp: Option<f64>,
     /// Automatic repositioning beyond this distance from the target (mm; 0: off).
     pub fReposDistance: Option<f64>,
+    /// Target clamping: the output (V, 0..10) pressing towards the target once there, in place
+    /// of the position controller (0: off).
+    pub fTargetClamping: Option<f64>,
     /// Position range of the target window monitoring (mm).
     pub fMonPositionRange: Option<f64>,
     /// Target range (mm).
@@ -243,6 +246,12 @@ pub struct HydraulicSection {
     pub fLagAmp: Option<f64>,
     /// Output limit of the position controller (normalised; 0: none).
     pub fLagAmpOutL: Option<f64>,
+    /// Gain of the position controller's I part, used as Ki (mm/s per mm and s; 0: no I part).
+    pub fLagAmpTi: Option<f64>,
+    /// Response window of the I part (mm): it grows only beyond this lag.
+    pub fLagAmpDx: Option<f64>,
+    /// Limit of the I part (normalised; 0: full scale).
+    pub fLagAmpWuL: Option<f64>,
     /// Weight of the set velocity in the output (1.0: full feed forward).
     pub fFeedForward: Option<f64>,
     /// Area ratio A:B (velocity ratio of the two directions).

@@ -307,6 +307,16 @@ fn bad_hydraulic_parameters_are_refused_naming_the_key() {
             "axes.ram.hydraulic.fLagAmp",
         ),
         (
+            "fLagAmp = 50.0",
+            "fLagAmp = 50.0\nfLagAmpTi = -1.0",
+            "axes.ram.hydraulic.fLagAmpTi",
+        ),
+        (
+            "fLagAmp = 50.0",
+            "fLagAmp = 50.0\nfTargetClamping = 11.0",
+            "axes.ram.hydraulic.fTargetClamping",
+        ),
+        (
             "overlap = 0.05",
             "overlap = 1.5",
             "devices.ram_valve.cylinder.overlap",
@@ -476,4 +486,173 @@ fn a_missing_feed_enable_refuses_a_move_and_pauses_a_running_one() {
     r.run_move(8000);
     let s = r.exec.status()[0];
     assert!((s.actual_position - 300.0).abs() < 0.2, "{s:?}");
+}
+
+/// The cell with a zero-overlap valve whose spool is 0.3 V off zero and nothing compensated:
+/// at standstill the position controller holds the cylinder with a standing lag.
+fn offset_valve(extra: &[(&str, &str)]) -> Cell {
+    let mut edits = vec![
+        ("overlap = 0.05 ", "overlap = 0.0 "),
+        ("offset = 0.01 ", "offset = 0.03 "),
+        ("fValve_OverlapCompP = 0.05", "fValve_OverlapCompP = 0.0"),
+        ("fZeroCompensation = -0.1", "fZeroCompensation = 0.0"),
+    ];
+    edits.extend_from_slice(extra);
+    cell(&edits)
+}
+
+impl Run<'_> {
+    /// Moves to `target` and stands there `cycles` more: the set position minus the actual
+    /// one at the end.
+    fn standing_lag(&mut self, target: f64, cycles: usize) -> f64 {
+        self.move_to(target, 120.0);
+        self.run_move(8000);
+        for _ in 0..cycles {
+            self.step();
+        }
+        let s = self.exec.status()[0];
+        s.position - s.actual_position
+    }
+}
+
+/// MC_AxCtrlAutoZero_BkPlcMc on the simulated valve: the 0.3 V offset leaves a standing lag of
+/// 0.136 mm (-0.03 of full scale at the valve is -0.03 · 0.6947 before Finish divides a
+/// retracting output by fAreaRatio, over fLagAmp 50 / fRefVelo 327); the compensation, enabled
+/// at standstill, integrates to -0.3 V within 5 % and the lag goes, Done once it has levelled
+/// out; the value stays when it is disabled.
+#[test]
+fn auto_zero_removes_a_0_3_v_offset_of_a_zero_overlap_valve() {
+    let cell = offset_valve(&[("fLagAmp = 50.0", "fLagAmp = 50.0\nfLagAmpDx = 0.002")]);
+    let mut r = Run::enabled(&cell);
+    let before = r.standing_lag(300.0, 1000);
+    assert!(
+        (before - -0.136).abs() < 0.01,
+        "lag {before} mm without AutoZero"
+    );
+    let params = tandem_motion::hydraulic::auto_zero::AutoZeroParams {
+        enable_on_moving: false,
+        offset_limit: 1.0,
+        tn: 10.0,
+        threshold: 0.01,
+        filter: 2.0,
+    };
+    r.cmd(Command::AutoZero {
+        enable: true,
+        params,
+    });
+    // Tn 10 s: the offset decays with a 10 s time constant; 60 s is six of them.
+    let mut done_at = None;
+    for k in 0..60_000 {
+        r.step();
+        let (status, on) = r.hyd().auto_zero.unwrap();
+        assert!(on && !status.limiting, "{status:?}");
+        if status.done && done_at.is_none() {
+            done_at = Some(k);
+        }
+    }
+    let (status, _) = r.hyd().auto_zero.unwrap();
+    assert!(
+        (status.compensation - -0.3).abs() < 0.015,
+        "fZeroCompensation {} V",
+        status.compensation
+    );
+    assert!(done_at.is_some(), "{status:?}");
+    let s = r.exec.status()[0];
+    let after = s.position - s.actual_position;
+    assert!(after.abs() < 0.01, "lag {after} mm with AutoZero");
+    // The compensation reaches the valve: its output at standstill is about -0.3 V + the P
+    // part of the remaining lag.
+    let out = r.exec.analog_drive(0).unwrap().link.normalized;
+    assert!((out - -0.03).abs() < 0.003, "output {out}");
+    // Disabled, the value stays and the next move lands without a lag.
+    r.cmd(Command::AutoZero {
+        enable: false,
+        params,
+    });
+    let lag = r.standing_lag(150.0, 1000);
+    assert!(lag.abs() < 0.01, "lag {lag} mm after a move");
+    assert_eq!(
+        r.hyd().auto_zero.unwrap().0.compensation,
+        status.compensation
+    );
+}
+
+#[test]
+fn auto_zero_is_refused_on_an_overlap_valve_and_with_bad_parameters() {
+    use tandem_motion::catalog::error_id::ErrorId;
+    let good = tandem_motion::hydraulic::auto_zero::AutoZeroParams::default();
+    let refused = |r: &mut Run, params| {
+        let t = r.k * MS;
+        let action = Action::Command(Command::AutoZero {
+            enable: true,
+            params,
+        });
+        let out = r
+            .exec
+            .apply_at(t, t, "ram", "test", action, &mut r.log)
+            .unwrap();
+        assert_eq!(out, Err(ErrorId::IllegalControllerParameter), "{params:?}");
+        r.step();
+        assert!(r.hyd().auto_zero.is_none());
+    };
+    // The bundled valve has overlap compensation: "only for zero overlap valves".
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    refused(&mut r, good);
+    let cell = offset_valve(&[]);
+    let mut r = Run::enabled(&cell);
+    for bad in [
+        tandem_motion::hydraulic::auto_zero::AutoZeroParams { tn: 0.0, ..good },
+        tandem_motion::hydraulic::auto_zero::AutoZeroParams {
+            offset_limit: 10.5,
+            ..good
+        },
+    ] {
+        refused(&mut r, bad);
+    }
+}
+
+/// The position controller's I part (fLagAmpTi as Ki, beyond fLagAmpDx) removes the standing
+/// lag of the same offset; without it the lag stays.
+#[test]
+fn the_i_part_removes_the_standing_lag_of_a_valve_offset() {
+    let cell = offset_valve(&[(
+        "fLagAmp = 50.0",
+        "fLagAmp = 50.0\nfLagAmpTi = 200.0\nfLagAmpDx = 0.002\nfLagAmpWuL = 0.1",
+    )]);
+    let mut r = Run::enabled(&cell);
+    let lag = r.standing_lag(300.0, 3000);
+    assert!(lag.abs() < 0.005, "lag {lag} mm with the I part");
+    let cell = offset_valve(&[]);
+    let mut r = Run::enabled(&cell);
+    let lag = r.standing_lag(300.0, 3000);
+    assert!(lag.abs() > 0.12, "lag {lag} mm without it");
+}
+
+/// fTargetClamping: at the target the generator's pressing output (with the sign of the
+/// approach) reaches the valve in place of the position controller; the free cylinder is
+/// pushed on beyond its target.
+#[test]
+fn target_clamping_presses_on_at_the_target() {
+    let cell = cell(&[("fLagAmp = 50.0", "fLagAmp = 50.0\nfTargetClamping = 1.5")]);
+    let mut r = Run::enabled(&cell);
+    r.move_to(300.0, 120.0);
+    r.until(8000, "creep", |r| r.hyd().state == HydState::CreepVelo);
+    r.until(8000, "idle", |r| r.hyd().state == HydState::Idle);
+    r.step();
+    let link = r.exec.analog_drive(0).unwrap().link;
+    // (1.5 V - 0.1 V of zero compensation) / 10 V.
+    assert!((link.normalized - 0.14).abs() < 1e-12, "{link:?}");
+    let p = r.exec.status()[0].actual_position;
+    for _ in 0..200 {
+        r.step();
+    }
+    assert!(r.exec.status()[0].actual_position > p + 1.0);
+    // Moving back, the pressing output is negative at the target.
+    r.move_to(200.0, 120.0);
+    r.until(8000, "creep", |r| r.hyd().state == HydState::CreepVelo);
+    r.until(8000, "idle", |r| r.hyd().state == HydState::Idle);
+    r.step();
+    let link = r.exec.analog_drive(0).unwrap().link;
+    assert!((link.normalized - -0.16).abs() < 1e-12, "{link:?}");
 }

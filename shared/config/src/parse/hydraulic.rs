@@ -25,9 +25,9 @@ const MONITOR_DEFAULTS: MonitorParams = MonitorParams {
     target_filter: 1.0,
 };
 
-/// The keys of `[axes.<name>.hydraulic]` the generator and the target window check, as paths
-/// from the axis.
-const PROFILE_KEYS: [&str; 21] = [
+/// The keys of `[axes.<name>.hydraulic]` the generator, the target window and the position
+/// controller with Finish check, as paths from the axis.
+const PROFILE_KEYS: [&str; 33] = [
     "hydraulic.fRefVelo",
     "hydraulic.fMaxVelo",
     "hydraulic.fAcc",
@@ -49,6 +49,18 @@ const PROFILE_KEYS: [&str; 21] = [
     "hydraulic.fMonPositionRange",
     "hydraulic.fMonTargetRange",
     "hydraulic.fMonTargetFilter",
+    "hydraulic.fLagAmp",
+    "hydraulic.fLagAmpOutL",
+    "hydraulic.fLagAmpTi",
+    "hydraulic.fLagAmpDx",
+    "hydraulic.fLagAmpWuL",
+    "hydraulic.fFeedForward",
+    "hydraulic.fAreaRatio",
+    "hydraulic.fValve_OverlapCompP",
+    "hydraulic.fValve_OverlapCompM",
+    "hydraulic.fValve_BendPointVelo",
+    "hydraulic.fValve_BendPointOutput",
+    "hydraulic.fZeroCompensation",
 ];
 
 /// The path from the axis of the library's parameter `name`.
@@ -63,7 +75,8 @@ fn profile_key(name: &str) -> &'static str {
 /// The generator and the target window of section `h`, checked: the path of the parameter out
 /// of range.
 pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldError> {
-    let p = unchecked_profile(h);
+    let controller = controller(h).map_err(|(name, problem)| (profile_key(name), problem))?;
+    let p = unchecked_profile(h, controller);
     CtrlBasedGenerator::new(p.generator, 0.0).map_err(|e| {
         let name = match e {
             GeneratorError::Invalid { name, .. } => name,
@@ -83,8 +96,8 @@ pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldErr
     Ok(p)
 }
 
-/// The generator and the target window of section `h`.
-fn unchecked_profile(h: &HydraulicSection) -> HydraulicProfile {
+/// The generator and the target window of section `h`, with the checked `controller`.
+fn unchecked_profile(h: &HydraulicSection, controller: HydControllerParams) -> HydraulicProfile {
     let d = GeneratorParams::default();
     let approach = |given: [Option<f64>; 4], of: &Approach| Approach {
         creep_speed: given[0].unwrap_or(of.creep_speed),
@@ -124,8 +137,7 @@ fn unchecked_profile(h: &HydraulicSection) -> HydraulicProfile {
             asymmetrical: h.bAsymmetricalTargeting.unwrap_or(d.asymmetrical),
             stop_ramp: h.fStopRamp.unwrap_or(d.stop_ramp),
             emergency_ramp: h.fEmergencyRamp.unwrap_or(d.emergency_ramp),
-            // Target clamping needs the pressing output on the drive connection: not yet.
-            target_clamping: 0.0,
+            target_clamping: h.fTargetClamping.unwrap_or(d.target_clamping),
             repos_distance: h.fReposDistance.unwrap_or(d.repos_distance),
         },
         monitor: MonitorParams {
@@ -135,6 +147,7 @@ fn unchecked_profile(h: &HydraulicSection) -> HydraulicProfile {
             target_range: h.fMonTargetRange.unwrap_or(MONITOR_DEFAULTS.target_range),
             target_filter: h.fMonTargetFilter.unwrap_or(MONITOR_DEFAULTS.target_filter),
         },
+        controller,
     }
 }
 
@@ -148,6 +161,9 @@ pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, Fi
     let params = HydControllerParams {
         lag_amp: h.fLagAmp.unwrap_or(HydControllerParams::default().lag_amp),
         lag_out_limit: h.fLagAmpOutL.unwrap_or(0.0),
+        lag_amp_ti: h.fLagAmpTi.unwrap_or(0.0),
+        lag_amp_dx: h.fLagAmpDx.unwrap_or(0.0),
+        lag_amp_wul: h.fLagAmpWuL.unwrap_or(0.0),
         finish: FinishParams {
             ref_velo: h.fRefVelo.unwrap_or(d.ref_velo),
             feed_forward: h.fFeedForward.unwrap_or(d.feed_forward),

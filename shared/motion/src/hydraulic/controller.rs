@@ -9,9 +9,21 @@
 //! limited to ±`fLagAmpOutL` when that is above 0 ("in preparation" in the library; 0 there
 //! means no limit). It acts only while the generator asks for position control: at standstill
 //! in the displacement-based mode (the generator's [`Setpoint::position_control`]), always for
-//! setpoints another generator computes (gearing, camming, velocity). Not built yet: the I part
-//! (`fLagAmpTi`, `fLagAmpDx`, `fLagAmpWuL`) and the extended controller
+//! setpoints another generator computes (gearing, camming, velocity).
+//!
+//! The optional I part (the library: "the Ti parameter is used by this controller as Ki; 0.0
+//! disables the I part"; its structure figure is not in the text, so the rest is inferred):
+//! while the controller acts and the lag is beyond the response window `fLagAmpDx`, the I part
+//! grows by `fLagAmpTi · lag · dt / fRefVelo` (normalised, like the P part), limited to
+//! ±`fLagAmpWuL` (±1.0, full scale, when 0); within the window it holds. While the controller
+//! does not act (a move in the displacement mode) the I part holds and the output is 0; without
+//! the drive's enable it is cleared ([`HydController::reset`]), as the extended controller
+//! documents. The sum is limited by `fLagAmpOutL`. Not built yet: the extended controller
 //! `MC_AxRtPosPiControllerEx_BkPlcMc`.
+//!
+//! [`HydControlInput::zero_compensation`] writes `fZeroCompensation` into Finish's parameters,
+//! as `MC_AxCtrlAutoZero_BkPlcMc` writes it into `ST_TcHydAxParam`
+//! ([`super::auto_zero`]).
 //!
 //! [`Setpoint::position_control`]: super::generator::Setpoint::position_control
 
@@ -25,6 +37,12 @@ pub struct HydControllerParams {
     pub lag_amp: f64,
     /// `fLagAmpOutL` (normalised, >= 0): the limit of the controller's output; 0: none.
     pub lag_out_limit: f64,
+    /// `fLagAmpTi` (mm/s per mm and s, >= 0), used as Ki: the I part's gain; 0: no I part.
+    pub lag_amp_ti: f64,
+    /// `fLagAmpDx` (mm, >= 0): the response window; the I part grows only beyond it.
+    pub lag_amp_dx: f64,
+    /// `fLagAmpWuL` (normalised, >= 0): the I part's limit; 0: full scale (1.0).
+    pub lag_amp_wul: f64,
     /// The Finish stage (`fRefVelo`, feed forward, area ratio, overlap, bend point, offset).
     pub finish: FinishParams,
 }
@@ -35,6 +53,9 @@ impl Default for HydControllerParams {
         Self {
             lag_amp: 0.05,
             lag_out_limit: 0.0,
+            lag_amp_ti: 0.0,
+            lag_amp_dx: 0.0,
+            lag_amp_wul: 0.0,
             finish: FinishParams::default(),
         }
     }
@@ -53,13 +74,19 @@ pub struct HydControlInput {
     pub position_control: bool,
     /// `fClampingOutput` (V): the pressing output of target clamping.
     pub clamping_output: f64,
+    /// `fZeroCompensation` (V) as `MC_AxCtrlAutoZero_BkPlcMc` has set it; `None`: unchanged.
+    pub zero_compensation: Option<f64>,
+    /// The cycle (s, > 0): the I part's time step.
+    pub dt: f64,
 }
 
 /// One cycle's values out of the controller.
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
 pub struct HydControlOutput {
-    /// `fLagCtrlOutput` (normalised).
+    /// `fLagCtrlOutput` (normalised): P and I part.
     pub lag_ctrl_output: f64,
+    /// The I part (normalised).
+    pub i_part: f64,
     /// `fOutput` (normalised, ±1.0 = ±10 V).
     pub output: f64,
     /// The overlap compensation in the output.
@@ -74,6 +101,8 @@ pub struct HydController {
     finish: Finish,
     /// The characteristic curve (4 KiB: boxed when built, never per cycle).
     table: Option<Box<ValveTable>>,
+    /// The I part (normalised).
+    i_part: f64,
 }
 
 impl HydController {
@@ -86,6 +115,9 @@ impl HydController {
         for (parameter, value) in [
             ("fLagAmp", params.lag_amp),
             ("fLagAmpOutL", params.lag_out_limit),
+            ("fLagAmpTi", params.lag_amp_ti),
+            ("fLagAmpDx", params.lag_amp_dx),
+            ("fLagAmpWuL", params.lag_amp_wul),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(FinishError::OutOfRange {
@@ -100,7 +132,13 @@ impl HydController {
             finish: Finish::new(params.finish)?,
             params,
             table: table.map(Box::new),
+            i_part: 0.0,
         })
+    }
+
+    /// Clears the I part (the drive is not enabled).
+    pub fn reset(&mut self) {
+        self.i_part = 0.0;
     }
 
     /// The parameters.
@@ -109,26 +147,26 @@ impl HydController {
     }
 
     /// One cycle: the controller's output from the lag (0 without position control), then
-    /// Finish. Non-finite inputs give an output of 0.
-    pub fn step(&self, i: &HydControlInput) -> HydControlOutput {
+    /// Finish. Non-finite inputs give an output of 0 and change nothing.
+    pub fn step(&mut self, i: &HydControlInput) -> HydControlOutput {
         let finite = [
             i.set_position,
             i.set_velocity,
             i.actual_position,
             i.clamping_output,
+            i.dt,
+            i.zero_compensation.unwrap_or(0.0),
         ]
         .iter()
         .all(|x| x.is_finite());
         if !finite {
             return HydControlOutput::default();
         }
+        if let Some(z) = i.zero_compensation {
+            self.finish.set_zero_compensation(z);
+        }
         let lag = if i.position_control {
-            let u = self.params.lag_amp * (i.set_position - i.actual_position)
-                / self.params.finish.ref_velo;
-            match self.params.lag_out_limit {
-                l if l > 0.0 => u.clamp(-l, l),
-                _ => u,
-            }
+            self.lag_ctrl_output(i.set_position - i.actual_position, i.dt)
         } else {
             0.0
         };
@@ -143,8 +181,29 @@ impl HydController {
         };
         HydControlOutput {
             lag_ctrl_output: lag,
+            i_part: self.i_part,
             output: out.output,
             active_overlap: out.active_overlap,
+        }
+    }
+
+    /// `fLagCtrlOutput` for `lag` (mm): the P part, the I part grown beyond the response
+    /// window, the sum limited.
+    fn lag_ctrl_output(&mut self, lag: f64, dt: f64) -> f64 {
+        let p = &self.params;
+        let ref_velo = p.finish.ref_velo;
+        if p.lag_amp_ti > 0.0 && lag.abs() > p.lag_amp_dx {
+            let limit = if p.lag_amp_wul > 0.0 {
+                p.lag_amp_wul
+            } else {
+                1.0
+            };
+            self.i_part = (self.i_part + p.lag_amp_ti * lag * dt / ref_velo).clamp(-limit, limit);
+        }
+        let u = p.lag_amp * lag / ref_velo + self.i_part;
+        match p.lag_out_limit {
+            l if l > 0.0 => u.clamp(-l, l),
+            _ => u,
         }
     }
 }
@@ -158,41 +217,46 @@ mod tests {
     fn params() -> HydControllerParams {
         HydControllerParams {
             lag_amp: 20.0,
-            lag_out_limit: 0.0,
             finish: FinishParams {
                 ref_velo: 200.0,
                 ..FinishParams::default()
             },
+            ..HydControllerParams::default()
+        }
+    }
+
+    fn at(set_position: f64, actual_position: f64) -> HydControlInput {
+        HydControlInput {
+            set_position,
+            actual_position,
+            position_control: true,
+            dt: 0.001,
+            ..HydControlInput::default()
         }
     }
 
     #[test]
     fn the_p_part_is_the_lag_times_the_gain_over_the_reference_velocity() {
-        let c = HydController::new(params(), None).unwrap();
+        let mut c = HydController::new(params(), None).unwrap();
         // 0.5 mm behind at 20 mm/s per mm: 10 mm/s of 200, 0.05; plus 40 mm/s fed forward.
         let out = c.step(&HydControlInput {
-            set_position: 10.5,
             set_velocity: 40.0,
-            actual_position: 10.0,
-            position_control: true,
-            clamping_output: 0.0,
+            ..at(10.5, 10.0)
         });
         assert!((out.lag_ctrl_output - 0.05).abs() < 1e-15);
         assert!((out.output - 0.25).abs() < 1e-15, "{out:?}");
         // Without position control only the feed forward.
         let out = c.step(&HydControlInput {
-            set_position: 10.5,
             set_velocity: 40.0,
-            actual_position: 10.0,
             position_control: false,
-            clamping_output: 0.0,
+            ..at(10.5, 10.0)
         });
         assert_eq!((out.lag_ctrl_output, out.output), (0.0, 0.2));
     }
 
     #[test]
     fn the_output_limit_bounds_the_controller_and_bad_values_are_refused() {
-        let c = HydController::new(
+        let mut c = HydController::new(
             HydControllerParams {
                 lag_out_limit: 0.1,
                 ..params()
@@ -200,27 +264,100 @@ mod tests {
             None,
         )
         .unwrap();
-        let out = c.step(&HydControlInput {
-            set_position: 100.0,
-            actual_position: 0.0,
-            position_control: true,
-            ..HydControlInput::default()
-        });
+        let out = c.step(&at(100.0, 0.0));
         assert_eq!(out.lag_ctrl_output, 0.1);
-        let e = HydController::new(
+        for (bad, name) in [
+            (
+                HydControllerParams {
+                    lag_amp: -1.0,
+                    ..params()
+                },
+                "fLagAmp",
+            ),
+            (
+                HydControllerParams {
+                    lag_amp_ti: f64::NAN,
+                    ..params()
+                },
+                "fLagAmpTi",
+            ),
+            (
+                HydControllerParams {
+                    lag_amp_dx: -0.1,
+                    ..params()
+                },
+                "fLagAmpDx",
+            ),
+            (
+                HydControllerParams {
+                    lag_amp_wul: -1.0,
+                    ..params()
+                },
+                "fLagAmpWuL",
+            ),
+        ] {
+            let e = HydController::new(bad, None).unwrap_err();
+            assert!(e.to_string().contains(name), "{e}");
+        }
+        let out = c.step(&HydControlInput {
+            set_position: f64::NAN,
+            ..at(0.0, 0.0)
+        });
+        assert_eq!(out, HydControlOutput::default());
+    }
+
+    #[test]
+    fn the_i_part_grows_beyond_the_window_holds_within_it_and_is_limited() {
+        let mut c = HydController::new(
             HydControllerParams {
-                lag_amp: -1.0,
+                lag_amp_ti: 50.0,
+                lag_amp_dx: 0.1,
+                lag_amp_wul: 0.02,
                 ..params()
             },
             None,
         )
-        .unwrap_err();
-        assert!(e.to_string().contains("fLagAmp"), "{e}");
+        .unwrap();
+        // 0.2 mm behind: 50 · 0.2 · 0.001 / 200 = 5e-5 a cycle, on top of the P part's 0.02.
+        let out = c.step(&at(10.2, 10.0));
+        assert!((out.i_part - 5e-5).abs() < 1e-18, "{out:?}");
+        assert!(
+            (out.lag_ctrl_output - (0.02 + 5e-5)).abs() < 1e-15,
+            "{out:?}"
+        );
+        // Within the window it holds.
+        let out = c.step(&at(10.05, 10.0));
+        assert!((out.i_part - 5e-5).abs() < 1e-18, "{out:?}");
+        // Without position control it holds and gives nothing.
         let out = c.step(&HydControlInput {
-            set_position: f64::NAN,
-            position_control: true,
-            ..HydControlInput::default()
+            position_control: false,
+            ..at(10.2, 10.0)
         });
-        assert_eq!(out, HydControlOutput::default());
+        assert_eq!(out.lag_ctrl_output, 0.0);
+        assert!((out.i_part - 5e-5).abs() < 1e-18, "{out:?}");
+        // Limited to fLagAmpWuL.
+        for _ in 0..10_000 {
+            c.step(&at(10.2, 10.0));
+        }
+        assert_eq!(c.step(&at(10.2, 10.0)).i_part, 0.02);
+        // Cleared without the drive's enable.
+        c.reset();
+        assert_eq!(c.step(&at(10.05, 10.0)).i_part, 0.0);
+    }
+
+    #[test]
+    fn without_ti_there_is_no_i_part_and_the_zero_compensation_is_written() {
+        let mut c = HydController::new(params(), None).unwrap();
+        for _ in 0..1000 {
+            assert_eq!(c.step(&at(10.2, 10.0)).i_part, 0.0);
+        }
+        // 0.5 V written: 0.05 of full scale at standstill on the set position.
+        let out = c.step(&HydControlInput {
+            zero_compensation: Some(0.5),
+            ..at(10.0, 10.0)
+        });
+        assert!((out.output - 0.05).abs() < 1e-15, "{out:?}");
+        // It stays when the axis no longer sends it.
+        assert!((c.step(&at(10.0, 10.0)).output - 0.05).abs() < 1e-15);
     }
 }

@@ -258,6 +258,14 @@ impl Finish {
         &self.p
     }
 
+    /// Writes `fZeroCompensation` (V), limited to ±10 V (what `MC_AxCtrlAutoZero_BkPlcMc`
+    /// does to `ST_TcHydAxParam`); a value that is not a number changes nothing.
+    pub fn set_zero_compensation(&mut self, volts: f64) {
+        if !volts.is_nan() {
+            self.p.zero_compensation = volts.clamp(-FULL_SCALE_V, FULL_SCALE_V);
+        }
+    }
+
     /// Step 1: the commanded velocity, normalised.
     fn commanded(&self, i: &FinishInput) -> f64 {
         self.p.feed_forward * i.set_velocity / self.p.ref_velo + i.lag_ctrl_output

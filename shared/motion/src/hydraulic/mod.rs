@@ -14,12 +14,14 @@
 //!   `MC_AxRtFinishLinear_BkPlcMc` (a characteristic curve);
 //! - [`valve_table`]: the characteristic curve of a valve and cylinder, read from the library's
 //!   table file format and checked;
-//! - [`controller`]: the position controller (`fLagAmp`) and Finish as one stage;
+//! - [`controller`]: the position controller (`fLagAmp`, the I part) and Finish as one stage;
+//! - [`auto_zero`]: the automatic zero compensation `MC_AxCtrlAutoZero_BkPlcMc`;
 //! - [`pressure`]: the pressures and force from two inputs (`MC_AxRtReadForceDiff_BkPlcMc`) and
 //!   the pressure or force controller (`MC_AxCtrlPressure_BkPlcMc`);
 //! - [`autoident`]: the automatic identification `MC_AxUtiAutoIdent_BkPlcMc` (end of travel,
 //!   overlap and offset, area ratio, characteristic curve).
 
+pub mod auto_zero;
 pub mod autoident;
 pub mod controller;
 pub mod finish;

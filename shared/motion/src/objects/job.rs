@@ -44,6 +44,8 @@ pub enum Instruction {
     MotionInVelocity,
     /// `MC_AxCtrlPressure_BkPlcMc` (Beckhoff hydraulic library): pressure or force control.
     PressureControl,
+    /// `MC_AxCtrlAutoZero_BkPlcMc` (Beckhoff hydraulic library): automatic zero compensation.
+    AutoZero,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -87,6 +89,7 @@ impl Instruction {
             Self::MotionInPosition => "MC_MotionInPosition",
             Self::MotionInVelocity => "MC_MotionInVelocity",
             Self::PressureControl => "MC_AxCtrlPressure_BkPlcMc",
+            Self::AutoZero => "MC_AxCtrlAutoZero_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::GearOut => "MC_GearOut",

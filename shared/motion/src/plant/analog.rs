@@ -753,8 +753,8 @@ impl AnalogConnection {
     pub fn command(&mut self, out: &DriveOutputs) -> AnalogCommand {
         self.request = out.enable;
         let active = out.enable && self.enable.status() == AnalogEnableStatus::Enabled;
-        let c = if let Some(h) = &self.hydraulic {
-            self.hydraulic_output(h, active, out)
+        let c = if self.hydraulic.is_some() {
+            self.hydraulic_output(active, out)
         } else if active {
             self.controller.step(
                 out.position,
@@ -790,26 +790,30 @@ impl AnalogConnection {
 
 impl AnalogConnection {
     /// The hydraulic controller's cycle: the lag from the set position of this cycle and the
-    /// actual position of its sample; nothing while the valve is not enabled.
-    fn hydraulic_output(
-        &self,
-        h: &HydController,
-        active: bool,
-        out: &DriveOutputs,
-    ) -> ControllerOutput {
+    /// actual position of its sample, the axis' pressing output and zero compensation; nothing
+    /// while the valve is not enabled (the I part cleared).
+    fn hydraulic_output(&mut self, active: bool, out: &DriveOutputs) -> ControllerOutput {
+        let dt = self.params.controller.cycle();
+        let actual = self.actual;
+        let Some(h) = self.hydraulic.as_mut() else {
+            return ControllerOutput::default();
+        };
         if !active {
+            h.reset();
             return ControllerOutput::default();
         }
         let o = h.step(&HydControlInput {
             set_position: out.position,
             set_velocity: out.velocity,
-            actual_position: self.actual,
+            actual_position: actual,
             position_control: out.position_controlled,
-            clamping_output: 0.0,
+            clamping_output: out.hydraulic.clamping_output,
+            zero_compensation: out.hydraulic.zero_compensation,
+            dt,
         });
         ControllerOutput {
             normalized: o.output,
-            control_difference: out.position - self.actual,
+            control_difference: out.position - actual,
             saturated: o.output.abs() >= 1.0,
         }
     }

@@ -136,6 +136,19 @@ pub struct DriveOutputs {
     pub quick_stop: bool,
     /// The homing job waits for this mark: the drive is to latch it (armed only while set).
     pub homing_latch: Option<HomingLatch>,
+    /// A hydraulic axis' values for its valve's Finish stage (zero for other axes).
+    pub hydraulic: HydValveOutputs,
+}
+
+/// What a hydraulic axis gives its valve's Finish stage besides the setpoint (Beckhoff TwinCAT
+/// PLC Hydraulic Positioning library, members of `ST_TcHydAxRtData` and `ST_TcHydAxParam`).
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct HydValveOutputs {
+    /// `fClampingOutput` (V): the generator's pressing output at the target (target clamping).
+    pub clamping_output: f64,
+    /// `fZeroCompensation` (V) as `MC_AxCtrlAutoZero_BkPlcMc` has set it; `None`: the
+    /// configured one.
+    pub zero_compensation: Option<f64>,
 }
 
 /// Switch levels read from input signals of the node's process image, in place of the

@@ -458,6 +458,17 @@ pub enum Command {
         /// `ReadingMode`: the force (`iTcHydPressureReadingActForce`), else the pressure.
         force: bool,
     },
+    /// The automatic zero compensation of a hydraulic axis with a zero-overlap valve (Beckhoff
+    /// TwinCAT PLC Hydraulic Positioning library, `MC_AxCtrlAutoZero_BkPlcMc`): with `enable` it
+    /// adjusts `fZeroCompensation` at standstill until the lag is gone; without, the value
+    /// stays.
+    #[doc(alias = "MC_AxCtrlAutoZero_BkPlcMc")]
+    AutoZero {
+        /// `Enable`.
+        enable: bool,
+        /// `EnableOnMoving`, `OffsetLimit`, `Tn`, `Threshold`, `Filter`.
+        params: crate::hydraulic::auto_zero::AutoZeroParams,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

@@ -232,6 +232,9 @@ pub struct HydraulicProfile {
     pub generator: crate::hydraulic::generator::GeneratorParams,
     /// `fMonPositionRange`, `fMonTargetRange`, `fMonTargetFilter`.
     pub monitor: crate::hydraulic::monitor::MonitorParams,
+    /// The position controller and Finish (`fLagAmp`, `fLagAmpDx`, `fZeroCompensation` …):
+    /// the basis of `MC_AxCtrlAutoZero_BkPlcMc` (the drive connection runs the controller).
+    pub controller: crate::hydraulic::controller::HydControllerParams,
 }
 
 /// What is wrong with a value of an [`AxisConfig`] (see [`AxisConfigError`]).

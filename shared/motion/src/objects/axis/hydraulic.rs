@@ -18,11 +18,14 @@
 
 use super::{Axis, Goal};
 use crate::catalog::error_id::ErrorId;
+use crate::hydraulic::auto_zero::{AutoZero, AutoZeroInput, AutoZeroParams, AutoZeroStatus};
+use crate::hydraulic::controller::HydControllerParams;
 use crate::hydraulic::generator::{CtrlBasedGenerator, HydState, Setpoint};
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
 use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
 use crate::kinematics::profile::{Profile, State};
 use crate::objects::job::{Instruction, JobEventKind, JobId};
+use crate::plant::link::HydValveOutputs;
 
 /// The hydraulic part of an axis (boxed in the axis: allocated when it is built).
 #[derive(Clone, Debug, PartialEq)]
@@ -41,6 +44,10 @@ pub(super) struct HydAxis {
     actual: Option<ActualForce>,
     /// The running MC_AxCtrlPressure_BkPlcMc job.
     pressure: Option<PressureJob>,
+    /// The position controller's and Finish's parameters (AutoZero's basis).
+    controller: HydControllerParams,
+    /// MC_AxCtrlAutoZero_BkPlcMc, once it has been enabled; its `Enable`.
+    auto_zero: Option<(AutoZero, bool)>,
 }
 
 /// A running pressure or force control.
@@ -75,6 +82,9 @@ pub struct HydraulicStatus {
     /// The pressure or force controller runs (MC_AxCtrlPressure_BkPlcMc), with its set value
     /// and its output of the last cycle.
     pub pressure_control: Option<(f64, PressureOutput)>,
+    /// MC_AxCtrlAutoZero_BkPlcMc's outputs and `fZeroCompensation`, once it has been enabled,
+    /// with its `Enable`.
+    pub auto_zero: Option<(AutoZeroStatus, bool)>,
 }
 
 impl HydAxis {
@@ -98,6 +108,8 @@ impl HydAxis {
             ref_velo: cfg.generator.ref_velo,
             actual: None,
             pressure: None,
+            controller: cfg.controller,
+            auto_zero: None,
         }))
     }
 }
@@ -356,6 +368,83 @@ impl Axis {
             in_target: h.window.in_target,
             actual: h.actual,
             pressure_control: h.pressure.map(|p| (p.set, p.last)),
+            auto_zero: h.auto_zero.map(|(a, on)| (a.status(), on)),
         })
+    }
+
+    /// `MC_AxCtrlAutoZero_BkPlcMc`: with `enable` the zero compensation adjusts
+    /// `fZeroCompensation` at standstill (a running one takes the new parameters, its value
+    /// kept); without, it stops adjusting and the value stays. Done at once (its outputs are in
+    /// [`HydraulicStatus::auto_zero`]). Refused with 16#8002 on an electric axis, with 16#80F5
+    /// for a parameter out of its range or a valve with overlap compensation (the library: "may
+    /// only be used for zero overlap valves").
+    pub(super) fn cmd_auto_zero(
+        &mut self,
+        enable: bool,
+        params: AutoZeroParams,
+    ) -> Result<JobId, ErrorId> {
+        let h = self.hyd.as_deref_mut().ok_or(ErrorId::IllegalObject)?;
+        let refused = ErrorId::IllegalControllerParameter;
+        let finish = &h.controller.finish;
+        if finish.overlap_comp_p != 0.0 || finish.overlap_comp_m != 0.0 {
+            return Err(refused);
+        }
+        h.auto_zero = match h.auto_zero {
+            Some((mut a, _)) => {
+                a.retune(params).map_err(|_| refused)?;
+                Some((a, enable))
+            }
+            None => Some((
+                AutoZero::new(params, finish.zero_compensation).map_err(|_| refused)?,
+                enable,
+            )),
+        };
+        let id = self.new_id();
+        self.emit(id, Instruction::AutoZero, JobEventKind::Done);
+        Ok(id)
+    }
+
+    /// One cycle of MC_AxCtrlAutoZero_BkPlcMc, once it has been enabled: after the setpoint of
+    /// this cycle, before the drive's outputs (the library calls it before Finish). Enabled
+    /// with the axis enabled and no pressure or force control running; idle when the setpoint
+    /// stands with the position controller acting.
+    pub(super) fn hyd_auto_zero(&mut self) {
+        let (enabled, position_control) = (self.enabled, self.hyd_position_control());
+        let total = self.total();
+        let (actual_p, actual_v, dt) = (self.actual_p, self.actual_v, self.cfg.cycle);
+        let Some(h) = self.hyd.as_deref_mut() else {
+            return;
+        };
+        let Some((a, on)) = h.auto_zero.as_mut() else {
+            return;
+        };
+        let idle =
+            position_control && total.v == 0.0 && (!h.engaged || h.last.state == HydState::Idle);
+        a.step(&AutoZeroInput {
+            enabled: *on && enabled && h.pressure.is_none(),
+            idle,
+            lag: total.p - actual_p,
+            lag_amp: h.controller.lag_amp,
+            ref_velo: h.controller.finish.ref_velo,
+            window: h.controller.lag_amp_dx,
+            actual_velocity: actual_v,
+            dt,
+        });
+    }
+
+    /// What the valve's Finish stage takes from the axis this cycle: the generator's pressing
+    /// output at the target (while it computes the setpoint) and AutoZero's compensation.
+    pub(super) fn hyd_valve_outputs(&self) -> HydValveOutputs {
+        match self.hyd.as_deref() {
+            Some(h) => HydValveOutputs {
+                clamping_output: if h.engaged && h.pressure.is_none() {
+                    h.last.clamping_output
+                } else {
+                    0.0
+                },
+                zero_compensation: h.auto_zero.map(|(a, _)| a.status().compensation),
+            },
+            None => HydValveOutputs::default(),
+        }
     }
 }

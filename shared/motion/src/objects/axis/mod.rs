@@ -1076,6 +1076,7 @@ impl Axis {
                     },
                 },
             ),
+            Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
             Command::MotionInPosition {
                 enable,
                 position,

@@ -43,6 +43,7 @@ impl Axis {
         self.check_sw_limits();
         self.update_jobs();
         self.monitor(act.balanced + self.offset);
+        self.hyd_auto_zero();
 
         let out = self.outputs();
         self.power.fault_reset = false;
@@ -65,6 +66,7 @@ impl Axis {
             acceleration: tot.a,
             quick_stop: self.power.quick_stop && !self.enabled && !self.power.awaiting_drive,
             homing_latch: self.homing_latch(),
+            hydraulic: self.hyd_valve_outputs(),
         }
     }
 
