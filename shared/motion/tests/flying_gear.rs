@@ -566,3 +566,30 @@ fn enable_false_while_geared_continues_with_the_velocity() {
     assert_eq!(s.sync_job, None);
     assert!((s.velocity - v).abs() < 1e-9, "{}", s.velocity);
 }
+
+#[test]
+fn a_motion_command_aborts_it_and_gear_out_ends_it_once_coupling() {
+    // A positioning of the follower aborts the flying gear (override table 2, as MC_GearIn).
+    let mut p = pair();
+    let id = p.f(flying(true, sample1())).unwrap();
+    p.step(5);
+    p.f(Command::MoveAbsolute {
+        position: 520.0,
+        dynamics: dynamics(100.0, 1000.0, 1000.0, 10_000.0),
+        direction: Direction::Shortest,
+    })
+    .unwrap();
+    assert!(p.has(id, JobEventKind::CommandAborted));
+    assert_eq!(p.fs().sync_job.map(|j| j.1), None);
+    // MC_GearOut: refused while the follower waits, ends the coupling once it engages.
+    let mut p = pair();
+    let id = p.f(flying(true, sample1())).unwrap();
+    p.step(5);
+    assert_eq!(p.f(Command::GearOut), Err(ErrorId::NoSynchronousOperation));
+    leader_to(&mut p, 400.0, 100.0, 100_000.0);
+    p.until(id, JobEventKind::StartSync, 5000);
+    p.step(10);
+    p.f(Command::GearOut).unwrap();
+    assert!(p.has(id, JobEventKind::CommandAborted));
+    assert_eq!(p.fs().sync_job, None);
+}
