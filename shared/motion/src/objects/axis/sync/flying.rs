@@ -17,8 +17,8 @@
 //!   to 0 until it stands at `SlaveStopPosition`.
 //! - [`FlyingPhase::Stopped`]: the follower stands at `SlaveStopPosition` (`Active` fell).
 //!
-//! Inferred (the reference gives the numbers of 'Sample #1', not the profile, whose figure is
-//! lost): the ramps are linear ramps of the *ratio* over leader distance. Only that makes the
+//! inferred: the ramps (the reference gives the numbers of 'Sample #1', not the profile, whose
+//! figure is lost) are linear ramps of the *ratio* over leader distance. Only that makes the
 //! reference's factor 2 come out ("with a ratio of 1.0, the master has a distance to synchronize
 //! of 2.0 · 50 mm"): the follower travels the integral of the ratio, `Ratio · D_leader / 2`, so
 //! `D_leader = 2 · D_follower / Ratio`. The follower's position is then a quadratic of the
@@ -208,7 +208,9 @@ pub struct FlyingGear {
     /// Leader position at which the geared follower is at `SlaveDesyncPosition`.
     master_desync: f64,
     /// The geared follower has been at or beyond `SlaveDesyncPosition` in its working direction
-    /// (the release starts only on the way back from there).
+    /// (the release starts only on the way back from there; inferred: the reference names the
+    /// position, not the crossing, and a follower geared past it on the way down must not
+    /// release there).
     armed: bool,
     phase: FlyingPhase,
 }
@@ -264,6 +266,9 @@ impl FlyingGear {
         if self.phase != FlyingPhase::Armed {
             return Ok(());
         }
+        // inferred: the master's working direction is towards MasterSyncPosition from where it
+        // is when the coupling starts (the reference deduces it "from the transferred
+        // parameters" and gives the error for a master already past the engage start).
         let to_sync = self.p.master_sync_position - master_position;
         let engage_start = self.engage_start_for(to_sync.signum());
         // At the sync position the direction is unknown: that leader is inside the section.
@@ -394,6 +399,8 @@ impl FlyingGear {
                     s * r * self.dir_m / l,
                 )
             }
+            // inferred: the stroke is over; the reference's 'Sample #3' returns the slave with
+            // its own command after the function block is deactivated.
             FlyingPhase::Stopped => point(self.p.slave_stop_position, 0.0, 0.0),
         }
     }

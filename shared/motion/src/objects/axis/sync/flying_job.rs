@@ -65,6 +65,8 @@ impl Axis {
         match (enable, running) {
             (true, Some(id)) => Ok(id),
             (false, Some(id)) => {
+                // inferred: the library ends a flying gear with its Enable only; how the follower
+                // then moves is not said, so it is what MC_GearOut_BkPlcMc does with a coupling.
                 self.end_sync_keep_velocity(JobEventKind::Done);
                 Ok(id)
             }
@@ -82,6 +84,8 @@ impl Axis {
         self.check_motion_allowed()?;
         let here = self.total();
         let gear = FlyingGear::new(*params, here.p)?;
+        // inferred: the slave's start is where it stands at Enable ('Sample #1': "The slave was
+        // positioned at 500.0 mm"); a moving one has no start position and is refused.
         if here.v != 0.0 {
             return Err(FlyingGearError::SlaveMoving { velocity: here.v }.into());
         }
@@ -141,7 +145,8 @@ impl Axis {
 
     /// The [`sync_status`] bits of a running flying gear (StartSync, InSync, Active).
     pub(in crate::objects::axis) fn flying_flags(&self) -> u8 {
-        let Some(SyncLaw::Flying(g)) = self.sync.as_ref().map(|s| s.law) else {
+        // Borrowed, not copied: every synchronous axis asks each cycle.
+        let Some(SyncLaw::Flying(g)) = self.sync.as_ref().map(|s| &s.law) else {
             return 0;
         };
         let p = g.phase();
