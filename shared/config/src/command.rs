@@ -7,8 +7,8 @@
 use core::fmt;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
-    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, StartMode, StopMode,
-    SyncDirection, SyncProfileReference, VelocityDirection,
+    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, FlyingGearParams,
+    StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::objects::leading::LeaderId;
 
@@ -233,6 +233,18 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         ],
     },
     InstructionSpec {
+        name: "MC_FlyingGear_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("ratio", Some(Value::Num(1.0))),
+            ("master_sync_position", None),
+            ("slave_sync_position", None),
+            ("slave_desync_position", None),
+            ("slave_stop_position", None),
+            ("default_slave_negative", Some(Value::Bool(false))),
+        ],
+    },
+    InstructionSpec {
         name: "MC_GearOut",
         params: &[],
     },
@@ -294,7 +306,7 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
 pub fn needs_master(spec: &InstructionSpec) -> bool {
     matches!(
         spec.name,
-        "MC_GearIn" | "MC_GearInPos" | "MC_GearInVelocity" | "MC_CamIn"
+        "MC_GearIn" | "MC_GearInPos" | "MC_GearInVelocity" | "MC_CamIn" | "MC_FlyingGear_BkPlcMc"
     )
 }
 
@@ -735,6 +747,18 @@ fn sync_command(a: &Args<'_>, refs: Refs) -> Result<Option<Command>, CommandErro
             }
         }
         "MC_GearInPos" => gear_in_pos(a, leader()?)?,
+        "MC_FlyingGear_BkPlcMc" => Command::FlyingGear {
+            master: leader()?,
+            enable: a.flag("enable")?,
+            params: FlyingGearParams {
+                ratio: a.num("ratio")?,
+                master_sync_position: a.num("master_sync_position")?,
+                slave_sync_position: a.num("slave_sync_position")?,
+                slave_desync_position: a.num("slave_desync_position")?,
+                slave_stop_position: a.num("slave_stop_position")?,
+                default_slave_negative: a.flag("default_slave_negative")?,
+            },
+        },
         "MC_GearOut" => Command::GearOut,
         "MC_CamIn" => {
             let master = leader()?;
@@ -1122,6 +1146,58 @@ mod tests {
         .unwrap_err()
         .to_string()
         .contains("buffer_mode must be 0..5"));
+    }
+
+    #[test]
+    fn flying_gear_parses_with_its_inputs_and_leader() {
+        let given = [
+            p("master_sync_position", Value::Num(460.0)),
+            p("slave_sync_position", Value::Num(450.0)),
+            p("slave_desync_position", Value::Num(450.0)),
+            p("slave_stop_position", Value::Num(500.0)),
+            p("ratio", Value::Num(0.98)),
+        ];
+        let refs = Refs {
+            master: Some(3),
+            cam: None,
+        };
+        let c = parse("flying_gear_bkplcmc", &given, refs).unwrap();
+        assert_eq!(
+            c,
+            Command::FlyingGear {
+                master: 3,
+                enable: true,
+                params: FlyingGearParams {
+                    ratio: 0.98,
+                    master_sync_position: 460.0,
+                    slave_sync_position: 450.0,
+                    slave_desync_position: 450.0,
+                    slave_stop_position: 500.0,
+                    default_slave_negative: false,
+                },
+            }
+        );
+        assert!(needs_master(find("MC_FlyingGear_BkPlcMc").unwrap()));
+        assert_eq!(
+            parse("MC_FlyingGear_BkPlcMc", &given, Refs::default()),
+            Err(CommandError::MissingReference {
+                instruction: "MC_FlyingGear_BkPlcMc",
+                param: "master",
+                what: "the leading axis",
+            })
+        );
+        let off = [
+            p("enable", Value::Bool(false)),
+            given[0].clone(),
+            given[1].clone(),
+        ];
+        assert!(matches!(
+            parse("MC_FlyingGear_BkPlcMc", &off, refs),
+            Err(CommandError::MissingParameter {
+                param: "slave_desync_position",
+                ..
+            })
+        ));
     }
 
     #[test]

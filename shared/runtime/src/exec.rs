@@ -852,6 +852,7 @@ impl<'c> Executive<'c> {
         let master = match command {
             Command::GearIn { master, .. }
             | Command::GearInPos { master, .. }
+            | Command::FlyingGear { master, .. }
             | Command::GearInVelocity { master, .. }
             | Command::CamIn { master, .. } => Some(master),
             _ => None,

@@ -30,6 +30,7 @@ const EXAMPLES: &[&str] = &[
     "inputs",
     "hydraulic",
     "hydraulic-press",
+    "hydraulic-flying-gear",
 ];
 
 fn root() -> PathBuf {

@@ -261,6 +261,18 @@ fn the_force_control_stages_step_without_allocating() {
     assert!(exec.commands == 7 && exec.rejected == 0);
 }
 
+/// MC_FlyingGear_BkPlcMc (`config/hydraulic-flying-gear.toml`): the cushion's flying gear on
+/// the slide through waiting, engaging, in sync, releasing and stopped, with 0 allocations.
+#[test]
+fn the_flying_gear_steps_without_allocating() {
+    let cell = example_cell("hydraulic-flying-gear");
+    let (mut exec, allocations) = run_counting(&cell, "hydraulic-flying-gear");
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    let st = exec.status()[0];
+    assert_eq!((st.position, st.sync_job), (250.0, None));
+    assert!(exec.commands == 7 && exec.rejected == 0);
+}
+
 /// The input stage (`config/inputs.toml`): a timestamped input driven by a sensor on the web
 /// feeding a cyclic measuring input, a probe pulsed by the script, and a plain input as the
 /// web's limit switch (alarm 531): sampled, sensed, measured and drained with 0 allocations.

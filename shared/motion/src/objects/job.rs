@@ -50,6 +50,9 @@ pub enum Instruction {
     GearIn,
     /// `MC_GearInPos`.
     GearInPos,
+    /// `MC_FlyingGear_BkPlcMc` (Beckhoff hydraulic library): gearing engaged and released in
+    /// leader-position space.
+    FlyingGear,
     /// `MC_GearOut`.
     GearOut,
     /// `MC_GearInVelocity`.
@@ -92,6 +95,7 @@ impl Instruction {
             Self::AutoZero => "MC_AxCtrlAutoZero_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
+            Self::FlyingGear => "MC_FlyingGear_BkPlcMc",
             Self::GearOut => "MC_GearOut",
             Self::GearInVelocity => "MC_GearInVelocity",
             Self::CamIn => "MC_CamIn",

@@ -533,6 +533,19 @@ pub enum Command {
         /// `SyncDirection` (modulo followers).
         sync_direction: SyncDirection,
     },
+    /// `MC_FlyingGear_BkPlcMc` (Beckhoff TwinCAT PLC Hydraulic Positioning library, 4.2.6):
+    /// level-driven gearing engaged and released on the fly, with ratio ramps in leader-position
+    /// space (see `docs/hydraulics.md`). Re-sent with its current inputs; `enable = false` ends
+    /// it.
+    #[doc(alias = "MC_FlyingGear_BkPlcMc")]
+    FlyingGear {
+        /// The leader (`Master`).
+        master: LeaderId,
+        /// `Enable`.
+        enable: bool,
+        /// `Ratio`, the sync, desync and stop positions, `DefaultSlaveNegative`.
+        params: super::sync::flying::FlyingGearParams,
+    },
     /// `MC_CamIn`: camming. `following = f((leading - MasterOffset) / MasterScaling) *
     /// SlaveScaling + SlaveOffset`; synchronous at `MasterSyncPosition` (relative to the cam
     /// start) after a synchronization like MC_GearInPos, or at once (reference `Direct`).

@@ -26,6 +26,7 @@ pub use config::{
     PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
 };
 pub use hydraulic::HydraulicStatus;
+pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
 
 use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
 use crate::catalog::error_id::ErrorId;
@@ -155,6 +156,16 @@ pub mod sync_status {
     /// Bit 3: the synchronous operation runs simulated (MC_SynchronizedMotionSimulation); the
     /// coupling goes on logically while the follower stands.
     pub const SIMULATION: u8 = 1 << 3;
+    /// Bit 4: `StartSync` of MC_FlyingGear_BkPlcMc (the leader is in the engage section).
+    #[doc(alias = "StartSync")]
+    pub const FLYING_START_SYNC: u8 = 1 << 4;
+    /// Bit 5: `InSync` of MC_FlyingGear_BkPlcMc (fully coupled).
+    #[doc(alias = "InSync")]
+    pub const FLYING_IN_SYNC: u8 = 1 << 5;
+    /// Bit 6: `Active` of MC_FlyingGear_BkPlcMc (from the sync point until the follower reaches
+    /// its stop position).
+    #[doc(alias = "Active")]
+    pub const FLYING_ACTIVE: u8 = 1 << 6;
 }
 
 impl AxisStatus {
@@ -1037,6 +1048,7 @@ impl Axis {
             }
             Command::GearIn { .. }
             | Command::GearInPos { .. }
+            | Command::FlyingGear { .. }
             | Command::GearOut
             | Command::CamIn { .. }
             | Command::CamOut

@@ -86,7 +86,7 @@ impl Axis {
         self.basic.p += self.shift_out.p;
         self.basic.v += self.shift_out.v;
         self.basic.a += self.shift_out.a;
-        self.sync_flags = self.exceedance_flags();
+        self.sync_flags = self.exceedance_flags() | self.flying_flags();
     }
 
     /// The pending job (GearInPos, CamIn): checks its start condition with its leader's value
@@ -200,6 +200,10 @@ impl Axis {
         match self.sync.as_ref()?.law {
             SyncLaw::Gear { .. } => Some(self.evaluate_gear(x)),
             SyncLaw::GearPos { .. } => self.evaluate_gear_pos(x),
+            SyncLaw::Flying(_) => self.evaluate_flying(x).map(|events| LawStep {
+                events,
+                cam_step: None,
+            }),
         }
     }
 

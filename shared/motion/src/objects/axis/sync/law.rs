@@ -161,6 +161,8 @@ pub(in crate::objects::axis) enum SyncLaw {
         y_sync: f64,
         quintic: Option<Quintic>,
     },
+    /// MC_FlyingGear_BkPlcMc: ratio ramps in leader position, geared in between.
+    Flying(super::flying::FlyingGear),
 }
 
 impl SyncLaw {
@@ -202,6 +204,7 @@ impl SyncLaw {
                     q.c[0] += delta;
                 }
             }
+            SyncLaw::Flying(g) => g.shift_follower(delta),
         }
     }
 }

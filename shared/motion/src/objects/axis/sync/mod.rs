@@ -12,10 +12,14 @@
 //!   simulation);
 //! - [`gearing`] and [`camming`]: the commands of each law (camming also its cam mapping);
 //! - [`phasing`]: phase shift and offset commands;
+//! - [`flying`] (the law) and `flying_job` (its command and cycle): MC_FlyingGear_BkPlcMc of the
+//!   Beckhoff hydraulic library, engaged and released in leader-position space;
 //! - [`cycle`]: the cyclic part (start conditions, set-up, evaluation of the law, shifts).
 
 mod camming;
 mod cycle;
+pub(in crate::objects::axis) mod flying;
+mod flying_job;
 mod gearing;
 mod job;
 mod law;
@@ -251,6 +255,11 @@ impl Axis {
                 (ratio_numerator, ratio_denominator),
                 slave_sync_position,
             ),
+            Command::FlyingGear {
+                master,
+                enable,
+                ref params,
+            } => self.cmd_flying_gear(master, enable, params),
             Command::GearOut => self.cmd_gear_out(),
             Command::CamIn {
                 master,
