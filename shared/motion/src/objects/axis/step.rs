@@ -748,7 +748,10 @@ impl Axis {
             sync_job: self.sync.as_ref().map(|s| (s.id, s.instr)),
             sync_function: match self.sync.as_ref().map(|s| s.instr) {
                 Some(Instruction::GearIn) => sync_function::GEAR_IN,
-                Some(Instruction::GearInPos) => sync_function::GEAR_IN_POS,
+                // MC_FlyingGear_BkPlcMc: a gearing synchronised on positions, as MC_GearInPos.
+                Some(Instruction::GearInPos | Instruction::FlyingGear) => {
+                    sync_function::GEAR_IN_POS
+                }
                 Some(Instruction::CamIn) => sync_function::CAM_IN,
                 _ => sync_function::NONE,
             },
