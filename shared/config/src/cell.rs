@@ -497,7 +497,7 @@ pub enum DriveConnection {
 }
 
 /// An axis on an analog drive of the process image.
-#[derive(Copy, Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct AnalogDriveConnection {
     /// The drive.
     pub device: DeviceIndex,
@@ -509,6 +509,9 @@ pub struct AnalogDriveConnection {
     pub hydraulic: Option<tandem_motion::hydraulic::controller::HydControllerParams>,
     /// A hydraulic axis' pressure inputs (`ScaleFactorA` … in `[axes.<name>.hydraulic]`).
     pub pressure: Option<tandem_motion::hydraulic::pressure::ForceScaling>,
+    /// A hydraulic axis' characteristic curve (`characteristic_curve`): Finish linearises with
+    /// it (`MC_AxRtFinishLinear_BkPlcMc`).
+    pub characteristic_curve: Option<Box<tandem_motion::hydraulic::valve_table::ValveTable>>,
 }
 
 /// An axis on a CiA 402 drive of the process image.

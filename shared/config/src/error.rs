@@ -150,6 +150,13 @@ pub enum Problem {
         /// The operating system's reason.
         error: String,
     },
+    /// A valve's characteristic curve file that is refused (the library's table rules).
+    CurveFile {
+        /// The path as resolved.
+        path: String,
+        /// What is wrong, with the library's error code.
+        error: String,
+    },
     /// A cam points file with a bad line.
     CamCsv {
         /// The path as resolved.
@@ -546,6 +553,7 @@ impl fmt::Display for Problem {
             Problem::DelayTooShort(d) => fmt::Display::fmt(d, f),
             Problem::CamFile { path, error } => write!(f, "cannot read {path}: {error}"),
             Problem::CamCsv { path, error } => write!(f, "{path}: {error}"),
+            Problem::CurveFile { path, error } => write!(f, "{path}: {error}"),
             Problem::Segment { index, problem } => write!(f, "segment {index}: {problem}"),
             Problem::Interpolation(e) => {
                 write!(f, "cannot interpolate: {e:?} ({})", e.error_id())

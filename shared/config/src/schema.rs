@@ -266,6 +266,15 @@ pub struct HydraulicSection {
     pub fValve_BendPointOutput: Option<f64>,
     /// Zero (offset) compensation (V).
     pub fZeroCompensation: Option<f64>,
+    /// The lowest velocity (mm/s) for the characteristic curve, positive direction; below it
+    /// the straight line from the zero point.
+    pub Valve_LinLimitP: Option<f64>,
+    /// The same for the negative direction.
+    pub Valve_LinLimitM: Option<f64>,
+    /// tandem's: a file with the valve's characteristic curve (the library's ASCII table
+    /// format, one "velocity output" pair per line, both normalised), relative to the cell
+    /// file; given, Finish linearises with it (`MC_AxRtFinishLinear_BkPlcMc`).
+    pub characteristic_curve: Option<String>,
     /// The pressure inputs (`MC_AxRtReadForceDiff_BkPlcMc`): chamber A's pressure per input
     /// increment (bar). Given, the axis reads its two pressure inputs every cycle.
     pub ScaleFactorA: Option<f64>,

@@ -656,3 +656,77 @@ fn target_clamping_presses_on_at_the_target() {
     let link = r.exec.analog_drive(0).unwrap().link;
     assert!((link.normalized - -0.16).abs() < 1e-12, "{link:?}");
 }
+
+/// The table of the library's FAQ #22 (a cylinder half as fast retracting, a zero-overlap valve
+/// with a bend at 40 %), in its file format (tabs, a comma as decimal separator in one line).
+const FAQ22_CURVE: &str = "-0.500\t-1.000\n-0.430\t-0.900\n-0.360\t-0.800\n-0.290\t-0.700\n\
+    -0.220\t-0.600\n-0.150\t-0.500\n-0.080\t-0.400\n-0.060\t-0.300\n-0.040\t-0.200\n\
+    -0.020\t-0.100\n0.000\t0.000\n0.040\t0.100\n0.080\t0.200\n0.120\t0.300\n0.160\t0.400\n\
+    0.300\t0.500\n0.440\t0.600\n0.580\t0.700\n0.720\t0.800\n0.860\t0.900\n1,000\t1.000\n";
+
+/// The bundled cell with `characteristic_curve = "<curve file>"`, both written to a fresh
+/// directory and loaded from there (the file is read relative to the cell file).
+fn with_curve(curve: &str, dir: &str) -> Result<Cell, tandem_config::ConfigError> {
+    let dir = tandem_testkit::scratch::fresh_dir(&format!("{dir}-{}", std::process::id()));
+    std::fs::write(dir.join("ram.curve"), curve).unwrap();
+    let src = source().replacen(
+        "fLagAmp = 50.0",
+        "fLagAmp = 50.0\ncharacteristic_curve = \"ram.curve\"",
+        1,
+    );
+    std::fs::write(dir.join("cell.toml"), src).unwrap();
+    let cell = tandem_config::load(&dir.join("cell.toml"));
+    tandem_testkit::scratch::remove_dir(&dir);
+    cell
+}
+
+/// `characteristic_curve`: Finish linearises with the table (MC_AxRtFinishLinear_BkPlcMc): while
+/// the generator travels (no position control) the valve's output is the table's output for
+/// the set velocity plus the zero compensation, to the bit.
+#[test]
+fn a_characteristic_curve_from_the_cell_file_linearises_the_valve_output() {
+    use tandem_motion::hydraulic::valve_table::{ValveTable, MAX_POINTS};
+    let cell = with_curve(FAQ22_CURVE, "hyd-curve").unwrap();
+    let mut buf = [(0.0, 0.0); MAX_POINTS];
+    let table = ValveTable::parse(FAQ22_CURVE, &mut buf).unwrap();
+    let mut r = Run::enabled(&cell);
+    r.move_to(400.0, 120.0);
+    r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
+    let mut seen = 0;
+    while r.hyd().state == HydState::ConstVelo {
+        let v = r.exec.status()[0].velocity;
+        r.step();
+        let link = r.exec.analog_drive(0).unwrap().link;
+        if r.hyd().state == HydState::ConstVelo {
+            // 120 mm/s of 327.06: 0.3669, between (0.300, 0.5) and (0.440, 0.6); -0.1 V.
+            let want = table.output(v / 327.06, 0.0) - 0.01;
+            assert_eq!(link.normalized, want, "at {v} mm/s");
+            assert!((want - 0.537).abs() < 0.001, "{want}");
+            seen += 1;
+        }
+    }
+    assert!(seen > 100, "{seen} cycles of travel");
+}
+
+/// A curve file that breaks one of the library's table rules is refused naming the key, the
+/// file, the rule and the library's error code.
+#[test]
+fn a_characteristic_curve_that_breaks_a_table_rule_is_refused() {
+    for (curve, what) in [
+        ("-1.0 -1.0\n0.5 0.5\n1.0 1.0\n", "zero point"),
+        ("-1.0 -1.0\n0.0 0.0\n0.0 0.5\n1.0 1.0\n", "not higher"),
+        ("-1.0 -1.0\n0.0 0.0\n1.0 x\n", "line 3"),
+        ("-1.0 -1.0\n0.0 0.0\n1.5 1.0\n", "1.5"),
+    ] {
+        let e = with_curve(curve, "hyd-curve-bad").unwrap_err().to_string();
+        assert!(
+            e.contains("axes.ram.hydraulic.characteristic_curve")
+                && e.contains("ram.curve")
+                && e.contains(what)
+                && e.contains("16#"),
+            "{curve:?}: {e}"
+        );
+    }
+    let e = with_curve("", "hyd-curve-empty").unwrap_err().to_string();
+    assert!(e.contains("at least 2 points"), "{e}");
+}

@@ -406,6 +406,7 @@ pub(super) fn drives(
     raw: &CellFile,
     axes: &mut [AxisEntry],
     devices: &[DeviceEntry],
+    dir: Option<&std::path::Path>,
 ) -> Result<(), ConfigError> {
     let mut taken: Vec<Option<usize>> = vec![None; devices.len()];
     for (i, (entry, (name, a))) in axes.iter_mut().zip(raw.axes.iter()).enumerate() {
@@ -481,6 +482,12 @@ pub(super) fn drives(
         )? {
             entry.drive = c;
         }
+        if let (DriveConnection::Analog(c), Some(h)) = (&mut entry.drive, &a.hydraulic) {
+            if c.hydraulic.is_some() {
+                c.characteristic_curve = super::hydraulic::characteristic_curve(h, dir)
+                    .map_err(|(k, p)| at(&["hydraulic", k], p))?;
+            }
+        }
     }
     Ok(())
 }
@@ -509,6 +516,7 @@ fn connection(
                 params,
                 hydraulic,
                 pressure,
+                characteristic_curve: None,
             }))
         }
         DeviceKind::SimServo(servo) => {

@@ -12,6 +12,7 @@ use tandem_motion::hydraulic::generator::{
 };
 use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
 use tandem_motion::hydraulic::pressure::ForceScaling;
+use tandem_motion::hydraulic::valve_table::{ValveTable, MAX_POINTS};
 use tandem_motion::objects::axis::HydraulicProfile;
 use tandem_motion::plant::hydraulic::{CylinderParams, SimValveCylinderParams};
 
@@ -27,7 +28,7 @@ const MONITOR_DEFAULTS: MonitorParams = MonitorParams {
 
 /// The keys of `[axes.<name>.hydraulic]` the generator, the target window and the position
 /// controller with Finish check, as paths from the axis.
-const PROFILE_KEYS: [&str; 33] = [
+const PROFILE_KEYS: [&str; 35] = [
     "hydraulic.fRefVelo",
     "hydraulic.fMaxVelo",
     "hydraulic.fAcc",
@@ -61,6 +62,8 @@ const PROFILE_KEYS: [&str; 33] = [
     "hydraulic.fValve_BendPointVelo",
     "hydraulic.fValve_BendPointOutput",
     "hydraulic.fZeroCompensation",
+    "hydraulic.Valve_LinLimitP",
+    "hydraulic.Valve_LinLimitM",
 ];
 
 /// The path from the axis of the library's parameter `name`.
@@ -176,7 +179,8 @@ pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, Fi
             bend_point_velo: h.fValve_BendPointVelo.unwrap_or(d.bend_point_velo),
             bend_point_output: h.fValve_BendPointOutput.unwrap_or(d.bend_point_output),
             zero_compensation: h.fZeroCompensation.unwrap_or(d.zero_compensation),
-            ..d
+            lin_limit_p: h.Valve_LinLimitP.unwrap_or(d.lin_limit_p),
+            lin_limit_m: h.Valve_LinLimitM.unwrap_or(d.lin_limit_m),
         },
     };
     HydController::new(params, None).map_err(|e| match e {
@@ -259,4 +263,33 @@ pub(super) fn pressure_inputs(h: &HydraulicSection) -> Result<Option<ForceScalin
         )
     })?;
     Ok(Some(s))
+}
+
+/// The characteristic curve of section `h` (`characteristic_curve`, a table file relative to
+/// `dir`), read and checked as the library's table rules ask; `None` without the key.
+pub(super) fn characteristic_curve(
+    h: &HydraulicSection,
+    dir: Option<&std::path::Path>,
+) -> Result<Option<Box<ValveTable>>, FieldError> {
+    let Some(file) = &h.characteristic_curve else {
+        return Ok(None);
+    };
+    let path = dir
+        .map(|d| d.join(file))
+        .unwrap_or_else(|| std::path::PathBuf::from(file));
+    let refused = |error: String| {
+        (
+            "characteristic_curve",
+            Problem::CurveFile {
+                path: path.display().to_string(),
+                error,
+            },
+        )
+    };
+    let text = crate::read::read_text(&path, crate::read::CAM_FILE_MAX)
+        .map_err(|e| refused(e.problem.to_string()))?;
+    let mut buf = Box::new([(0.0, 0.0); MAX_POINTS]);
+    let table =
+        ValveTable::parse(&text, &mut buf).map_err(|e| refused(format!("{e} ({})", e.code())))?;
+    Ok(Some(Box::new(table)))
 }

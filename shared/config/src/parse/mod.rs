@@ -135,7 +135,8 @@ pub fn locate(src: &str, path: &[&str]) -> Option<usize> {
     Some(line_at(src, span?.start))
 }
 
-/// Loads and validates a cell file (cam CSV files are read relative to it).
+/// Loads and validates a cell file (cam CSV files and characteristic curves are read relative
+/// to it).
 pub fn load(path: &Path) -> Result<Cell, ConfigError> {
     let src = crate::read::read_text(path, crate::read::CELL_FILE_MAX)?;
     parse_in(&path.display().to_string(), &src, path.parent())
@@ -163,7 +164,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
     let devices = device::devices(cx, &raw, &nodes)?;
     let (devices, ethercat) = ethercat::segments(cx, &raw, &nodes, devices)?;
     let mut axes = axes(cx, &raw, &nodes)?;
-    device::drives(cx, &raw, &mut axes, &devices)?;
+    device::drives(cx, &raw, &mut axes, &devices, dir)?;
     leaders(cx, &raw, &mut axes)?;
     let mut encoders = encoder::encoders(cx, &raw, &axes, &nodes)?;
     let cams = cam::cams(cx, &raw, dir)?;

@@ -108,7 +108,8 @@ impl AnalogLink {
         let connection = match c.hydraulic {
             Some(h) => AnalogConnection::hydraulic(
                 c.params,
-                HydController::new(h, None).map_err(AnalogConnectionError::Hydraulic)?,
+                HydController::new(h, c.characteristic_curve.as_deref().cloned())
+                    .map_err(AnalogConnectionError::Hydraulic)?,
                 plant,
                 p0,
             )?,
