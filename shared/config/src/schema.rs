@@ -144,6 +144,9 @@ pub struct DeviceSection {
     /// sim_valve_cylinder: the pressure sensors' range (bar at 10 V, input word 27648;
     /// default 250).
     pub pressure_range: Option<f64>,
+    /// sim_valve_cylinder: how the valve's amplifier takes its command: `voltage` (±10 V,
+    /// default), `two_coil`, `one_coil`, or `current` (the magnitude with direction valves).
+    pub valve_input: Option<String>,
 }
 
 /// `[devices.<name>.cylinder]` of a `sim_valve_cylinder`: a proportional valve and a
@@ -271,6 +274,14 @@ pub struct HydraulicSection {
     pub Valve_LinLimitP: Option<f64>,
     /// The same for the negative direction.
     pub Valve_LinLimitM: Option<f64>,
+    /// tandem's: the form of the valve output after Finish (`MC_AxRtDrive_BkPlcMc`):
+    /// `voltage` (±10 V, default), `two_coil` or `one_coil`.
+    pub valve_output: Option<String>,
+    /// The output as a magnitude, the direction on `bMovePos` / `bMoveNeg` (a current valve;
+    /// with `valve_output = "voltage"` only).
+    pub bDrive_AbsoluteOutput: Option<bool>,
+    /// The output negated.
+    pub bDrive_Reversed: Option<bool>,
     /// tandem's: a file with the valve's characteristic curve (the library's ASCII table
     /// format, one "velocity output" pair per line, both normalised), relative to the cell
     /// file; given, Finish linearises with it (`MC_AxRtFinishLinear_BkPlcMc`).

@@ -374,7 +374,8 @@ fn connection_disables_with_a_zero_word_before_the_enable_drops() {
         l.written,
         AnalogCommand {
             enable: true,
-            word: 0
+            word: 0,
+            ..AnalogCommand::default()
         }
     );
     l.cycle(5.0, 0.0, false);
@@ -382,7 +383,8 @@ fn connection_disables_with_a_zero_word_before_the_enable_drops() {
         l.written,
         AnalogCommand {
             enable: false,
-            word: 0
+            word: 0,
+            ..AnalogCommand::default()
         }
     );
 }
@@ -442,6 +444,7 @@ fn simulated_drive_speed_loop_is_a_first_order_lag_with_a_limit() {
     d.exchange(&AnalogCommand {
         enable: true,
         word: 13824,
+        ..AnalogCommand::default()
     });
     // 50 % of 3000/min, after one time constant 63.2 % of it.
     d.advance(4 * MS);
@@ -455,6 +458,7 @@ fn simulated_drive_speed_loop_is_a_first_order_lag_with_a_limit() {
     d.exchange(&AnalogCommand {
         enable: true,
         word: OVERRANGE_WORD,
+        ..AnalogCommand::default()
     });
     d.advance(1000 * MS);
     assert!((d.speed() - 3300.0).abs() < 1e-6, "{}", d.speed());
@@ -481,6 +485,7 @@ fn simulated_drive_ready_delay_offset_and_fault_latch() {
     d.exchange(&AnalogCommand {
         enable: true,
         word: 0,
+        ..AnalogCommand::default()
     });
     d.advance(9 * MS);
     assert!(!d.feedback().ready, "ready 10 ms after the enable");

@@ -730,3 +730,100 @@ fn a_characteristic_curve_that_breaks_a_table_rule_is_refused() {
     let e = with_curve("", "hyd-curve-empty").unwrap_err().to_string();
     assert!(e.contains("at least 2 points"), "{e}");
 }
+
+/// The bundled cell with the axis' `valve_output` (and `bDrive_*` lines) and the valve's
+/// `valve_input`.
+fn valve_forms(axis: &str, valve: &str) -> Cell {
+    cell(&[
+        ("fLagAmp = 50.0", &format!("fLagAmp = 50.0\n{axis}")),
+        (
+            "load = 0.0 ",
+            &format!("valve_input = \"{valve}\"\nload = 0.0 "),
+        ),
+    ])
+}
+
+/// The drive stage's forms (MC_AxRtDrive_BkPlcMc) on a valve wired for each: the positioning
+/// out and back lands in the target window as with the ±10 V word, and the words and bits
+/// written are the form's: two coils one per direction, one coil around its centre, a current
+/// valve's magnitude with its direction bits.
+#[test]
+fn each_valve_output_form_positions_a_valve_wired_for_it() {
+    for (axis, valve) in [
+        ("valve_output = \"two_coil\"", "two_coil"),
+        ("valve_output = \"one_coil\"", "one_coil"),
+        ("bDrive_AbsoluteOutput = true", "current"),
+    ] {
+        let cell = valve_forms(axis, valve);
+        let mut r = Run::enabled(&cell);
+        for (target, positive) in [(350.0, true), (120.0, false)] {
+            r.move_to(target, 120.0);
+            r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
+            let c = r.exec.analog_drive(0).unwrap().latched;
+            match (valve, positive) {
+                ("two_coil", true) => assert!(c.word > 0 && c.word_b == 0, "{c:?}"),
+                ("two_coil", false) => assert!(c.word == 0 && c.word_b > 0, "{c:?}"),
+                ("one_coil", true) => assert!(c.word > 16384, "{c:?}"),
+                ("one_coil", false) => assert!((0..16384).contains(&c.word), "{c:?}"),
+                _ => assert!(c.word > 0, "{c:?}"),
+            }
+            assert_eq!((c.move_positive, c.move_negative), (positive, !positive));
+            r.run_move(8000);
+            let s = r.exec.status()[0];
+            assert!(
+                (s.actual_position - target).abs() < 0.2 && r.hyd().in_target,
+                "{valve}: at {} for {target}",
+                s.actual_position
+            );
+        }
+    }
+}
+
+/// A form that does not match the valve's wiring misbehaves in the simulator as on the
+/// machine: two coils on a ±10 V valve never retract it (its negative half reads the coil A
+/// word, 0); `bDrive_Reversed` on a plain valve drives it away from the target.
+#[test]
+fn a_valve_output_that_does_not_match_the_wiring_misbehaves_as_on_the_machine() {
+    let cell = valve_forms("valve_output = \"two_coil\"", "voltage");
+    let mut r = Run::enabled(&cell);
+    r.move_to(50.0, 120.0);
+    for _ in 0..1000 {
+        r.step();
+    }
+    assert!(r.exec.status()[0].actual_position > 99.0, "it retracted");
+    let cell = valve_forms("bDrive_Reversed = true", "voltage");
+    let mut r = Run::enabled(&cell);
+    r.move_to(350.0, 120.0);
+    for _ in 0..300 {
+        r.step();
+    }
+    assert!(
+        r.exec.status()[0].actual_position < 95.0,
+        "it did not run away"
+    );
+}
+
+#[test]
+fn bad_valve_output_settings_are_refused_naming_the_key() {
+    let src = source();
+    for (from, to, key) in [
+        (
+            "fLagAmp = 50.0",
+            "fLagAmp = 50.0\nvalve_output = \"two_coil\"\nbDrive_AbsoluteOutput = true",
+            "axes.ram.hydraulic.bDrive_AbsoluteOutput",
+        ),
+        (
+            "fLagAmp = 50.0",
+            "fLagAmp = 50.0\nvalve_output = \"current\"",
+            "axes.ram.hydraulic.valve_output",
+        ),
+        (
+            "load = 0.0 ",
+            "valve_input = \"three_coil\"\nload = 0.0 ",
+            "devices.ram_valve.valve_input",
+        ),
+    ] {
+        let e = tandem_config::parse("hydraulic.toml", &src.replacen(from, to, 1)).unwrap_err();
+        assert!(e.to_string().contains(key), "{to}: {e}");
+    }
+}

@@ -107,7 +107,8 @@ pub(super) fn devices(
                     return Err(at(k, Problem::NotForKind("sim_servo or sim_analog_drive")));
                 }
                 let params = super::hydraulic::valve_cylinder(d).map_err(|(k, p)| {
-                    if k == "ready_delay" || k == "load" {
+                    // The device's own keys; the rest are `[devices.<name>.cylinder]`'s.
+                    if ["ready_delay", "load", "pressure_range", "valve_input"].contains(&k) {
                         at(k, p)
                     } else {
                         cx.at_or_table(&["devices", name, "cylinder", k], p)

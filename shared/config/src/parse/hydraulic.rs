@@ -6,6 +6,7 @@ use super::FieldError;
 use crate::error::Problem;
 use crate::schema::{CylinderSection, DeviceSection, HydraulicSection};
 use tandem_motion::hydraulic::controller::{HydController, HydControllerParams};
+use tandem_motion::hydraulic::drive_output::{DriveOutputParams, ValveOutput};
 use tandem_motion::hydraulic::finish::{FinishError, FinishParams};
 use tandem_motion::hydraulic::generator::{
     Approach, CtrlBasedGenerator, GeneratorError, GeneratorParams,
@@ -26,9 +27,25 @@ const MONITOR_DEFAULTS: MonitorParams = MonitorParams {
     target_filter: 1.0,
 };
 
+/// The forms of `valve_output` (the axis; `bDrive_AbsoluteOutput` apart).
+const VALVE_OUTPUTS: [(&str, ValveOutput); 3] = [
+    ("voltage", ValveOutput::Voltage),
+    ("two_coil", ValveOutput::TwoCoil),
+    ("one_coil", ValveOutput::OneCoil),
+];
+
+/// The forms of `valve_input` (a `sim_valve_cylinder`'s amplifier; `current` is the voltage
+/// form as a magnitude with direction valves).
+const VALVE_INPUTS: [(&str, (ValveOutput, bool)); 4] = [
+    ("voltage", (ValveOutput::Voltage, false)),
+    ("two_coil", (ValveOutput::TwoCoil, false)),
+    ("one_coil", (ValveOutput::OneCoil, false)),
+    ("current", (ValveOutput::Voltage, true)),
+];
+
 /// The keys of `[axes.<name>.hydraulic]` the generator, the target window and the position
 /// controller with Finish check, as paths from the axis.
-const PROFILE_KEYS: [&str; 35] = [
+const PROFILE_KEYS: [&str; 37] = [
     "hydraulic.fRefVelo",
     "hydraulic.fMaxVelo",
     "hydraulic.fAcc",
@@ -64,6 +81,8 @@ const PROFILE_KEYS: [&str; 35] = [
     "hydraulic.fZeroCompensation",
     "hydraulic.Valve_LinLimitP",
     "hydraulic.Valve_LinLimitM",
+    "hydraulic.valve_output",
+    "hydraulic.bDrive_AbsoluteOutput",
 ];
 
 /// The path from the axis of the library's parameter `name`.
@@ -161,7 +180,16 @@ pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, Fi
     let g = GeneratorParams::default();
     let asymmetrical = h.bAsymmetricalTargeting.unwrap_or(d.asymmetrical);
     let creep_p = h.fCreepSpeedP.unwrap_or(g.approach_p.creep_speed);
+    let output = match &h.valve_output {
+        Some(v) => super::pick("valve_output", v, &VALVE_OUTPUTS)?,
+        None => ValveOutput::Voltage,
+    };
     let params = HydControllerParams {
+        drive: DriveOutputParams {
+            output,
+            absolute: h.bDrive_AbsoluteOutput.unwrap_or(false),
+            reversed: h.bDrive_Reversed.unwrap_or(false),
+        },
         lag_amp: h.fLagAmp.unwrap_or(HydControllerParams::default().lag_amp),
         lag_out_limit: h.fLagAmpOutL.unwrap_or(0.0),
         lag_amp_ti: h.fLagAmpTi.unwrap_or(0.0),
@@ -184,6 +212,12 @@ pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, Fi
         },
     };
     HydController::new(params, None).map_err(|e| match e {
+        FinishError::DriveOutput(_) => (
+            "bDrive_AbsoluteOutput",
+            Problem::Invalid(
+                "only with `valve_output = \"voltage\"`: a coil output carries its direction",
+            ),
+        ),
         FinishError::OutOfRange { parameter, .. } | FinishError::NotAbove { parameter, .. } => (
             parameter,
             Problem::Invalid("out of its range (ST_TcHydAxParam)"),
@@ -230,6 +264,17 @@ pub(super) fn valve_cylinder(d: &DeviceSection) -> Result<SimValveCylinderParams
         ready_delay: d.ready_delay.unwrap_or(0.01),
         load: d.load.unwrap_or(0.0),
         pressure_range: d.pressure_range.unwrap_or(250.0),
+        input: match &d.valve_input {
+            Some(v) => {
+                let (output, absolute) = super::pick("valve_input", v, &VALVE_INPUTS)?;
+                DriveOutputParams {
+                    output,
+                    absolute,
+                    reversed: false,
+                }
+            }
+            None => DriveOutputParams::default(),
+        },
     };
     p.check().map_err(|e| {
         let why = match e.name {

@@ -45,6 +45,9 @@ pub struct HydControllerParams {
     pub lag_amp_wul: f64,
     /// The Finish stage (`fRefVelo`, feed forward, area ratio, overlap, bend point, offset).
     pub finish: FinishParams,
+    /// The drive stage after Finish (the valve's output form, `bDrive_AbsoluteOutput`,
+    /// `bDrive_Reversed`); the drive connection applies it.
+    pub drive: super::drive_output::DriveOutputParams,
 }
 
 impl Default for HydControllerParams {
@@ -57,6 +60,7 @@ impl Default for HydControllerParams {
             lag_amp_dx: 0.0,
             lag_amp_wul: 0.0,
             finish: FinishParams::default(),
+            drive: super::drive_output::DriveOutputParams::default(),
         }
     }
 }
@@ -128,6 +132,7 @@ impl HydController {
                 });
             }
         }
+        params.drive.check().map_err(FinishError::DriveOutput)?;
         Ok(Self {
             finish: Finish::new(params.finish)?,
             params,

@@ -131,6 +131,8 @@ pub enum FinishError {
         /// `fValve_BendPointOutput`.
         output: f64,
     },
+    /// The drive stage's form and `bDrive_AbsoluteOutput` do not go together.
+    DriveOutput(super::drive_output::DriveOutputError),
 }
 
 impl FinishError {
@@ -166,6 +168,7 @@ impl core::fmt::Display for FinishError {
                 "bend point (fValve_BendPointVelo {velo}, fValve_BendPointOutput {output}): \
                  both 0 (no bend) or both above 0 and below 1"
             ),
+            Self::DriveOutput(e) => write!(f, "{e}"),
         }
     }
 }

@@ -16,6 +16,8 @@
 //!   table file format and checked;
 //! - [`controller`]: the position controller (`fLagAmp`, the I part) and Finish as one stage;
 //! - [`auto_zero`]: the automatic zero compensation `MC_AxCtrlAutoZero_BkPlcMc`;
+//! - [`drive_output`]: the drive stage `MC_AxRtDrive_BkPlcMc` (±10 V, two coils, one coil,
+//!   absolute output with direction bits, reversal);
 //! - [`pressure`]: the pressures and force from two inputs (`MC_AxRtReadForceDiff_BkPlcMc`) and
 //!   the pressure or force controller (`MC_AxCtrlPressure_BkPlcMc`);
 //! - [`autoident`]: the automatic identification `MC_AxUtiAutoIdent_BkPlcMc` (end of travel,
@@ -24,6 +26,7 @@
 pub mod auto_zero;
 pub mod autoident;
 pub mod controller;
+pub mod drive_output;
 pub mod finish;
 pub mod generator;
 pub mod monitor;

@@ -35,13 +35,11 @@ use super::drive::{Actual, Plant};
 use super::link::{AxisSignals, DriveInputs, DriveOutputs, DriveState};
 use super::mechanics::{RawCounter, Scaling, DEGREES_PER_REVOLUTION};
 use crate::hydraulic::controller::{HydControlInput, HydController};
+use crate::hydraulic::drive_output::ValveWords;
 use crate::hydraulic::pressure::{ActualForce, ForceScaling};
 
-/// The word of an S7 analog output at its nominal value: ±27648 is ±10 V, ±100 % of the
-/// reference speed (S7 analog value representation, output ranges ±10 V).
-pub const NOMINAL_WORD: i16 = 27648;
-/// The largest word an S7 analog output takes: 32511, the end of its overrange (11.759 V).
-pub const OVERRANGE_WORD: i16 = 32511;
+pub use super::analog_word::{output_word, word_to_normalized, NOMINAL_WORD, OVERRANGE_WORD};
+
 /// The voltage of [`NOMINAL_WORD`] (V).
 pub const NOMINAL_VOLTAGE: f64 = 10.0;
 /// The largest normalized command, `32511 / 27648` (about 117.6 %): the manual's "analog
@@ -63,24 +61,6 @@ pub const MAX_KPC_PERCENT: f64 = 150.0;
 /// The largest time constant accepted (s). Inferred: the manual gives no bound; a speed loop
 /// slower than this is no servo drive.
 pub const MAX_TIME_CONSTANT: f64 = 10.0;
-
-/// The word of an S7 analog output for normalized command `normalized` (1.0 = 100 % = 10 V):
-/// `round(normalized * 27648)`, saturated at ±[`OVERRANGE_WORD`]. NaN gives 0.
-#[doc(alias = "NSET")]
-pub fn output_word(normalized: f64) -> i16 {
-    if normalized.is_nan() {
-        return 0;
-    }
-    let w = (normalized * f64::from(NOMINAL_WORD)).round();
-    let max = f64::from(OVERRANGE_WORD);
-    // Within ±32511 after the clamp: the conversion is exact.
-    w.clamp(-max, max) as i16
-}
-
-/// The normalized command of an analog output word (the inverse of [`output_word`]).
-pub fn word_to_normalized(word: i16) -> f64 {
-    f64::from(word) / f64::from(NOMINAL_WORD)
-}
 
 /// What is wrong with a parameter of the analog connection or the simulated analog drive.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -545,9 +525,16 @@ impl AnalogEnable {
 pub struct AnalogCommand {
     /// The enable digital output.
     pub enable: bool,
-    /// The analog output word ([`output_word`]).
+    /// The analog output word ([`output_word`]); a hydraulic axis' valve output in the form of
+    /// its drive stage (coil A's current with two coils, [`crate::hydraulic::drive_output`]).
     #[doc(alias = "NSET")]
     pub word: i16,
+    /// A hydraulic axis with two coils: coil B's current word (0 otherwise).
+    pub word_b: i16,
+    /// A hydraulic axis: the control value is positive (`bMovePos`).
+    pub move_positive: bool,
+    /// A hydraulic axis: the control value is negative (`bMoveNeg`).
+    pub move_negative: bool,
 }
 
 /// What the node reads of an analog drive and its encoder: its process image inputs.
@@ -772,7 +759,14 @@ impl AnalogConnection {
             1.0
         };
         let normalized = sign * c.normalized;
-        let word = output_word(normalized);
+        let words = match &self.hydraulic {
+            Some(h) => h.params().drive.encode(normalized),
+            None => ValveWords {
+                word: output_word(normalized),
+                ..ValveWords::default()
+            },
+        };
+        let word = words.word;
         self.status = AnalogStatus {
             enable_do: self.enable_do,
             normalized,
@@ -784,6 +778,9 @@ impl AnalogConnection {
         AnalogCommand {
             enable: self.enable_do,
             word,
+            word_b: words.word_b,
+            move_positive: words.move_positive,
+            move_negative: words.move_negative,
         }
     }
 }

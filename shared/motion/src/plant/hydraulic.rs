@@ -30,9 +30,10 @@
 //! mm³/s inside. Integrated with [`SUBSTEPS`] semi-implicit Euler steps per call (the oil spring
 //! is stiff). Pure: no IO, no clock (the cycle time is an input), no allocation.
 
-use super::analog::{word_to_normalized, Amplifier, AnalogCommand, AnalogFeedback};
+use super::analog::{Amplifier, AnalogCommand, AnalogFeedback};
 use super::mechanics::Scaling;
 use crate::catalog::hyd_error::HydErrorCode;
+use crate::hydraulic::drive_output::ValveWords;
 /// Integration steps per [`SimCylinder::step`] call, at least (more when the call is long: no
 /// sub-step exceeds [`MAX_SUBSTEP`]).
 pub const SUBSTEPS: u32 = 20;
@@ -403,6 +404,10 @@ pub struct SimValveCylinderParams {
     /// The pressure sensors' range (bar at 10 V, the input word 27648; > 0): each chamber's
     /// pressure is read through a 16-bit analog input.
     pub pressure_range: f64,
+    /// How the amplifier takes its command: ±10 V (default), two coils, one coil, or a current
+    /// valve (the magnitude with direction valves: `absolute`). `reversed` must be false: a
+    /// valve's wiring has no reversal (the axis' `bDrive_Reversed` is the controller's).
+    pub input: crate::hydraulic::drive_output::DriveOutputParams,
 }
 
 /// A proportional valve with its amplifier on an analog output (enable DO and output word
@@ -418,6 +423,8 @@ pub struct SimValveCylinder {
     amplifier: Amplifier,
     /// The pressure inputs' words per bar.
     words_per_bar: f64,
+    /// How the amplifier takes its command.
+    input: crate::hydraulic::drive_output::DriveOutputParams,
 }
 
 impl SimValveCylinderParams {
@@ -434,10 +441,16 @@ impl SimValveCylinderParams {
                 self.pressure_range > 0.0,
             ),
         ];
-        match ok.into_iter().find(|(_, v, ok)| !(v.is_finite() && *ok)) {
-            Some((name, value, _)) => Err(CylinderError { name, value }),
-            None => Ok(()),
+        if let Some((name, value, _)) = ok.into_iter().find(|(_, v, ok)| !(v.is_finite() && *ok)) {
+            return Err(CylinderError { name, value });
         }
+        if self.input.reversed || self.input.check().is_err() {
+            return Err(CylinderError {
+                name: "valve_input",
+                value: f64::NAN,
+            });
+        }
+        Ok(())
     }
 }
 
@@ -452,6 +465,7 @@ impl SimValveCylinder {
             cylinder,
             scaling,
             amplifier: Amplifier::new(p.ready_delay),
+            input: p.input,
             words_per_bar: f64::from(super::analog::NOMINAL_WORD) / p.pressure_range,
         })
     }
@@ -465,7 +479,13 @@ impl SimValveCylinder {
     pub fn advance(&mut self, dt_ns: i64) {
         let dt = dt_ns.max(0) as f64 * 1e-9;
         let u = if self.amplifier.on() {
-            word_to_normalized(self.amplifier.command().word)
+            let c = self.amplifier.command();
+            self.input.decode(&ValveWords {
+                word: c.word,
+                word_b: c.word_b,
+                move_positive: c.move_positive,
+                move_negative: c.move_negative,
+            })
         } else {
             0.0
         };

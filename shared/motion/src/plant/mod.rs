@@ -5,6 +5,7 @@
 //! differential cylinder ([`hydraulic`]); and the timestamped edges of a mark sensor ([`sensor`]).
 
 pub mod analog;
+pub mod analog_word;
 pub mod cia402;
 pub mod drive;
 pub mod hydraulic;
