@@ -10,6 +10,7 @@ use crate::commands::{Done, Queued};
 use crate::logring::{DiagRecord, LogRing, Record, TextWriter};
 use crate::owns;
 use crate::ports::Ports;
+use crate::recorder::{Lost, RowPool, Wake};
 use crate::report::{cpu_time_ns, Report};
 use std::io::Write as _;
 use std::sync::mpsc::{Receiver, SyncSender};
@@ -25,19 +26,6 @@ use tandem_protocol::wire::{
 use tandem_rt as rt;
 use tandem_runtime::exec::{Applied, Describe, Executive, JobNote, SignalValue};
 
-/// A trace row: the cycle's time and the status of every owned axis.
-pub(crate) type Row = (i64, Vec<AxisStatus>);
-
-/// The rows the cyclic thread fills and the recorder thread writes, without allocating: a
-/// row comes from `free`, goes out on `full`, and comes back to `free` once written.
-#[derive(Debug)]
-pub(crate) struct RowPool {
-    /// Empty rows.
-    pub(crate) free: Receiver<Row>,
-    /// Filled rows, to the recorder.
-    pub(crate) full: SyncSender<Row>,
-}
-
 /// The cyclic thread's links to the node's other threads.
 #[derive(Debug)]
 pub(crate) struct Links {
@@ -51,9 +39,9 @@ pub(crate) struct Links {
     /// Trace rows, when a trace is written.
     pub(crate) rows: Option<RowPool>,
     /// What the recorder could not write to the disk (copied into the health).
-    pub(crate) lost: std::sync::Arc<crate::recorder::Lost>,
+    pub(crate) lost: std::sync::Arc<Lost>,
     /// Wakes the recorder before its channels fill (it sleeps its idle turns).
-    pub(crate) wake: crate::recorder::Wake,
+    pub(crate) wake: Wake,
 }
 
 /// Where the node's cycles lie on the cell clock.

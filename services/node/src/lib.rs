@@ -43,10 +43,11 @@ pub use error::NodeError;
 pub use report::{Histogram, Report, Stages};
 
 use commands::{command_thread, CommandLinks, Done, Queued};
-use cycle::{Clock, CycleParts, Links, NodeCycle, Row, RowPool};
+use cycle::{Clock, CycleParts, Links, NodeCycle};
 use logring::{Record, DIAG_RECORDS};
 use ports::{PortPlan, Ports};
 use recorder::{recorder_thread, Lost, RecorderPlan};
+use recorder::{Row, RowPool};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::sync_channel;

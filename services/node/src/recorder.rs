@@ -15,7 +15,6 @@
 //! returns; there is no backlog (rows that arrive while the disk is full are lost, not
 //! kept). Losing and resuming are each a `warn` event with the counts.
 
-use crate::cycle::Row;
 use crate::logring::{DiagRecord, Record, DIAG_RECORDS};
 use crate::retain::Retainer;
 use std::fs::File;
@@ -26,11 +25,25 @@ use std::sync::mpsc::{Receiver, SyncSender};
 use std::sync::Arc;
 use std::time::Duration;
 use tandem_config::Cell;
+use tandem_motion::objects::axis::AxisStatus;
 use tandem_protocol::json::error_id_text;
 use tandem_protocol::wire::{NodeHealth, EVENT_LOG, JOB_ERROR};
 use tandem_runtime::exec::Secs;
 use tandem_runtime::sim::AXIS_COLUMNS;
 use tracing::{debug, info, warn};
+
+/// A trace row: the cycle's time and the status of every owned axis.
+pub(crate) type Row = (i64, Vec<AxisStatus>);
+
+/// The rows the cyclic thread fills and the recorder thread writes, without allocating: a
+/// row comes from `free`, goes out on `full`, and comes back to `free` once written.
+#[derive(Debug)]
+pub(crate) struct RowPool {
+    /// Empty rows.
+    pub(crate) free: Receiver<Row>,
+    /// Filled rows, to the recorder.
+    pub(crate) full: SyncSender<Row>,
+}
 
 /// What the recorder writes and where its records come from.
 #[derive(Debug)]

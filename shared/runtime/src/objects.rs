@@ -3,6 +3,7 @@
 
 use crate::error::ExecError;
 use crate::notes::{keep, seconds, Describe, IoNote, Secs, NOTES};
+use crate::outputs::ObjectEdge;
 use std::io::{self, Write};
 use tandem_config::{AxisIndex, CamTrackEntry, Cell, MeasuringInputEntry, OutputCamEntry};
 use tandem_motion::catalog::alarm::AlarmInstance;
@@ -171,16 +172,6 @@ pub(crate) struct SimInput {
     edges: InputEdges,
     job: Option<JobId>,
     logged: (u32, i64, u32, i64, bool),
-}
-
-/// An output edge of an output cam or cam track, for the output stage
-/// ([`crate::outputs`]).
-#[derive(Copy, Clone, Debug)]
-pub(crate) struct ObjectEdge {
-    /// The object, numbered as [`IoNote::object`] (output cams, then cam tracks).
-    pub(crate) object: usize,
-    /// The edge, with its exact time.
-    pub(crate) edge: tandem_motion::objects::output_cam::Edge,
 }
 
 /// What the objects' steps produce besides the log, shared by all objects of a step.

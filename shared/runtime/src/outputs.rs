@@ -50,7 +50,6 @@
 //! Every switch is recorded ([`OutputSwitch`]) with the instant the channel changed, for tests
 //! and traces. Nothing here allocates after [`Outputs::new`].
 
-use crate::objects::ObjectEdge;
 use tandem_config::{Cell, DeviceKind, SignalIndex};
 use tandem_motion::objects::output_cam::{
     OutputCamParameters, PositionType, SwitchingAhead, EDGE_CAPACITY,
@@ -275,6 +274,15 @@ const ETHERCAT_DIO_OUTPUTS: tandem_config::DigitalOutputParams =
         channels: 8,
         timestamped: false,
     };
+
+/// An output edge of an output cam or cam track, for the output stage.
+#[derive(Copy, Clone, Debug)]
+pub(crate) struct ObjectEdge {
+    /// The object, numbered as [`crate::notes::IoNote::object`] (output cams, then cam tracks).
+    pub(crate) object: usize,
+    /// The edge, with its exact time.
+    pub(crate) edge: tandem_motion::objects::output_cam::Edge,
+}
 
 /// The look-ahead of an output cam or cam track on `position_type` that drives `output`: `Λ`
 /// of the node of the output's device (see the module documentation), or `None` when it

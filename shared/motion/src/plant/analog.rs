@@ -825,8 +825,14 @@ pub enum AnalogConnectionError {
     Timeout(InvalidReadyTimeout),
     /// A hydraulic axis' position controller or Finish parameter.
     Hydraulic(crate::hydraulic::finish::FinishError),
-    /// A simulated valve and cylinder's parameter.
-    Cylinder(crate::plant::hydraulic::CylinderError),
+    /// A simulated valve and cylinder's parameter out of its range (`CylinderError` of
+    /// `plant::hydraulic`, which builds on this module: its name and value).
+    Cylinder {
+        /// The parameter's name.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
     /// The scaling of a hydraulic axis' pressure inputs.
     Pressure(crate::hydraulic::pressure::PressureError),
 }
@@ -837,7 +843,10 @@ impl fmt::Display for AnalogConnectionError {
             Self::Params(e) => write!(f, "{e}"),
             Self::Timeout(e) => write!(f, "analog drive: {e}"),
             Self::Hydraulic(e) => write!(f, "hydraulic axis: {e}"),
-            Self::Cylinder(e) => write!(f, "valve and cylinder: {e}"),
+            Self::Cylinder { name, value } => write!(
+                f,
+                "valve and cylinder: cylinder parameter `{name}` = {value} is out of its range"
+            ),
             Self::Pressure(e) => write!(f, "pressure inputs: {e}"),
         }
     }
