@@ -15,12 +15,12 @@ impl Axis {
     /// setpoint for `now_ns`; the simulated drive then moves the plant to the next cycle.
     pub fn step(&mut self, now_ns: i64) {
         self.now = now_ns;
-        let inputs = match &mut self.link {
-            DriveLink::Simulation(plant) => plant.sample(),
-            DriveLink::Connected { inputs, .. } => *inputs,
+        let (inputs, connected) = match &mut self.link {
+            DriveLink::Simulation(plant) => (plant.sample(), false),
+            DriveLink::Connected { inputs, .. } => (*inputs, true),
         };
         self.signals = inputs.signals;
-        if matches!(self.link, DriveLink::Connected { .. }) {
+        if connected {
             self.in_limitation = inputs.in_limitation;
             self.drive_state(inputs.state);
         }
@@ -53,7 +53,9 @@ impl Axis {
         self.forget_status();
     }
 
-    /// The drive outputs of this cycle: the total setpoint in physical coordinates.
+    /// The drive outputs of this cycle: the total setpoint in physical coordinates. (Inlined:
+    /// built in place where the step hands them to the drive, not returned through memory.)
+    #[inline]
     pub(super) fn outputs(&self) -> DriveOutputs {
         let tot = self.total();
         DriveOutputs {
@@ -82,7 +84,8 @@ impl Axis {
             _ => None,
         };
         let hc = &self.cfg.homing;
-        if let Some(h) = self.main.as_ref().and_then(|m| m.homing) {
+        // (Looked at in place: the job's homing state is not copied out.)
+        if let Some(h) = self.main.as_ref().and_then(|m| m.homing.as_ref()) {
             let heading = sign(self.total().v) == hc.homing_direction.sign();
             return latch(h.phase, hc.active_mark)
                 .filter(|l| *l == HomingLatch::ZeroMark || heading);
