@@ -528,7 +528,6 @@ impl Axis {
     }
 
     fn update_jobs(&mut self) {
-        let finished = self.main_motion_finished();
         let sup_done = self
             .sup_job
             .as_ref()
@@ -539,6 +538,12 @@ impl Axis {
             self.sup_job = None;
             self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Done);
         }
+        // Without a basic motion job and a disabling, nothing below applies: the profile's end
+        // (a cache line of its own, which a follower's cycle need not touch) is not looked at.
+        if self.main.is_none() && !self.power.disabling {
+            return;
+        }
+        let finished = self.main_motion_finished();
         if self.power.disabling && finished {
             self.remove_enable();
             return;
