@@ -785,54 +785,40 @@ impl Axis {
         (ew, ww, detail)
     }
 
-    /// The StatusWord bits of the enable, the alarms and the running jobs.
+    /// The StatusWord bits of the enable, the alarms and the running jobs. (The running job's
+    /// instruction and the synchronous phase are each matched once, not compared per bit.)
     fn job_status_bits(&self, main: Option<Instruction>, detail: &ErrorDetail) -> u32 {
-        let sync_phase = self.sync.as_ref().map(|j| j.phase);
-        bit(status_bit::ENABLE, self.enabled)
+        use super::sync::SyncPhase;
+        let main_bits = match main {
+            Some(
+                Instruction::MoveAbsolute | Instruction::MoveRelative | Instruction::MoveAdditive,
+            ) => status_bit::POSITIONING_COMMAND,
+            Some(Instruction::MoveJog) => status_bit::JOG_COMMAND,
+            Some(Instruction::MoveVelocity) => status_bit::VELOCITY_COMMAND,
+            Some(Instruction::Home) => status_bit::HOMING_COMMAND,
+            Some(Instruction::MotionInPosition | Instruction::MotionInVelocity) => {
+                status_bit::MOTION_IN_COMMAND
+            }
+            _ => 0,
+        };
+        let sync_bits = match self.sync.as_ref().map(|j| j.phase) {
+            Some(SyncPhase::Synchronizing) => status_bit::SYNCHRONIZING,
+            Some(SyncPhase::Synchronous) => status_bit::SYNCHRONOUS,
+            _ => 0,
+        };
+        main_bits
+            | sync_bits
+            | bit(status_bit::ENABLE, self.enabled)
             | bit(status_bit::ERROR, detail.number != 0)
             | bit(status_bit::HOMING_DONE, self.homed)
             | bit(
                 status_bit::DONE,
                 self.main.is_none() && self.sup_job.is_none() && self.sync.is_none(),
             )
-            | bit(
-                status_bit::POSITIONING_COMMAND,
-                matches!(
-                    main,
-                    Some(
-                        Instruction::MoveAbsolute
-                            | Instruction::MoveRelative
-                            | Instruction::MoveAdditive
-                    )
-                ),
-            )
-            | bit(status_bit::JOG_COMMAND, main == Some(Instruction::MoveJog))
-            | bit(
-                status_bit::VELOCITY_COMMAND,
-                main == Some(Instruction::MoveVelocity),
-            )
-            | bit(
-                status_bit::HOMING_COMMAND,
-                main == Some(Instruction::Home) || self.passive.is_some(),
-            )
+            | bit(status_bit::HOMING_COMMAND, self.passive.is_some())
             | bit(
                 status_bit::SUPERIMPOSED_MOTION_COMMAND,
                 self.sup_job.is_some(),
-            )
-            | bit(
-                status_bit::MOTION_IN_COMMAND,
-                matches!(
-                    main,
-                    Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
-                ),
-            )
-            | bit(
-                status_bit::SYNCHRONIZING,
-                sync_phase == Some(super::sync::SyncPhase::Synchronizing),
-            )
-            | bit(
-                status_bit::SYNCHRONOUS,
-                sync_phase == Some(super::sync::SyncPhase::Synchronous),
             )
             | bit(status_bit::PHASING_COMMAND, self.phasing.is_some())
     }
@@ -844,26 +830,28 @@ impl Axis {
             .standstill_since
             .map(|t| self.now - t >= (self.cfg.standstill.min_dwell_time * 1e9).round() as i64)
             .unwrap_or(false);
-        let hw = self.hw_trigger.map(|(s, _)| s);
-        bit(
-            status_bit::STANDSTILL,
-            standstill && self.cfg.kind != AxisKind::Speed,
-        ) | bit(status_bit::CONSTANT_VELOCITY, tot.a == 0.0)
+        let sw_limit = match self.sw_active {
+            Some(Sense::Negative) => status_bit::SW_LIMIT_MIN_ACTIVE,
+            Some(Sense::Positive) => status_bit::SW_LIMIT_MAX_ACTIVE,
+            None => 0,
+        };
+        let hw_limit = match self.hw_trigger {
+            Some((Sense::Negative, _)) => status_bit::HW_LIMIT_MIN_ACTIVE,
+            Some((Sense::Positive, _)) => status_bit::HW_LIMIT_MAX_ACTIVE,
+            None => 0,
+        };
+        sw_limit
+            | hw_limit
+            | bit(
+                status_bit::STANDSTILL,
+                standstill && self.cfg.kind != AxisKind::Speed,
+            )
+            | bit(status_bit::CONSTANT_VELOCITY, tot.a == 0.0)
             | bit(
                 status_bit::ACCELERATING,
                 tot.a != 0.0 && tot.a * tot.v >= 0.0,
             )
             | bit(status_bit::DECELERATING, tot.a * tot.v < 0.0)
-            | bit(
-                status_bit::SW_LIMIT_MIN_ACTIVE,
-                self.sw_active == Some(Sense::Negative),
-            )
-            | bit(
-                status_bit::SW_LIMIT_MAX_ACTIVE,
-                self.sw_active == Some(Sense::Positive),
-            )
-            | bit(status_bit::HW_LIMIT_MIN_ACTIVE, hw == Some(Sense::Negative))
-            | bit(status_bit::HW_LIMIT_MAX_ACTIVE, hw == Some(Sense::Positive))
             | bit(status_bit::AXIS_SIMULATION, self.cfg.virtual_axis)
             | bit(
                 status_bit::NON_POSITION_CONTROLLED,
