@@ -1406,15 +1406,18 @@ impl<'c> Executive<'c> {
     /// [`Executive::step_axes`]).
     fn axis_events(&mut self, t: i64, log: &mut impl Write) -> io::Result<()> {
         let cell = self.cell;
-        for (i, axis) in self.axes.iter_mut().enumerate() {
-            if !self.owned.axes[i] {
-                continue;
+        let mut from = 0;
+        // Without job events nor a pending alarm since the last step, nor alarms seen then,
+        // there is nothing to log: only the owned axes with news are looked at, found by a
+        // tight scan of the two flag arrays.
+        while let Some(i) = next_news(&self.news, &self.owned.axes, from) {
+            from = i + 1;
+            if let Some(news) = self.news.get_mut(i) {
+                *news = false;
             }
-            // Without job events nor a pending alarm since the last step, nor alarms seen then,
-            // there is nothing to log (and the axis is not looked at).
-            if !std::mem::take(&mut self.news[i]) {
+            let Some(axis) = self.axes.get_mut(i) else {
                 continue;
-            }
+            };
             while let Some(ev) = axis.pop_event() {
                 let name = &cell.axes[i].name;
                 job_event(&mut self.jobs, &mut self.notes_dropped, log, name, i, ev)?;
@@ -1564,4 +1567,14 @@ impl<'c> Executive<'c> {
             let _ = b.samples.push(s);
         }
     }
+}
+
+/// The first axis from `from` on that is owned and has news (job events, a pending alarm or
+/// alarms seen last step), in index order.
+fn next_news(news: &[bool], owned: &[bool], from: usize) -> Option<usize> {
+    let (news, owned) = (news.get(from..)?, owned.get(from..)?);
+    news.iter()
+        .zip(owned)
+        .position(|(n, o)| *n && *o)
+        .map(|k| from + k)
 }

@@ -529,7 +529,9 @@ impl Axis {
 
     /// Whether the alarm `id` is pending.
     pub fn has_alarm(&self, id: AlarmId) -> bool {
-        self.alarms().any(|a| a.id == id)
+        // `alarm_pending` is kept with the slots: without it no slot need be scanned (the
+        // software limits ask every cycle).
+        self.alarm_pending && self.alarms().any(|a| a.id == id)
     }
 
     /// This axis as a leader with setpoint coupling: its total setpoint (continuous position).

@@ -15,12 +15,12 @@ impl Axis {
     /// setpoint for `now_ns`; the simulated drive then moves the plant to the next cycle.
     pub fn step(&mut self, now_ns: i64) {
         self.now = now_ns;
-        let inputs = match &mut self.link {
-            DriveLink::Simulation(plant) => plant.sample(),
-            DriveLink::Connected { inputs, .. } => *inputs,
+        let (inputs, connected) = match &mut self.link {
+            DriveLink::Simulation(plant) => (plant.sample(), false),
+            DriveLink::Connected { inputs, .. } => (*inputs, true),
         };
         self.signals = inputs.signals;
-        if matches!(self.link, DriveLink::Connected { .. }) {
+        if connected {
             self.in_limitation = inputs.in_limitation;
             self.drive_state(inputs.state);
         }
@@ -54,7 +54,9 @@ impl Axis {
         self.forget_status();
     }
 
-    /// The drive outputs of this cycle: the total setpoint in physical coordinates.
+    /// The drive outputs of this cycle: the total setpoint in physical coordinates. (Inlined:
+    /// built in place where the step hands them to the drive, not returned through memory.)
+    #[inline]
     pub(super) fn outputs(&self) -> DriveOutputs {
         let tot = self.total();
         DriveOutputs {
@@ -84,7 +86,8 @@ impl Axis {
             _ => None,
         };
         let hc = &self.cfg.homing;
-        if let Some(h) = self.main.as_ref().and_then(|m| m.homing) {
+        // (Looked at in place: the job's homing state is not copied out.)
+        if let Some(h) = self.main.as_ref().and_then(|m| m.homing.as_ref()) {
             let heading = sign(self.total().v) == hc.homing_direction.sign();
             return latch(h.phase, hc.active_mark)
                 .filter(|l| *l == HomingLatch::ZeroMark || heading);
@@ -527,7 +530,6 @@ impl Axis {
     }
 
     fn update_jobs(&mut self) {
-        let finished = self.main_motion_finished();
         let sup_done = self
             .sup_job
             .as_ref()
@@ -538,6 +540,12 @@ impl Axis {
             self.sup_job = None;
             self.emit(id, Instruction::MoveSuperimposed, JobEventKind::Done);
         }
+        // Without a basic motion job and a disabling, nothing below applies: the profile's end
+        // (a cache line of its own, which a follower's cycle need not touch) is not looked at.
+        if self.main.is_none() && !self.power.disabling {
+            return;
+        }
+        let finished = self.main_motion_finished();
         if self.power.disabling && finished {
             self.remove_enable();
             return;
@@ -782,54 +790,40 @@ impl Axis {
         (ew, ww, detail)
     }
 
-    /// The StatusWord bits of the enable, the alarms and the running jobs.
+    /// The StatusWord bits of the enable, the alarms and the running jobs. (The running job's
+    /// instruction and the synchronous phase are each matched once, not compared per bit.)
     fn job_status_bits(&self, main: Option<Instruction>, detail: &ErrorDetail) -> u32 {
-        let sync_phase = self.sync.as_ref().map(|j| j.phase);
-        bit(status_bit::ENABLE, self.enabled)
+        use super::sync::SyncPhase;
+        let main_bits = match main {
+            Some(
+                Instruction::MoveAbsolute | Instruction::MoveRelative | Instruction::MoveAdditive,
+            ) => status_bit::POSITIONING_COMMAND,
+            Some(Instruction::MoveJog) => status_bit::JOG_COMMAND,
+            Some(Instruction::MoveVelocity) => status_bit::VELOCITY_COMMAND,
+            Some(Instruction::Home) => status_bit::HOMING_COMMAND,
+            Some(Instruction::MotionInPosition | Instruction::MotionInVelocity) => {
+                status_bit::MOTION_IN_COMMAND
+            }
+            _ => 0,
+        };
+        let sync_bits = match self.sync.as_ref().map(|j| j.phase) {
+            Some(SyncPhase::Synchronizing) => status_bit::SYNCHRONIZING,
+            Some(SyncPhase::Synchronous) => status_bit::SYNCHRONOUS,
+            _ => 0,
+        };
+        main_bits
+            | sync_bits
+            | bit(status_bit::ENABLE, self.enabled)
             | bit(status_bit::ERROR, detail.number != 0)
             | bit(status_bit::HOMING_DONE, self.homed)
             | bit(
                 status_bit::DONE,
                 self.main.is_none() && self.sup_job.is_none() && self.sync.is_none(),
             )
-            | bit(
-                status_bit::POSITIONING_COMMAND,
-                matches!(
-                    main,
-                    Some(
-                        Instruction::MoveAbsolute
-                            | Instruction::MoveRelative
-                            | Instruction::MoveAdditive
-                    )
-                ),
-            )
-            | bit(status_bit::JOG_COMMAND, main == Some(Instruction::MoveJog))
-            | bit(
-                status_bit::VELOCITY_COMMAND,
-                main == Some(Instruction::MoveVelocity),
-            )
-            | bit(
-                status_bit::HOMING_COMMAND,
-                main == Some(Instruction::Home) || self.passive.is_some(),
-            )
+            | bit(status_bit::HOMING_COMMAND, self.passive.is_some())
             | bit(
                 status_bit::SUPERIMPOSED_MOTION_COMMAND,
                 self.sup_job.is_some(),
-            )
-            | bit(
-                status_bit::MOTION_IN_COMMAND,
-                matches!(
-                    main,
-                    Some(Instruction::MotionInPosition | Instruction::MotionInVelocity)
-                ),
-            )
-            | bit(
-                status_bit::SYNCHRONIZING,
-                sync_phase == Some(super::sync::SyncPhase::Synchronizing),
-            )
-            | bit(
-                status_bit::SYNCHRONOUS,
-                sync_phase == Some(super::sync::SyncPhase::Synchronous),
             )
             | bit(status_bit::PHASING_COMMAND, self.phasing.is_some())
     }
@@ -841,26 +835,28 @@ impl Axis {
             .standstill_since
             .map(|t| self.now - t >= (self.cfg.standstill.min_dwell_time * 1e9).round() as i64)
             .unwrap_or(false);
-        let hw = self.hw_trigger.map(|(s, _)| s);
-        bit(
-            status_bit::STANDSTILL,
-            standstill && self.cfg.kind != AxisKind::Speed,
-        ) | bit(status_bit::CONSTANT_VELOCITY, tot.a == 0.0)
+        let sw_limit = match self.sw_active {
+            Some(Sense::Negative) => status_bit::SW_LIMIT_MIN_ACTIVE,
+            Some(Sense::Positive) => status_bit::SW_LIMIT_MAX_ACTIVE,
+            None => 0,
+        };
+        let hw_limit = match self.hw_trigger {
+            Some((Sense::Negative, _)) => status_bit::HW_LIMIT_MIN_ACTIVE,
+            Some((Sense::Positive, _)) => status_bit::HW_LIMIT_MAX_ACTIVE,
+            None => 0,
+        };
+        sw_limit
+            | hw_limit
+            | bit(
+                status_bit::STANDSTILL,
+                standstill && self.cfg.kind != AxisKind::Speed,
+            )
+            | bit(status_bit::CONSTANT_VELOCITY, tot.a == 0.0)
             | bit(
                 status_bit::ACCELERATING,
                 tot.a != 0.0 && tot.a * tot.v >= 0.0,
             )
             | bit(status_bit::DECELERATING, tot.a * tot.v < 0.0)
-            | bit(
-                status_bit::SW_LIMIT_MIN_ACTIVE,
-                self.sw_active == Some(Sense::Negative),
-            )
-            | bit(
-                status_bit::SW_LIMIT_MAX_ACTIVE,
-                self.sw_active == Some(Sense::Positive),
-            )
-            | bit(status_bit::HW_LIMIT_MIN_ACTIVE, hw == Some(Sense::Negative))
-            | bit(status_bit::HW_LIMIT_MAX_ACTIVE, hw == Some(Sense::Positive))
             | bit(status_bit::AXIS_SIMULATION, self.cfg.virtual_axis)
             | bit(
                 status_bit::NON_POSITION_CONTROLLED,
