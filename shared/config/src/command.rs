@@ -188,6 +188,34 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("filter", Some(Value::Num(0.1))),
         ],
     },
+    // The Beckhoff hydraulic library's stops (a hydraulic axis): `execute = false` releases the
+    // lock of MC_EmergencyStop_BkPlcMc / MC_ImmediateStop_BkPlcMc; ramp_time 0: the
+    // parameter's ramp.
+    InstructionSpec {
+        name: "MC_EmergencyStop_BkPlcMc",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("ramp_time", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_ImmediateStop_BkPlcMc",
+        params: &[("execute", Some(Value::Bool(true)))],
+    },
+    InstructionSpec {
+        name: "MC_RampedStop_BkPlcMc",
+        params: &[("ramp_time", Some(Value::Num(0.0)))],
+    },
+    // The Beckhoff hydraulic library's MC_SetPosition (mode TRUE: relative) and
+    // MC_SetReferenceFlag.
+    InstructionSpec {
+        name: "MC_SetPosition_BkPlcMc",
+        params: &[("position", None), ("mode", Some(Value::Bool(false)))],
+    },
+    InstructionSpec {
+        name: "MC_SetReferenceFlag_BkPlcMc",
+        params: &[("reference_flag", Some(Value::Bool(true)))],
+    },
     InstructionSpec {
         name: "MC_MotionInPosition",
         params: &[
@@ -980,6 +1008,23 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
                 filter: a.num("filter")?,
             },
         },
+        "MC_EmergencyStop_BkPlcMc" => Command::EmergencyStop {
+            execute: a.flag("execute")?,
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_ImmediateStop_BkPlcMc" => Command::ImmediateStop {
+            execute: a.flag("execute")?,
+        },
+        "MC_RampedStop_BkPlcMc" => Command::RampedStop {
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
+            position: a.num("position")?,
+            relative: a.flag("mode")?,
+        },
+        "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
+            reference_flag: a.flag("reference_flag")?,
+        },
         "MC_MotionInPosition" => Command::MotionInPosition {
             enable: a.flag("enable")?,
             position: a.num("position")?,
@@ -1015,6 +1060,53 @@ mod tests {
             assert_eq!(find(n).map(|s| s.name), Some("MC_MoveAbsolute"));
         }
         assert!(find("MC_Fly").is_none());
+    }
+
+    #[test]
+    fn the_library_stops_and_set_position_take_their_inputs() {
+        let c = parse("MC_EmergencyStop_BkPlcMc", &[], Refs::default()).unwrap();
+        assert_eq!(
+            c,
+            Command::EmergencyStop {
+                execute: true,
+                ramp_time: 0.0
+            }
+        );
+        let c = parse(
+            "MC_ImmediateStop_BkPlcMc",
+            &[p("execute", Value::Bool(false))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(c, Command::ImmediateStop { execute: false });
+        let c = parse(
+            "MC_RampedStop_BkPlcMc",
+            &[p("ramp_time", Value::Num(1.5))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(c, Command::RampedStop { ramp_time: 1.5 });
+        let c = parse(
+            "MC_SetPosition_BkPlcMc",
+            &[p("position", Value::Num(5.0)), p("mode", Value::Bool(true))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::HydSetPosition {
+                position: 5.0,
+                relative: true
+            }
+        );
+        assert!(parse("MC_SetPosition_BkPlcMc", &[], Refs::default()).is_err());
+        let c = parse("MC_SetReferenceFlag_BkPlcMc", &[], Refs::default()).unwrap();
+        assert_eq!(
+            c,
+            Command::SetReferenceFlag {
+                reference_flag: true
+            }
+        );
     }
 
     #[test]

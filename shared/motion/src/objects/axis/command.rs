@@ -469,6 +469,47 @@ pub enum Command {
         /// `EnableOnMoving`, `OffsetLimit`, `Tn`, `Threshold`, `Filter`.
         params: crate::hydraulic::auto_zero::AutoZeroParams,
     },
+    /// `MC_EmergencyStop_BkPlcMc` (Beckhoff TwinCAT PLC Hydraulic Positioning library, from
+    /// V3.0.5): the set velocity ramps to 0 on the generator (`RampTime` from `fRefVelo`, else
+    /// `fEmergencyRamp`); once it is 0 the valve output is suppressed while `execute` stays
+    /// TRUE (`bLocked_Estop`). Re-sent with `execute = false` to release the lock.
+    #[doc(alias = "MC_EmergencyStop_BkPlcMc")]
+    EmergencyStop {
+        /// `Execute` (TRUE: stop and lock; FALSE: release).
+        execute: bool,
+        /// `RampTime` (s from `fRefVelo` to 0; not above 0: `fEmergencyRamp`).
+        ramp_time: f64,
+    },
+    /// `MC_ImmediateStop_BkPlcMc` (Beckhoff hydraulic library, from V3.0.5): the control value
+    /// is 0 at once, no ramp; the valve output is suppressed while `execute` stays TRUE.
+    #[doc(alias = "MC_ImmediateStop_BkPlcMc")]
+    ImmediateStop {
+        /// `Execute` (TRUE: stop and lock; FALSE: release).
+        execute: bool,
+    },
+    /// `MC_RampedStop_BkPlcMc` (Beckhoff hydraulic library): a pure time ramp of the set
+    /// velocity to 0, with no defined end position (it may overrun a software limit).
+    #[doc(alias = "MC_RampedStop_BkPlcMc")]
+    RampedStop {
+        /// `RampTime` (s from `fRefVelo` to 0; not above 0: `fStopRamp`).
+        ramp_time: f64,
+    },
+    /// `MC_SetPosition_BkPlcMc` (Beckhoff hydraulic library): sets the actual position, also
+    /// during a motion (the set position, the target and the target window move with it).
+    #[doc(alias = "MC_SetPosition_BkPlcMc")]
+    HydSetPosition {
+        /// `Position` (mm): the new actual position, or the shift with `relative`.
+        position: f64,
+        /// `Mode`: TRUE shifts the actual position by `position`, FALSE sets it.
+        relative: bool,
+    },
+    /// `MC_SetReferenceFlag_BkPlcMc` (Beckhoff hydraulic library): sets or clears the axis'
+    /// homed status (`dwTcHydNsDwReferenced`).
+    #[doc(alias = "MC_SetReferenceFlag_BkPlcMc")]
+    SetReferenceFlag {
+        /// `ReferenceFlag`.
+        reference_flag: bool,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

@@ -10,6 +10,7 @@ mod adjustment;
 mod buffer;
 mod command;
 mod config;
+mod hyd_commands;
 mod hydraulic;
 mod step;
 mod sync;
@@ -931,7 +932,7 @@ impl Axis {
         if self.stopping_alarm_pending() {
             return Err(ErrorId::JobRejectedInErrorStop);
         }
-        if self.stop_lock {
+        if self.stop_lock || self.hyd_locked() {
             return Err(ErrorId::AxisLocked);
         }
         Ok(())
@@ -1089,6 +1090,11 @@ impl Axis {
                 },
             ),
             Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
+            Command::EmergencyStop { .. }
+            | Command::ImmediateStop { .. }
+            | Command::RampedStop { .. }
+            | Command::HydSetPosition { .. }
+            | Command::SetReferenceFlag { .. } => self.apply_hyd_command(cmd),
             Command::MotionInPosition {
                 enable,
                 position,
