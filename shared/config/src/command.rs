@@ -206,6 +206,13 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         name: "MC_RampedStop_BkPlcMc",
         params: &[("ramp_time", Some(Value::Num(0.0)))],
     },
+    InstructionSpec {
+        name: "MC_ResetAndStop_BkPlcMc",
+        params: &[
+            ("deceleration", Some(Value::Num(0.0))),
+            ("ramp_time", Some(Value::Num(0.0))),
+        ],
+    },
     // The Beckhoff hydraulic library's MC_SetPosition (mode TRUE: relative) and
     // MC_SetReferenceFlag.
     InstructionSpec {
@@ -1018,6 +1025,10 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
         "MC_RampedStop_BkPlcMc" => Command::RampedStop {
             ramp_time: a.num("ramp_time")?,
         },
+        "MC_ResetAndStop_BkPlcMc" => Command::ResetAndStop {
+            deceleration: a.num("deceleration")?,
+            ramp_time: a.num("ramp_time")?,
+        },
         "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
             position: a.num("position")?,
             relative: a.flag("mode")?,
@@ -1100,6 +1111,19 @@ mod tests {
             }
         );
         assert!(parse("MC_SetPosition_BkPlcMc", &[], Refs::default()).is_err());
+        let c = parse(
+            "MC_ResetAndStop_BkPlcMc",
+            &[p("deceleration", Value::Num(100.0))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::ResetAndStop {
+                deceleration: 100.0,
+                ramp_time: 0.0
+            }
+        );
         let c = parse("MC_SetReferenceFlag_BkPlcMc", &[], Refs::default()).unwrap();
         assert_eq!(
             c,

@@ -314,6 +314,10 @@ fn refusals_of_the_library_instructions() {
         Command::SetReferenceFlag {
             reference_flag: true,
         },
+        Command::ResetAndStop {
+            deceleration: 0.0,
+            ramp_time: 0.0,
+        },
     ] {
         let out = exec
             .apply_at(0, 0, "slide", "test", Action::Command(c), &mut log)
@@ -386,4 +390,39 @@ fn set_reference_flag_sets_and_clears_homed() {
     r.move_to(60.0, 100.0).unwrap();
     r.until(8000, "landed", |r| r.job().is_none());
     assert!((r.status().actual_position - 60.0).abs() < 0.2);
+}
+
+/// MC_ResetAndStop_BkPlcMc during a move: the set velocity ramps down with `Deceleration`
+/// (100 mm/s²: 0.1 mm/s a cycle), the axis is Stopping and refuses a move (16#80F0) until the
+/// job is Done at rest; then Standstill and a move runs. With `RampTime` only, fRefVelo /
+/// RampTime; on a standing axis it is Done at once.
+#[test]
+fn reset_and_stop_stops_with_its_deceleration_and_is_done_at_rest() {
+    let cell = cell("hydraulic.toml");
+    for (deceleration, ramp_time, per_cycle) in [(100.0, 0.0, 0.1), (0.0, 4.0, REF_VELO / 4e3)] {
+        let mut r = Run::travelling(&cell);
+        r.cmd(Command::ResetAndStop {
+            deceleration,
+            ramp_time,
+        });
+        assert_eq!(r.job(), Some(Instruction::ResetAndStop));
+        r.step();
+        assert_eq!(r.state(), AxisState::Stopping);
+        assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
+        let steps = r.ramp_down(5000);
+        for d in &steps[..steps.len() - 1] {
+            assert!((d - per_cycle).abs() < 1e-9, "{d} per cycle");
+        }
+        r.step();
+        assert_eq!(r.job(), None);
+        assert_eq!(r.state(), AxisState::Standstill);
+        assert_ne!(r.word(), 0, "the position controller acts");
+        r.move_to(300.0, 100.0).unwrap();
+        r.until(8000, "landed", |r| r.job().is_none());
+        r.cmd(Command::ResetAndStop {
+            deceleration: 0.0,
+            ramp_time: 0.0,
+        });
+        assert_eq!(r.job(), None);
+    }
 }

@@ -58,6 +58,8 @@ pub enum Instruction {
     SetPosition,
     /// `MC_SetReferenceFlag_BkPlcMc` (Beckhoff hydraulic library): sets the homed status.
     SetReferenceFlag,
+    /// `MC_ResetAndStop_BkPlcMc` (Beckhoff hydraulic library): reset, abort and stop.
+    ResetAndStop,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -110,6 +112,7 @@ impl Instruction {
             Self::RampedStop => "MC_RampedStop_BkPlcMc",
             Self::SetPosition => "MC_SetPosition_BkPlcMc",
             Self::SetReferenceFlag => "MC_SetReferenceFlag_BkPlcMc",
+            Self::ResetAndStop => "MC_ResetAndStop_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

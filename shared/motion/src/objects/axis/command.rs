@@ -510,6 +510,16 @@ pub enum Command {
         /// `ReferenceFlag`.
         reference_flag: bool,
     },
+    /// `MC_ResetAndStop_BkPlcMc` (Beckhoff hydraulic library): acknowledges the axis' errors
+    /// as MC_Reset does, aborts a motion and stops it (not interruptible); Done once the axis is
+    /// error-free and stands.
+    #[doc(alias = "MC_ResetAndStop_BkPlcMc")]
+    ResetAndStop {
+        /// `Deceleration` (mm/s²; not above 0: `RampTime`).
+        deceleration: f64,
+        /// `RampTime` (s from `fRefVelo` to 0; not above 0 either: `fMaxDec`).
+        ramp_time: f64,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

@@ -72,6 +72,10 @@ impl Axis {
             Command::HydSetPosition { position, relative } => {
                 self.cmd_hyd_set_position(position, relative)
             }
+            Command::ResetAndStop {
+                deceleration,
+                ramp_time,
+            } => self.cmd_reset_and_stop(deceleration, ramp_time),
             Command::SetReferenceFlag { reference_flag } => {
                 Ok(self.instant_job(Instruction::SetReferenceFlag, |ax| {
                     ax.homed = reference_flag;
@@ -90,15 +94,20 @@ impl Axis {
         id
     }
 
-    /// The lock of an emergency or immediate stop holds (or its ramp still runs): motion is
-    /// refused.
+    /// The lock of an emergency or immediate stop holds (or its ramp still runs), or an
+    /// MC_ResetAndStop_BkPlcMc stops the axis: motion is refused.
     pub(super) fn hyd_locked(&self) -> bool {
         self.hyd.as_deref().is_some_and(|h| h.cmds.lock.is_some())
+            || self
+                .main
+                .is_some_and(|m| m.instr == Instruction::ResetAndStop)
     }
 
-    /// The PLCopen state is Stopping: an emergency or immediate stop runs or holds its lock.
-    pub(super) fn hyd_stopping(&self, _main: Option<Instruction>) -> bool {
-        self.hyd_locked()
+    /// The PLCopen state is Stopping: an emergency or immediate stop runs or holds its lock, or
+    /// an MC_ResetAndStop_BkPlcMc runs (the library's MC_ReadStatus: "Stopping" for MC_Stop and
+    /// MC_ResetAndStop).
+    pub(super) fn hyd_stopping(&self, main: Option<Instruction>) -> bool {
+        main == Some(Instruction::ResetAndStop) || self.hyd_locked()
     }
 
     /// The refusals of the library's stops (as MC_Stop_BkPlcMc's): not enabled, in error,
@@ -251,7 +260,10 @@ impl Axis {
             self.hyd_lock_cycle(l);
         }
         let main = self.main;
-        if let Some(m) = main.filter(|m| m.instr == Instruction::RampedStop) {
+        let ends_at_rest = |m: &super::MotionJob| {
+            matches!(m.instr, Instruction::RampedStop | Instruction::ResetAndStop)
+        };
+        if let Some(m) = main.filter(ends_at_rest) {
             if self.hyd_finished() != Some(false) {
                 self.finish_main(m.id, m.instr);
             }
@@ -300,6 +312,42 @@ impl Axis {
             ax.hyd.as_deref().map_or(1.0, |h| h.gen.params().stop_ramp)
         });
         Ok(self.start_generator_stop(Instruction::RampedStop, dec))
+    }
+
+    /// MC_ResetAndStop_BkPlcMc: the reset of MC_Reset (its own job), then, on an enabled
+    /// axis that moves, a stop on the generator with `Deceleration`, else `fRefVelo /
+    /// RampTime`, else `fMaxDec` (MC_Stop_BkPlcMc's order); Done at rest (at once on a standing
+    /// or disabled axis). Refused with the error that the reset could not clear (16#80F3), while
+    /// an emergency or immediate stop holds the axis (16#80F0) and on a coupled axis (16#80A1;
+    /// inferred: decouple first, as for the library's stops).
+    fn cmd_reset_and_stop(&mut self, deceleration: f64, ramp_time: f64) -> Result<JobId, ErrorId> {
+        if !(deceleration.is_finite() && ramp_time.is_finite()) {
+            return Err(ErrorId::IllegalDeceleration);
+        }
+        if self.hyd_locked() || self.stop_lock {
+            return Err(ErrorId::AxisLocked);
+        }
+        if self.sync.is_some() || self.sync_pending.is_some() {
+            return Err(ErrorId::SyncJobActive);
+        }
+        self.cmd_reset(false)?;
+        if self.stopping_alarm_pending() {
+            return Err(ErrorId::JobRejectedInErrorStop);
+        }
+        if !self.enabled || !self.hyd_moving() {
+            return Ok(self.instant_job(Instruction::ResetAndStop, |_| {}));
+        }
+        let dec = if deceleration > 0.0 {
+            deceleration
+        } else {
+            self.hyd_ramp(ramp_time, |ax| {
+                // RampTime not above 0 either: fMaxDec, as a ramp time from fRefVelo.
+                ax.hyd
+                    .as_deref()
+                    .map_or(1.0, |h| h.ref_velo / h.gen.params().max_dec)
+            })
+        };
+        Ok(self.start_generator_stop(Instruction::ResetAndStop, dec))
     }
 
     /// MC_SetPosition_BkPlcMc: the actual position becomes `position` (or moves by it with

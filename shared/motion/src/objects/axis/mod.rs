@@ -1094,7 +1094,8 @@ impl Axis {
             | Command::ImmediateStop { .. }
             | Command::RampedStop { .. }
             | Command::HydSetPosition { .. }
-            | Command::SetReferenceFlag { .. } => self.apply_hyd_command(cmd),
+            | Command::SetReferenceFlag { .. }
+            | Command::ResetAndStop { .. } => self.apply_hyd_command(cmd),
             Command::MotionInPosition {
                 enable,
                 position,
