@@ -8,7 +8,7 @@ use core::fmt;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
     ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, FlyingGearParams,
-    StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+    HydJogMode, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::objects::leading::LeaderId;
 
@@ -211,6 +211,21 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         params: &[
             ("deceleration", Some(Value::Num(0.0))),
             ("ramp_time", Some(Value::Num(0.0))),
+        ],
+    },
+    // The Beckhoff hydraulic library's jog: level inputs re-sent with their values; mode 0
+    // STANDARD_SLOW, 1 STANDARD_FAST, 2 CONTINUOUS, 3 INCHING (by `position`).
+    InstructionSpec {
+        name: "MC_MoveJog_BkPlcMc",
+        params: &[
+            ("jog_forward", Some(Value::Bool(false))),
+            ("jog_backwards", Some(Value::Bool(false))),
+            ("mode", Some(Value::Num(0.0))),
+            ("position", Some(Value::Num(0.0))),
+            ("velocity", Some(Value::Num(0.0))),
+            ("acceleration", Some(Value::Num(0.0))),
+            ("deceleration", Some(Value::Num(0.0))),
+            ("jerk", Some(Value::Num(0.0))),
         ],
     },
     // The Beckhoff hydraulic library's MC_SetPosition (mode TRUE: relative) and
@@ -1029,6 +1044,22 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
             deceleration: a.num("deceleration")?,
             ramp_time: a.num("ramp_time")?,
         },
+        "MC_MoveJog_BkPlcMc" => Command::HydMoveJog {
+            forward: a.flag("jog_forward")?,
+            backward: a.flag("jog_backwards")?,
+            mode: a.choice(
+                "mode",
+                &[
+                    (0, HydJogMode::StandardSlow),
+                    (1, HydJogMode::StandardFast),
+                    (2, HydJogMode::Continuous),
+                    (3, HydJogMode::Inching),
+                ],
+                "0 STANDARD_SLOW, 1 STANDARD_FAST, 2 CONTINUOUS, 3 INCHING",
+            )?,
+            position: a.num("position")?,
+            dynamics: a.dynamics("velocity")?,
+        },
         "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
             position: a.num("position")?,
             relative: a.flag("mode")?,
@@ -1111,6 +1142,37 @@ mod tests {
             }
         );
         assert!(parse("MC_SetPosition_BkPlcMc", &[], Refs::default()).is_err());
+        let c = parse(
+            "MC_MoveJog_BkPlcMc",
+            &[
+                p("jog_backwards", Value::Bool(true)),
+                p("mode", Value::Num(3.0)),
+                p("position", Value::Num(2.5)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::HydMoveJog {
+                forward: false,
+                backward: true,
+                mode: HydJogMode::Inching,
+                position: 2.5,
+                dynamics: Dynamics {
+                    velocity: 0.0,
+                    acceleration: 0.0,
+                    deceleration: 0.0,
+                    jerk: 0.0
+                },
+            }
+        );
+        assert!(parse(
+            "MC_MoveJog_BkPlcMc",
+            &[p("mode", Value::Num(4.0))],
+            Refs::default()
+        )
+        .is_err());
         let c = parse(
             "MC_ResetAndStop_BkPlcMc",
             &[p("deceleration", Value::Num(100.0))],

@@ -13,7 +13,7 @@ use tandem_motion::hydraulic::generator::HydState;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::action::Action;
 use tandem_motion::objects::axis::{
-    AxisState, AxisStatus, Command, Direction, HydraulicStatus, StartMode, StopMode,
+    AxisState, AxisStatus, Command, Direction, HydJogMode, HydraulicStatus, StartMode, StopMode,
 };
 use tandem_motion::objects::job::Instruction;
 use tandem_runtime::exec::Executive;
@@ -424,5 +424,117 @@ fn reset_and_stop_stops_with_its_deceleration_and_is_done_at_rest() {
             ramp_time: 0.0,
         });
         assert_eq!(r.job(), None);
+    }
+}
+
+impl Run<'_> {
+    fn jog(&mut self, forward: bool, backward: bool, mode: HydJogMode, position: f64) {
+        self.cmd(Command::HydMoveJog {
+            forward,
+            backward,
+            mode,
+            position,
+            dynamics: Dynamics {
+                velocity: 60.0,
+                acceleration: 0.0,
+                deceleration: 0.0,
+                jerk: 0.0,
+            },
+        });
+    }
+}
+
+/// MC_MoveJog_BkPlcMc's velocity modes: STANDARD_SLOW runs at fJogVeloSlow (a new key, 30 mm/s
+/// here), STANDARD_FAST at fJogVeloFast (90 mm/s), CONTINUOUS at the command's 60 mm/s, each
+/// while its input is held (an edge of the other input meanwhile is ignored) and stopping to
+/// Standstill once it falls.
+#[test]
+fn jog_velocity_modes_run_at_their_velocity_while_held() {
+    let cell = {
+        let s = std::fs::read_to_string(root().join("config/hydraulic.toml")).unwrap();
+        let s = s.replacen(
+            "fEmergencyRamp = 0.1",
+            "fEmergencyRamp = 0.1\nfJogVeloSlow = 30.0\nfJogVeloFast = 90.0",
+            1,
+        );
+        tandem_config::parse("hydraulic.toml", &s).unwrap()
+    };
+    let mut r = Run::enabled(&cell);
+    for (mode, forward, v) in [
+        (HydJogMode::StandardSlow, true, 30.0),
+        (HydJogMode::StandardFast, false, -90.0),
+        (HydJogMode::Continuous, true, 60.0),
+    ] {
+        r.jog(forward, !forward, mode, 0.0);
+        assert_eq!(r.job(), Some(Instruction::HydMoveJog));
+        for _ in 0..800 {
+            r.step();
+        }
+        assert_eq!(r.status().velocity, v, "{mode:?} {:?}", r.status());
+        assert!(
+            (r.status().actual_velocity - v).abs() < 0.05 * v.abs(),
+            "{mode:?}"
+        );
+        // The other input's edge is not accepted while moving.
+        r.jog(true, true, mode, 0.0);
+        r.jog(forward, !forward, mode, 0.0);
+        r.step();
+        assert_eq!(r.status().velocity, v);
+        r.jog(false, false, mode, 0.0);
+        r.until(2000, "stopped", |r| r.job().is_none());
+        assert_eq!(r.state(), AxisState::Standstill);
+        assert_eq!(r.status().velocity, 0.0);
+    }
+}
+
+/// MC_JOGMODE_INCHING: each rising edge moves exactly `Position` (in the input's direction) on
+/// the generator and ends Done in the target window; holding the input does not repeat.
+#[test]
+fn inching_moves_exactly_position_per_rising_edge() {
+    let cell = cell("hydraulic.toml");
+    let mut r = Run::enabled(&cell);
+    let start = r.status().position;
+    for (k, forward) in [true, true, false].into_iter().enumerate() {
+        r.jog(forward, !forward, HydJogMode::Inching, 12.5);
+        assert_eq!(r.job(), Some(Instruction::HydMoveJog));
+        r.until(8000, "step done", |r| r.job().is_none());
+        // Held: no new step.
+        r.jog(forward, !forward, HydJogMode::Inching, 12.5);
+        assert_eq!(r.job(), None);
+        r.jog(false, false, HydJogMode::Inching, 12.5);
+        let expected = start + 12.5 * [1.0, 2.0, 1.0][k];
+        assert_eq!(r.hyd().target, expected);
+        assert_eq!(
+            r.status().position,
+            expected,
+            "the set position is the target"
+        );
+        assert!((r.status().actual_position - expected).abs() < 0.2);
+    }
+    // Position 0 is refused.
+    assert_eq!(
+        r.try_cmd(Command::HydMoveJog {
+            forward: true,
+            backward: false,
+            mode: HydJogMode::Inching,
+            position: 0.0,
+            dynamics: Dynamics::DEFAULT,
+        }),
+        Err(ErrorId::IllegalDistance)
+    );
+}
+
+/// fJogVeloSlow / fJogVeloFast must be above 0: the cell is refused naming the key.
+#[test]
+fn jog_velocities_out_of_range_are_refused_naming_the_key() {
+    let s = std::fs::read_to_string(root().join("config/hydraulic.toml")).unwrap();
+    for key in ["fJogVeloSlow", "fJogVeloFast"] {
+        let bad = s.replacen(
+            "fEmergencyRamp = 0.1",
+            &format!("fEmergencyRamp = 0.1\n{key} = 0.0"),
+            1,
+        );
+        let e = tandem_config::parse("hydraulic.toml", &bad).unwrap_err();
+        assert!(e.to_string().contains(key), "{e}");
     }
 }

@@ -60,6 +60,8 @@ pub enum Instruction {
     SetReferenceFlag,
     /// `MC_ResetAndStop_BkPlcMc` (Beckhoff hydraulic library): reset, abort and stop.
     ResetAndStop,
+    /// `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library): jog in its four modes.
+    HydMoveJog,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -113,6 +115,7 @@ impl Instruction {
             Self::SetPosition => "MC_SetPosition_BkPlcMc",
             Self::SetReferenceFlag => "MC_SetReferenceFlag_BkPlcMc",
             Self::ResetAndStop => "MC_ResetAndStop_BkPlcMc",
+            Self::HydMoveJog => "MC_MoveJog_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

@@ -520,6 +520,24 @@ pub enum Command {
         /// `RampTime` (s from `fRefVelo` to 0; not above 0 either: `fMaxDec`).
         ramp_time: f64,
     },
+    /// `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library, 4.2.19): level inputs, re-sent with
+    /// their current values; a rising edge starts (JogForward wins), no edge is accepted while
+    /// the axis moves. The velocity modes stop when the input of their direction falls; inching
+    /// moves by `position` per rising edge.
+    #[doc(alias = "MC_MoveJog_BkPlcMc")]
+    HydMoveJog {
+        /// `JogForward`.
+        forward: bool,
+        /// `JogBackwards`.
+        backward: bool,
+        /// `Mode` (`E_TcMcJogMode`).
+        mode: HydJogMode,
+        /// `Position` (mm): the distance of an inching step (its sign is the input's).
+        position: f64,
+        /// `Velocity`, `Acceleration`, `Deceleration` (0 or -1: the axis' defaults; used by
+        /// the continuous and inching modes).
+        dynamics: Dynamics,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {
@@ -677,4 +695,22 @@ pub enum Command {
         /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` of the shift.
         dynamics: Dynamics,
     },
+}
+
+/// `E_TcMcJogMode` of `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library, 4.3.38).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum HydJogMode {
+    /// `MC_JOGMODE_STANDARD_SLOW` (0): `fJogVeloSlow` with the standard dynamics while the
+    /// input is held.
+    #[doc(alias = "MC_JOGMODE_STANDARD_SLOW")]
+    StandardSlow,
+    /// `MC_JOGMODE_STANDARD_FAST` (1): `fJogVeloFast` likewise.
+    #[doc(alias = "MC_JOGMODE_STANDARD_FAST")]
+    StandardFast,
+    /// `MC_JOGMODE_CONTINUOUS` (2): the command's velocity and dynamics while held.
+    #[doc(alias = "MC_JOGMODE_CONTINUOUS")]
+    Continuous,
+    /// `MC_JOGMODE_INCHING` (3): a relative move by `Position` per rising edge.
+    #[doc(alias = "MC_JOGMODE_INCHING")]
+    Inching,
 }

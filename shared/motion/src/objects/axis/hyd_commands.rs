@@ -20,14 +20,25 @@
 //!   TRUE), also during a motion: the set position, the generator's target and set position and
 //!   the target window move with it ("all other affected elements are automatically updated").
 //! - **MC_SetReferenceFlag_BkPlcMc**: sets or clears the homed status.
+//! - **MC_MoveJog_BkPlcMc** (4.2.19, `E_TcMcJogMode` 4.3.38): on a rising edge of an input
+//!   (JogForward wins) a velocity motion with `fJogVeloSlow` / `fJogVeloFast` and the standard
+//!   dynamics, or the command's velocity and dynamics (continuous), stopped when that input
+//!   falls; or (inching) a relative positioning on the generator by `Position`, Done in the
+//!   target window. No edge is accepted while the jog moves. The velocity modes run on
+//!   tandem's profile with the loop closed, as every velocity motion of a hydraulic axis
+//!   (inferred: the library runs MC_MoveVelocity_BkPlcMc as a positioning to the software
+//!   limit); their stop uses the job's deceleration (inferred: the library's MC_Stop_BkPlcMc
+//!   without Deceleration and RampTime takes `fMaxDec`).
 //!
 //! Refusals of the three stops, as the library's: an axis in error (16#80F3), one already
 //! stopping (16#80F0, the library's `dwTcHydErrCdNotReady`), one coupled to another axis
 //! (16#80A1, likewise); an axis that stands is Done at once. Every instruction here is refused
 //! with 16#8002 on an electric axis.
 
-use super::{reduce, Axis, Command, Goal};
+use super::{reduce, Axis, Command, Goal, HydJogMode};
 use crate::catalog::error_id::ErrorId;
+use crate::catalog::override_table::NewJob;
+use crate::kinematics::dynamics::Dynamics;
 use crate::kinematics::profile::{Limits, State};
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 
@@ -42,13 +53,37 @@ struct StopLock {
     suppressing: bool,
 }
 
+/// A running MC_MoveJog_BkPlcMc.
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct JogRun {
+    job: JobId,
+    mode: HydJogMode,
+    positive: bool,
+    lim: Limits,
+}
+
 /// The state of the library's instructions on a hydraulic axis.
-#[derive(Copy, Clone, Debug, Default, PartialEq)]
+#[derive(Copy, Clone, Debug, PartialEq)]
 pub(super) struct HydCommands {
     lock: Option<StopLock>,
+    /// `fJogVeloSlow`, `fJogVeloFast`.
+    jog_velo: [f64; 2],
+    /// MC_MoveJog_BkPlcMc's inputs of the last command (for the rising edges).
+    jog_inputs: (bool, bool),
+    jog: Option<JogRun>,
 }
 
 impl HydCommands {
+    /// Nothing running, with `fJogVeloSlow` and `fJogVeloFast`.
+    pub(super) fn new(jog_velo: [f64; 2]) -> Self {
+        Self {
+            lock: None,
+            jog_velo,
+            jog_inputs: (false, false),
+            jog: None,
+        }
+    }
+
     /// The valve output is suppressed (the lock of an emergency or immediate stop).
     pub(super) fn outputs_locked(&self) -> bool {
         self.lock.is_some_and(|l| l.suppressing)
@@ -76,6 +111,13 @@ impl Axis {
                 deceleration,
                 ramp_time,
             } => self.cmd_reset_and_stop(deceleration, ramp_time),
+            Command::HydMoveJog {
+                forward,
+                backward,
+                mode,
+                position,
+                dynamics,
+            } => self.cmd_hyd_jog(forward, backward, mode, position, &dynamics),
             Command::SetReferenceFlag { reference_flag } => {
                 Ok(self.instant_job(Instruction::SetReferenceFlag, |ax| {
                     ax.homed = reference_flag;
@@ -259,14 +301,23 @@ impl Axis {
         if let Some(l) = h.cmds.lock {
             self.hyd_lock_cycle(l);
         }
-        let main = self.main;
-        let ends_at_rest = |m: &super::MotionJob| {
-            matches!(m.instr, Instruction::RampedStop | Instruction::ResetAndStop)
+        let Some(m) = self.main else {
+            return;
         };
-        if let Some(m) = main.filter(ends_at_rest) {
-            if self.hyd_finished() != Some(false) {
-                self.finish_main(m.id, m.instr);
+        let done = match m.instr {
+            Instruction::RampedStop | Instruction::ResetAndStop => {
+                self.hyd_finished() != Some(false)
             }
+            Instruction::HydMoveJog if matches!(self.goal, Goal::Position { .. }) => {
+                self.hyd_done() == Some(true)
+            }
+            Instruction::HydMoveJog if matches!(self.goal, Goal::Stop { .. }) => {
+                self.main_motion_finished()
+            }
+            _ => false,
+        };
+        if done {
+            self.finish_main(m.id, m.instr);
         }
     }
 
@@ -368,5 +419,107 @@ impl Axis {
             return Err(ErrorId::IllegalPosition);
         }
         Ok(self.instant_job(Instruction::SetPosition, |ax| ax.shift(delta)))
+    }
+
+    /// MC_MoveJog_BkPlcMc with its inputs of now: a running jog goes on (a velocity mode stops
+    /// when the input of its direction falls); otherwise a rising edge starts one.
+    fn cmd_hyd_jog(
+        &mut self,
+        forward: bool,
+        backward: bool,
+        mode: HydJogMode,
+        position: f64,
+        dynamics: &Dynamics,
+    ) -> Result<JobId, ErrorId> {
+        let Some(h) = self.hyd.as_deref_mut() else {
+            return Err(ErrorId::IllegalObject);
+        };
+        let (was_forward, was_backward) = h.cmds.jog_inputs;
+        h.cmds.jog_inputs = (forward, backward);
+        let (jog, jog_velo) = (h.cmds.jog, h.cmds.jog_velo);
+        let running = jog.filter(|j| self.main.is_some_and(|m| m.id == j.job));
+        if let Some(j) = running {
+            let held = if j.positive { forward } else { backward };
+            if j.mode != HydJogMode::Inching && !held && !matches!(self.goal, Goal::Stop { .. }) {
+                self.set_goal(Goal::Stop { lim: j.lim });
+            }
+            return Ok(j.job);
+        }
+        let positive = forward && !was_forward;
+        if !positive && !(backward && !was_backward) {
+            return Ok(0);
+        }
+        let sign = if positive { 1.0 } else { -1.0 };
+        // The library: 0.0 for Acceleration or Deceleration is the axis' default (Jerk is
+        // reserved: the axis' default).
+        let default0 = |x: f64| if x == 0.0 { -1.0 } else { x };
+        let dynamics = Dynamics {
+            acceleration: default0(dynamics.acceleration),
+            deceleration: default0(dynamics.deceleration),
+            jerk: -1.0,
+            ..*dynamics
+        };
+        let id = match mode {
+            HydJogMode::Inching => {
+                let distance = position.abs() * sign;
+                if distance == 0.0 {
+                    return Err(ErrorId::IllegalDistance);
+                }
+                self.cmd_positioning(Instruction::HydMoveJog, distance, &dynamics, |ax, _| {
+                    ax.basic.p + distance
+                })?
+            }
+            _ => {
+                let velocity = match mode {
+                    HydJogMode::StandardSlow => jog_velo[0],
+                    HydJogMode::StandardFast => jog_velo[1],
+                    _ => dynamics.velocity.abs(),
+                };
+                let d = if mode == HydJogMode::Continuous {
+                    Dynamics {
+                        velocity,
+                        ..dynamics
+                    }
+                } else {
+                    Dynamics {
+                        velocity,
+                        ..Dynamics::DEFAULT
+                    }
+                };
+                self.start_jog_velocity(sign, &d)?
+            }
+        };
+        let lim = self.main.map_or_else(|| self.default_limits(), |m| m.lim);
+        if let Some(h) = self.hyd.as_deref_mut() {
+            h.cmds.jog = Some(JogRun {
+                job: id,
+                mode,
+                positive,
+                lim,
+            });
+        }
+        Ok(id)
+    }
+
+    /// The velocity motion of a jog in direction `sign` with dynamics `d` (velocity below 1 %
+    /// of `fRefVelo`: 16#8003, the library's `dwTcHydErrCdSetVelo`).
+    fn start_jog_velocity(&mut self, sign: f64, d: &Dynamics) -> Result<JobId, ErrorId> {
+        let ref_velo = self.hyd.as_deref().map_or(0.0, |h| h.ref_velo);
+        if !(d.velocity.is_finite() && d.velocity >= 0.01 * ref_velo) {
+            return Err(ErrorId::IllegalVelocity);
+        }
+        self.check_motion_allowed()?;
+        self.hyd_check_feed(self.actual_p + sign)?;
+        let r = self.cfg.limits.resolve(&self.cfg.defaults, d, true)?;
+        self.warn_clamped(r.clamped);
+        self.apply_override_table(NewJob::Positioning);
+        self.fold_superimposed();
+        self.force_position_control();
+        let lim = Limits {
+            vel: self.cfg.limits.max_velocity,
+            ..r.limits
+        };
+        let v = sign * r.limits.vel;
+        Ok(self.start_main(Instruction::HydMoveJog, lim, Goal::Velocity { v, lim }))
     }
 }

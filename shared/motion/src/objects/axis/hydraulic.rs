@@ -112,7 +112,7 @@ impl HydAxis {
             pressure: None,
             controller: cfg.controller,
             auto_zero: None,
-            cmds: super::hyd_commands::HydCommands::default(),
+            cmds: super::hyd_commands::HydCommands::new(cfg.jog_velo),
         }))
     }
 }

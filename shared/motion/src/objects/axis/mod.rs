@@ -18,13 +18,14 @@ mod sync;
 pub use adjustment::{AbsoluteOffset, RestoreOffsetError};
 pub use buffer::JOB_QUEUE_CAPACITY;
 pub use command::{
-    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, StartMode, StopMode,
-    SyncDirection, SyncProfileReference, VelocityDirection,
+    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, HydJogMode, StartMode,
+    StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
 };
 pub use config::{
     AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
     FollowingErrorMonitoring, HomingConfig, HomingMark, HydraulicProfile, MotionType,
     PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
+    JOG_VELO_DEFAULTS,
 };
 pub use hydraulic::HydraulicStatus;
 pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
@@ -1095,7 +1096,8 @@ impl Axis {
             | Command::RampedStop { .. }
             | Command::HydSetPosition { .. }
             | Command::SetReferenceFlag { .. }
-            | Command::ResetAndStop { .. } => self.apply_hyd_command(cmd),
+            | Command::ResetAndStop { .. }
+            | Command::HydMoveJog { .. } => self.apply_hyd_command(cmd),
             Command::MotionInPosition {
                 enable,
                 position,
