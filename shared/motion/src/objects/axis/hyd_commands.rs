@@ -446,7 +446,8 @@ impl Axis {
             return Ok(j.job);
         }
         let positive = forward && !was_forward;
-        if !positive && !(backward && !was_backward) {
+        let negative = backward && !was_backward;
+        if !(positive || negative) {
             return Ok(0);
         }
         let sign = if positive { 1.0 } else { -1.0 };
