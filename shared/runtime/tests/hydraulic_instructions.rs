@@ -538,3 +538,33 @@ fn jog_velocities_out_of_range_are_refused_naming_the_key() {
         assert!(e.to_string().contains(key), "{e}");
     }
 }
+
+/// MC_ResetAndStop_BkPlcMc's reset: a following-error alarm (a 1 mm limit, exceeded by the
+/// displacement mode's lag in travel) puts the moving axis into ErrorStop with its enable
+/// removed (motion refused); MC_ResetAndStop_BkPlcMc acknowledges it (the error word clears, the
+/// axis leaves ErrorStop and, MC_Power's Enable still held, asks for its enable again) and is
+/// Done at once on the disabled axis.
+#[test]
+fn reset_and_stop_acknowledges_an_alarm() {
+    let s = std::fs::read_to_string(root().join("config/hydraulic.toml")).unwrap();
+    let s = s.replacen(
+        "enable = false                    # the displacement mode",
+        "enable = true\nmin_value = 1.0\nmax_value = 1.0\nmin_velocity = 1.0\n# the displacement mode",
+        1,
+    );
+    let cell = tandem_config::parse("hydraulic.toml", &s).unwrap();
+    let mut r = Run::enabled(&cell);
+    r.move_to(450.0, 200.0).unwrap();
+    r.until(3000, "alarm", |r| r.state() == AxisState::ErrorStop);
+    assert_ne!(r.status().error_word, 0);
+    assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::NotEnabled));
+    r.until(3000, "stood", |r| r.status().actual_velocity.abs() < 0.5);
+    r.cmd(Command::ResetAndStop {
+        deceleration: 0.0,
+        ramp_time: 0.0,
+    });
+    assert_eq!(r.job(), None);
+    r.step();
+    assert_eq!(r.status().error_word, 0);
+    assert_eq!(r.state(), AxisState::Disabled);
+}
