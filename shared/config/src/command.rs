@@ -8,7 +8,7 @@ use core::fmt;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
     ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, FlyingGearParams,
-    StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+    HydJogMode, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::objects::leading::LeaderId;
 
@@ -187,6 +187,56 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("threshold", Some(Value::Num(0.1))),
             ("filter", Some(Value::Num(0.1))),
         ],
+    },
+    // The Beckhoff hydraulic library's stops (a hydraulic axis): `execute = false` releases the
+    // lock of MC_EmergencyStop_BkPlcMc / MC_ImmediateStop_BkPlcMc; ramp_time 0: the
+    // parameter's ramp.
+    InstructionSpec {
+        name: "MC_EmergencyStop_BkPlcMc",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("ramp_time", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_ImmediateStop_BkPlcMc",
+        params: &[("execute", Some(Value::Bool(true)))],
+    },
+    InstructionSpec {
+        name: "MC_RampedStop_BkPlcMc",
+        params: &[("ramp_time", Some(Value::Num(0.0)))],
+    },
+    InstructionSpec {
+        name: "MC_ResetAndStop_BkPlcMc",
+        params: &[
+            ("deceleration", Some(Value::Num(0.0))),
+            ("ramp_time", Some(Value::Num(0.0))),
+        ],
+    },
+    // The Beckhoff hydraulic library's jog: level inputs re-sent with their values; mode 0
+    // STANDARD_SLOW, 1 STANDARD_FAST, 2 CONTINUOUS, 3 INCHING (by `position`).
+    InstructionSpec {
+        name: "MC_MoveJog_BkPlcMc",
+        params: &[
+            ("jog_forward", Some(Value::Bool(false))),
+            ("jog_backwards", Some(Value::Bool(false))),
+            ("mode", Some(Value::Num(0.0))),
+            ("position", Some(Value::Num(0.0))),
+            ("velocity", Some(Value::Num(0.0))),
+            ("acceleration", Some(Value::Num(0.0))),
+            ("deceleration", Some(Value::Num(0.0))),
+            ("jerk", Some(Value::Num(0.0))),
+        ],
+    },
+    // The Beckhoff hydraulic library's MC_SetPosition (mode TRUE: relative) and
+    // MC_SetReferenceFlag.
+    InstructionSpec {
+        name: "MC_SetPosition_BkPlcMc",
+        params: &[("position", None), ("mode", Some(Value::Bool(false)))],
+    },
+    InstructionSpec {
+        name: "MC_SetReferenceFlag_BkPlcMc",
+        params: &[("reference_flag", Some(Value::Bool(true)))],
     },
     InstructionSpec {
         name: "MC_MotionInPosition",
@@ -980,6 +1030,43 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
                 filter: a.num("filter")?,
             },
         },
+        "MC_EmergencyStop_BkPlcMc" => Command::EmergencyStop {
+            execute: a.flag("execute")?,
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_ImmediateStop_BkPlcMc" => Command::ImmediateStop {
+            execute: a.flag("execute")?,
+        },
+        "MC_RampedStop_BkPlcMc" => Command::RampedStop {
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_ResetAndStop_BkPlcMc" => Command::ResetAndStop {
+            deceleration: a.num("deceleration")?,
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_MoveJog_BkPlcMc" => Command::HydMoveJog {
+            forward: a.flag("jog_forward")?,
+            backward: a.flag("jog_backwards")?,
+            mode: a.choice(
+                "mode",
+                &[
+                    (0, HydJogMode::StandardSlow),
+                    (1, HydJogMode::StandardFast),
+                    (2, HydJogMode::Continuous),
+                    (3, HydJogMode::Inching),
+                ],
+                "0 STANDARD_SLOW, 1 STANDARD_FAST, 2 CONTINUOUS, 3 INCHING",
+            )?,
+            position: a.num("position")?,
+            dynamics: a.dynamics("velocity")?,
+        },
+        "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
+            position: a.num("position")?,
+            relative: a.flag("mode")?,
+        },
+        "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
+            reference_flag: a.flag("reference_flag")?,
+        },
         "MC_MotionInPosition" => Command::MotionInPosition {
             enable: a.flag("enable")?,
             position: a.num("position")?,
@@ -1015,6 +1102,97 @@ mod tests {
             assert_eq!(find(n).map(|s| s.name), Some("MC_MoveAbsolute"));
         }
         assert!(find("MC_Fly").is_none());
+    }
+
+    #[test]
+    fn the_library_stops_and_set_position_take_their_inputs() {
+        let c = parse("MC_EmergencyStop_BkPlcMc", &[], Refs::default()).unwrap();
+        assert_eq!(
+            c,
+            Command::EmergencyStop {
+                execute: true,
+                ramp_time: 0.0
+            }
+        );
+        let c = parse(
+            "MC_ImmediateStop_BkPlcMc",
+            &[p("execute", Value::Bool(false))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(c, Command::ImmediateStop { execute: false });
+        let c = parse(
+            "MC_RampedStop_BkPlcMc",
+            &[p("ramp_time", Value::Num(1.5))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(c, Command::RampedStop { ramp_time: 1.5 });
+        let c = parse(
+            "MC_SetPosition_BkPlcMc",
+            &[p("position", Value::Num(5.0)), p("mode", Value::Bool(true))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::HydSetPosition {
+                position: 5.0,
+                relative: true
+            }
+        );
+        assert!(parse("MC_SetPosition_BkPlcMc", &[], Refs::default()).is_err());
+        let c = parse(
+            "MC_MoveJog_BkPlcMc",
+            &[
+                p("jog_backwards", Value::Bool(true)),
+                p("mode", Value::Num(3.0)),
+                p("position", Value::Num(2.5)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::HydMoveJog {
+                forward: false,
+                backward: true,
+                mode: HydJogMode::Inching,
+                position: 2.5,
+                dynamics: Dynamics {
+                    velocity: 0.0,
+                    acceleration: 0.0,
+                    deceleration: 0.0,
+                    jerk: 0.0
+                },
+            }
+        );
+        assert!(parse(
+            "MC_MoveJog_BkPlcMc",
+            &[p("mode", Value::Num(4.0))],
+            Refs::default()
+        )
+        .is_err());
+        let c = parse(
+            "MC_ResetAndStop_BkPlcMc",
+            &[p("deceleration", Value::Num(100.0))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::ResetAndStop {
+                deceleration: 100.0,
+                ramp_time: 0.0
+            }
+        );
+        let c = parse("MC_SetReferenceFlag_BkPlcMc", &[], Refs::default()).unwrap();
+        assert_eq!(
+            c,
+            Command::SetReferenceFlag {
+                reference_flag: true
+            }
+        );
     }
 
     #[test]

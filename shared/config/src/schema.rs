@@ -236,6 +236,10 @@ pub struct HydraulicSection {
     pub fEmergencyRamp: Option<f64>,
     /// Automatic repositioning beyond this distance from the target (mm; 0: off).
     pub fReposDistance: Option<f64>,
+    /// Velocity of slow manual travel, MC_MoveJog_BkPlcMc's MC_JOGMODE_STANDARD_SLOW (mm/s).
+    pub fJogVeloSlow: Option<f64>,
+    /// Velocity of fast manual travel, MC_JOGMODE_STANDARD_FAST (mm/s).
+    pub fJogVeloFast: Option<f64>,
     /// Target clamping: the output (V, 0..10) pressing towards the target once there, in place
     /// of the position controller (0: off).
     pub fTargetClamping: Option<f64>,

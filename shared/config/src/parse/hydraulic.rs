@@ -14,7 +14,7 @@ use tandem_motion::hydraulic::generator::{
 use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
 use tandem_motion::hydraulic::pressure::ForceScaling;
 use tandem_motion::hydraulic::valve_table::{ValveTable, MAX_POINTS};
-use tandem_motion::objects::axis::HydraulicProfile;
+use tandem_motion::objects::axis::{HydraulicProfile, JOG_VELO_DEFAULTS};
 use tandem_motion::plant::hydraulic::{CylinderParams, SimValveCylinderParams};
 
 /// The axis kind of a hydraulic axis in the cell file.
@@ -45,7 +45,7 @@ const VALVE_INPUTS: [(&str, (ValveOutput, bool)); 4] = [
 
 /// The keys of `[axes.<name>.hydraulic]` the generator, the target window and the position
 /// controller with Finish check, as paths from the axis.
-const PROFILE_KEYS: [&str; 37] = [
+const PROFILE_KEYS: [&str; 39] = [
     "hydraulic.fRefVelo",
     "hydraulic.fMaxVelo",
     "hydraulic.fAcc",
@@ -83,6 +83,8 @@ const PROFILE_KEYS: [&str; 37] = [
     "hydraulic.Valve_LinLimitM",
     "hydraulic.valve_output",
     "hydraulic.bDrive_AbsoluteOutput",
+    "hydraulic.fJogVeloSlow",
+    "hydraulic.fJogVeloFast",
 ];
 
 /// The path from the axis of the library's parameter `name`.
@@ -115,6 +117,14 @@ pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldErr
             Problem::Invalid("out of its range (ST_TcHydAxParam)"),
         )
     })?;
+    for (name, v) in ["fJogVeloSlow", "fJogVeloFast"].into_iter().zip(p.jog_velo) {
+        if !(v.is_finite() && v > 0.0) {
+            return Err((
+                profile_key(name),
+                Problem::Invalid("out of its range (ST_TcHydAxParam)"),
+            ));
+        }
+    }
     Ok(p)
 }
 
@@ -170,6 +180,10 @@ fn unchecked_profile(h: &HydraulicSection, controller: HydControllerParams) -> H
             target_filter: h.fMonTargetFilter.unwrap_or(MONITOR_DEFAULTS.target_filter),
         },
         controller,
+        jog_velo: [
+            h.fJogVeloSlow.unwrap_or(JOG_VELO_DEFAULTS[0]),
+            h.fJogVeloFast.unwrap_or(JOG_VELO_DEFAULTS[1]),
+        ],
     }
 }
 

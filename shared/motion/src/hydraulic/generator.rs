@@ -333,6 +333,11 @@ impl CtrlBasedGenerator {
         })
     }
 
+    /// The parameters.
+    pub fn params(&self) -> &GeneratorParams {
+        &self.p
+    }
+
     /// The state.
     pub fn state(&self) -> HydState {
         self.state

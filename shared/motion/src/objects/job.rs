@@ -46,6 +46,22 @@ pub enum Instruction {
     PressureControl,
     /// `MC_AxCtrlAutoZero_BkPlcMc` (Beckhoff hydraulic library): automatic zero compensation.
     AutoZero,
+    /// `MC_EmergencyStop_BkPlcMc` (Beckhoff hydraulic library): stop on the emergency ramp,
+    /// outputs locked while Execute.
+    EmergencyStop,
+    /// `MC_ImmediateStop_BkPlcMc` (Beckhoff hydraulic library): output 0 at once, locked while
+    /// Execute.
+    ImmediateStop,
+    /// `MC_RampedStop_BkPlcMc` (Beckhoff hydraulic library): a time ramp of the set velocity.
+    RampedStop,
+    /// `MC_SetPosition_BkPlcMc` (Beckhoff hydraulic library): sets the actual position.
+    SetPosition,
+    /// `MC_SetReferenceFlag_BkPlcMc` (Beckhoff hydraulic library): sets the homed status.
+    SetReferenceFlag,
+    /// `MC_ResetAndStop_BkPlcMc` (Beckhoff hydraulic library): reset, abort and stop.
+    ResetAndStop,
+    /// `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library): jog in its four modes.
+    HydMoveJog,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -93,6 +109,13 @@ impl Instruction {
             Self::MotionInVelocity => "MC_MotionInVelocity",
             Self::PressureControl => "MC_AxCtrlPressure_BkPlcMc",
             Self::AutoZero => "MC_AxCtrlAutoZero_BkPlcMc",
+            Self::EmergencyStop => "MC_EmergencyStop_BkPlcMc",
+            Self::ImmediateStop => "MC_ImmediateStop_BkPlcMc",
+            Self::RampedStop => "MC_RampedStop_BkPlcMc",
+            Self::SetPosition => "MC_SetPosition_BkPlcMc",
+            Self::SetReferenceFlag => "MC_SetReferenceFlag_BkPlcMc",
+            Self::ResetAndStop => "MC_ResetAndStop_BkPlcMc",
+            Self::HydMoveJog => "MC_MoveJog_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

@@ -795,7 +795,7 @@ impl AnalogConnection {
         let Some(h) = self.hydraulic.as_mut() else {
             return ControllerOutput::default();
         };
-        if !active {
+        if !active || out.hydraulic.locked {
             h.reset();
             return ControllerOutput::default();
         }

@@ -149,6 +149,10 @@ pub struct HydValveOutputs {
     /// `fZeroCompensation` (V) as `MC_AxCtrlAutoZero_BkPlcMc` has set it; `None`: the
     /// configured one.
     pub zero_compensation: Option<f64>,
+    /// The valve output is suppressed (0) while an emergency or immediate stop holds its lock
+    /// (`bLocked_Estop` of `MC_EmergencyStop_BkPlcMc` / `MC_ImmediateStop_BkPlcMc`).
+    #[doc(alias = "bLocked_Estop")]
+    pub locked: bool,
 }
 
 /// Switch levels read from input signals of the node's process image, in place of the

@@ -469,6 +469,75 @@ pub enum Command {
         /// `EnableOnMoving`, `OffsetLimit`, `Tn`, `Threshold`, `Filter`.
         params: crate::hydraulic::auto_zero::AutoZeroParams,
     },
+    /// `MC_EmergencyStop_BkPlcMc` (Beckhoff TwinCAT PLC Hydraulic Positioning library, from
+    /// V3.0.5): the set velocity ramps to 0 on the generator (`RampTime` from `fRefVelo`, else
+    /// `fEmergencyRamp`); once it is 0 the valve output is suppressed while `execute` stays
+    /// TRUE (`bLocked_Estop`). Re-sent with `execute = false` to release the lock.
+    #[doc(alias = "MC_EmergencyStop_BkPlcMc")]
+    EmergencyStop {
+        /// `Execute` (TRUE: stop and lock; FALSE: release).
+        execute: bool,
+        /// `RampTime` (s from `fRefVelo` to 0; not above 0: `fEmergencyRamp`).
+        ramp_time: f64,
+    },
+    /// `MC_ImmediateStop_BkPlcMc` (Beckhoff hydraulic library, from V3.0.5): the control value
+    /// is 0 at once, no ramp; the valve output is suppressed while `execute` stays TRUE.
+    #[doc(alias = "MC_ImmediateStop_BkPlcMc")]
+    ImmediateStop {
+        /// `Execute` (TRUE: stop and lock; FALSE: release).
+        execute: bool,
+    },
+    /// `MC_RampedStop_BkPlcMc` (Beckhoff hydraulic library): a pure time ramp of the set
+    /// velocity to 0, with no defined end position (it may overrun a software limit).
+    #[doc(alias = "MC_RampedStop_BkPlcMc")]
+    RampedStop {
+        /// `RampTime` (s from `fRefVelo` to 0; not above 0: `fStopRamp`).
+        ramp_time: f64,
+    },
+    /// `MC_SetPosition_BkPlcMc` (Beckhoff hydraulic library): sets the actual position, also
+    /// during a motion (the set position, the target and the target window move with it).
+    #[doc(alias = "MC_SetPosition_BkPlcMc")]
+    HydSetPosition {
+        /// `Position` (mm): the new actual position, or the shift with `relative`.
+        position: f64,
+        /// `Mode`: TRUE shifts the actual position by `position`, FALSE sets it.
+        relative: bool,
+    },
+    /// `MC_SetReferenceFlag_BkPlcMc` (Beckhoff hydraulic library): sets or clears the axis'
+    /// homed status (`dwTcHydNsDwReferenced`).
+    #[doc(alias = "MC_SetReferenceFlag_BkPlcMc")]
+    SetReferenceFlag {
+        /// `ReferenceFlag`.
+        reference_flag: bool,
+    },
+    /// `MC_ResetAndStop_BkPlcMc` (Beckhoff hydraulic library): acknowledges the axis' errors
+    /// as MC_Reset does, aborts a motion and stops it (not interruptible); Done once the axis is
+    /// error-free and stands.
+    #[doc(alias = "MC_ResetAndStop_BkPlcMc")]
+    ResetAndStop {
+        /// `Deceleration` (mm/s²; not above 0: `RampTime`).
+        deceleration: f64,
+        /// `RampTime` (s from `fRefVelo` to 0; not above 0 either: `fMaxDec`).
+        ramp_time: f64,
+    },
+    /// `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library, 4.2.19): level inputs, re-sent with
+    /// their current values; a rising edge starts (JogForward wins), no edge is accepted while
+    /// the axis moves. The velocity modes stop when the input of their direction falls; inching
+    /// moves by `position` per rising edge.
+    #[doc(alias = "MC_MoveJog_BkPlcMc")]
+    HydMoveJog {
+        /// `JogForward`.
+        forward: bool,
+        /// `JogBackwards`.
+        backward: bool,
+        /// `Mode` (`E_TcMcJogMode`).
+        mode: HydJogMode,
+        /// `Position` (mm): the distance of an inching step (its sign is the input's).
+        position: f64,
+        /// `Velocity`, `Acceleration`, `Deceleration` (0 or -1: the axis' defaults; used by
+        /// the continuous and inching modes).
+        dynamics: Dynamics,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {
@@ -626,4 +695,22 @@ pub enum Command {
         /// `Velocity`, `Acceleration`, `Deceleration`, `Jerk` of the shift.
         dynamics: Dynamics,
     },
+}
+
+/// `E_TcMcJogMode` of `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library, 4.3.38).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum HydJogMode {
+    /// `MC_JOGMODE_STANDARD_SLOW` (0): `fJogVeloSlow` with the standard dynamics while the
+    /// input is held.
+    #[doc(alias = "MC_JOGMODE_STANDARD_SLOW")]
+    StandardSlow,
+    /// `MC_JOGMODE_STANDARD_FAST` (1): `fJogVeloFast` likewise.
+    #[doc(alias = "MC_JOGMODE_STANDARD_FAST")]
+    StandardFast,
+    /// `MC_JOGMODE_CONTINUOUS` (2): the command's velocity and dynamics while held.
+    #[doc(alias = "MC_JOGMODE_CONTINUOUS")]
+    Continuous,
+    /// `MC_JOGMODE_INCHING` (3): a relative move by `Position` per rising edge.
+    #[doc(alias = "MC_JOGMODE_INCHING")]
+    Inching,
 }

@@ -235,7 +235,14 @@ pub struct HydraulicProfile {
     /// The position controller and Finish (`fLagAmp`, `fLagAmpDx`, `fZeroCompensation` …):
     /// the basis of `MC_AxCtrlAutoZero_BkPlcMc` (the drive connection runs the controller).
     pub controller: crate::hydraulic::controller::HydControllerParams,
+    /// `fJogVeloSlow` and `fJogVeloFast` (mm/s, > 0): MC_MoveJog_BkPlcMc's standard modes.
+    #[doc(alias = "fJogVeloSlow")]
+    #[doc(alias = "fJogVeloFast")]
+    pub jog_velo: [f64; 2],
 }
+
+/// `fJogVeloSlow` and `fJogVeloFast` by default (mm/s), as the library's `ST_TcHydAxParam`.
+pub const JOG_VELO_DEFAULTS: [f64; 2] = [25.0, 100.0];
 
 /// What is wrong with a value of an [`AxisConfig`] (see [`AxisConfigError`]).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

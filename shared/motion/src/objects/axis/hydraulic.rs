@@ -30,16 +30,16 @@ use crate::plant::link::HydValveOutputs;
 /// The hydraulic part of an axis (boxed in the axis: allocated when it is built).
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct HydAxis {
-    gen: CtrlBasedGenerator,
+    pub(super) gen: CtrlBasedGenerator,
     monitor: TargetMonitor,
     /// The generator computes the basic setpoint.
-    engaged: bool,
+    pub(super) engaged: bool,
     /// The generator's output of the last cycle.
     last: Setpoint,
     /// The target window of the last cycle.
     window: TargetStatus,
     /// `fRefVelo` (mm/s): the velocity of a control value of 1.0.
-    ref_velo: f64,
+    pub(super) ref_velo: f64,
     /// The pressures and the force of the last sample; `None` without pressure inputs.
     actual: Option<ActualForce>,
     /// The running MC_AxCtrlPressure_BkPlcMc job.
@@ -48,6 +48,8 @@ pub(super) struct HydAxis {
     controller: HydControllerParams,
     /// MC_AxCtrlAutoZero_BkPlcMc, once it has been enabled; its `Enable`.
     auto_zero: Option<(AutoZero, bool)>,
+    /// The library's stop and jog instructions' state (`super::hyd_commands`).
+    pub(super) cmds: super::hyd_commands::HydCommands,
 }
 
 /// A running pressure or force control.
@@ -110,6 +112,7 @@ impl HydAxis {
             pressure: None,
             controller: cfg.controller,
             auto_zero: None,
+            cmds: super::hyd_commands::HydCommands::new(cfg.jog_velo),
         }))
     }
 }
@@ -443,6 +446,7 @@ impl Axis {
                     0.0
                 },
                 zero_compensation: h.auto_zero.map(|(a, _)| a.status().compensation),
+                locked: h.cmds.outputs_locked(),
             },
             None => HydValveOutputs::default(),
         }

@@ -10,6 +10,7 @@ mod adjustment;
 mod buffer;
 mod command;
 mod config;
+mod hyd_commands;
 mod hydraulic;
 mod step;
 mod sync;
@@ -17,13 +18,14 @@ mod sync;
 pub use adjustment::{AbsoluteOffset, RestoreOffsetError};
 pub use buffer::JOB_QUEUE_CAPACITY;
 pub use command::{
-    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, StartMode, StopMode,
-    SyncDirection, SyncProfileReference, VelocityDirection,
+    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, HydJogMode, StartMode,
+    StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
 };
 pub use config::{
     AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
     FollowingErrorMonitoring, HomingConfig, HomingMark, HydraulicProfile, MotionType,
     PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
+    JOG_VELO_DEFAULTS,
 };
 pub use hydraulic::HydraulicStatus;
 pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
@@ -933,7 +935,7 @@ impl Axis {
         if self.stopping_alarm_pending() {
             return Err(ErrorId::JobRejectedInErrorStop);
         }
-        if self.stop_lock {
+        if self.stop_lock || self.hyd_locked() {
             return Err(ErrorId::AxisLocked);
         }
         Ok(())
@@ -1091,6 +1093,13 @@ impl Axis {
                 },
             ),
             Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
+            Command::EmergencyStop { .. }
+            | Command::ImmediateStop { .. }
+            | Command::RampedStop { .. }
+            | Command::HydSetPosition { .. }
+            | Command::SetReferenceFlag { .. }
+            | Command::ResetAndStop { .. }
+            | Command::HydMoveJog { .. } => self.apply_hyd_command(cmd),
             Command::MotionInPosition {
                 enable,
                 position,

@@ -42,6 +42,7 @@ impl Axis {
         self.lead = [None; 2];
         self.check_sw_limits();
         self.update_jobs();
+        self.hyd_commands_cycle();
         self.monitor(act.balanced + self.offset);
         self.hyd_auto_zero();
 
@@ -871,7 +872,11 @@ impl Axis {
             AxisState::ErrorStop
         } else if !self.enabled {
             AxisState::Disabled
-        } else if self.stop_lock || main == Some(Instruction::Stop) || self.power.disabling {
+        } else if self.stop_lock
+            || main == Some(Instruction::Stop)
+            || self.power.disabling
+            || self.hyd_stopping(main)
+        {
             AxisState::Stopping
         } else {
             match main {
