@@ -8,17 +8,16 @@
 //! parameters are refused naming the key.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod hyd_rig;
+use hyd_rig::{Run, MS};
+
 use tandem_config::{AxisIndex, Cell};
 use tandem_motion::hydraulic::generator::HydState;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::action::Action;
-use tandem_motion::objects::axis::{
-    AxisState, Command, Direction, HydraulicStatus, StartMode, StopMode, VelocityDirection,
-};
+use tandem_motion::objects::axis::{AxisState, Command, Direction, VelocityDirection};
 use tandem_runtime::exec::Executive;
 use tandem_testkit::workspace::root;
-
-const MS: i64 = 1_000_000;
 
 fn source() -> String {
     std::fs::read_to_string(root().join("config/hydraulic.toml")).unwrap()
@@ -34,88 +33,7 @@ fn cell(edits: &[(&str, &str)]) -> Cell {
     tandem_config::parse("hydraulic.toml", &s).unwrap()
 }
 
-struct Run<'c> {
-    exec: Executive<'c>,
-    k: i64,
-    log: Vec<u8>,
-}
-
-impl<'c> Run<'c> {
-    /// The axis powered and homed at 100 mm, standing.
-    fn enabled(cell: &'c Cell) -> Self {
-        let mut r = Self {
-            exec: Executive::new(cell, None).unwrap(),
-            k: 0,
-            log: Vec::new(),
-        };
-        r.step();
-        r.cmd(Command::Power {
-            enable: true,
-            start_mode: StartMode::PositionControlled,
-            stop_mode: StopMode::Emergency,
-        });
-        r.cmd(Command::Home {
-            mode: 0,
-            position: 100.0,
-        });
-        r.until(100, "enabled", |r| r.state() == AxisState::Standstill);
-        r
-    }
-
-    fn apply_ok(&mut self, action: Action) {
-        let t = self.k * MS;
-        let r = self
-            .exec
-            .apply_at(t, t, "ram", "test", action, &mut self.log)
-            .unwrap();
-        assert!(r.is_ok(), "{r:?}\n{}", self.log());
-    }
-
-    fn cmd(&mut self, c: Command) {
-        self.apply_ok(Action::Command(c));
-    }
-
-    fn step(&mut self) {
-        self.exec.step(self.k * MS, &mut self.log).unwrap();
-        self.k += 1;
-    }
-
-    fn log(&self) -> String {
-        String::from_utf8_lossy(&self.log).into_owned()
-    }
-
-    fn state(&mut self) -> AxisState {
-        self.exec.status()[0].state
-    }
-
-    fn hyd(&self) -> HydraulicStatus {
-        let axis = self.exec.axis(AxisIndex(0)).unwrap();
-        axis.hydraulic_status().unwrap()
-    }
-
-    fn until(&mut self, max: usize, what: &str, f: impl Fn(&mut Self) -> bool) {
-        for _ in 0..max {
-            if f(self) {
-                return;
-            }
-            self.step();
-        }
-        panic!("{what}: not within {max} cycles\n{}", self.log());
-    }
-
-    fn move_to(&mut self, position: f64, velocity: f64) {
-        self.cmd(Command::MoveAbsolute {
-            position,
-            dynamics: Dynamics {
-                velocity,
-                acceleration: -1.0,
-                deceleration: -1.0,
-                jerk: -1.0,
-            },
-            direction: Direction::Shortest,
-        });
-    }
-
+impl Run<'_> {
     /// Steps until the positioning job is Done (or `max` cycles): the states the generator
     /// passed (deduplicated) and the largest change of the set velocity per cycle before idle.
     fn run_move(&mut self, max: usize) -> (Vec<HydState>, f64) {
@@ -259,9 +177,7 @@ fn mc_halt_stops_on_the_generator_ramp_and_a_velocity_motion_takes_over_without_
     assert_eq!(r.hyd().state, HydState::Idle);
     // MC_MoveVelocity: a profile from the standing setpoint; the generator lets go and the
     // position controller acts while moving.
-    r.until(2000, "halt done", |r| {
-        r.exec.status()[0].motion_job.is_none()
-    });
+    r.until(2000, "halt done", |r| r.status().motion_job.is_none());
     let p0 = r.exec.status()[0].position;
     r.cmd(Command::MoveVelocity {
         dynamics: Dynamics {
@@ -438,16 +354,14 @@ fn pressure_control_is_refused_without_pressure_inputs_and_with_bad_parameters()
 #[test]
 fn a_missing_feed_enable_refuses_a_move_and_pauses_a_running_one() {
     use tandem_motion::catalog::error_id::ErrorId;
-    let feed = |positive, negative| {
-        Action::Command(Command::HydPower {
-            enable: true,
-            enable_positive: positive,
-            enable_negative: negative,
-        })
+    let feed = |positive, negative| Command::HydPower {
+        enable: true,
+        enable_positive: positive,
+        enable_negative: negative,
     };
     let cell = cell(&[]);
     let mut r = Run::enabled(&cell);
-    r.apply_ok(feed(false, true));
+    r.cmd(feed(false, true));
     let t = r.k * MS;
     let mv = Action::Command(Command::MoveAbsolute {
         position: 300.0,
@@ -465,12 +379,12 @@ fn a_missing_feed_enable_refuses_a_move_and_pauses_a_running_one() {
         .unwrap();
     assert_eq!(out, Err(ErrorId::NoFeedEnable));
     // Allowed again: the move starts; its enable drops in travel.
-    r.apply_ok(feed(true, true));
+    r.cmd(feed(true, true));
     r.move_to(300.0, 120.0);
     r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
-    r.apply_ok(feed(false, true));
+    r.cmd(feed(false, true));
     r.until(1000, "paused", |r| {
-        r.hyd().state == HydState::FeedStop && r.exec.status()[0].velocity == 0.0
+        r.hyd().state == HydState::FeedStop && r.status().velocity == 0.0
     });
     assert_eq!(
         r.hyd().state.name(r.hyd().positive),
@@ -482,7 +396,7 @@ fn a_missing_feed_enable_refuses_a_move_and_pauses_a_running_one() {
     let s = r.exec.status()[0];
     assert!(s.actual_velocity.abs() < 1.0, "{s:?}");
     assert!(s.motion_job.is_some(), "the move waits");
-    r.apply_ok(feed(true, true));
+    r.cmd(feed(true, true));
     r.run_move(8000);
     let s = r.exec.status()[0];
     assert!((s.actual_position - 300.0).abs() < 0.2, "{s:?}");

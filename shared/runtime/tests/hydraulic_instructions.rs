@@ -7,19 +7,19 @@
 //! sets and clears the homed status; an electric axis refuses them (16#8002).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use tandem_config::{AxisIndex, Cell};
+mod hyd_rig;
+use hyd_rig::Run;
+
+use tandem_config::Cell;
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::hydraulic::generator::HydState;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::action::Action;
-use tandem_motion::objects::axis::{
-    AxisState, AxisStatus, Command, Direction, HydJogMode, HydraulicStatus, StartMode, StopMode,
-};
+use tandem_motion::objects::axis::{AxisState, Command, HydJogMode, StartMode, StopMode};
 use tandem_motion::objects::job::Instruction;
 use tandem_runtime::exec::Executive;
 use tandem_testkit::workspace::root;
 
-const MS: i64 = 1_000_000;
 /// fRefVelo of config/hydraulic.toml.
 const REF_VELO: f64 = 327.06;
 
@@ -28,103 +28,11 @@ fn cell(file: &str) -> Cell {
     tandem_config::parse(file, &s).unwrap()
 }
 
-struct Run<'c> {
-    exec: Executive<'c>,
-    k: i64,
-    log: Vec<u8>,
-}
-
 impl<'c> Run<'c> {
-    /// The axis powered and homed at 100 mm, standing.
-    fn enabled(cell: &'c Cell) -> Self {
-        let mut r = Self {
-            exec: Executive::new(cell, None).unwrap(),
-            k: 0,
-            log: Vec::new(),
-        };
-        r.step();
-        r.cmd(Command::Power {
-            enable: true,
-            start_mode: StartMode::PositionControlled,
-            stop_mode: StopMode::Emergency,
-        });
-        r.cmd(Command::Home {
-            mode: 0,
-            position: 100.0,
-        });
-        r.until(100, "enabled", |r| r.state() == AxisState::Standstill);
-        r
-    }
-
-    fn try_cmd(&mut self, c: Command) -> Result<Option<u32>, ErrorId> {
-        let t = self.k * MS;
-        self.exec
-            .apply_at(t, t, "ram", "test", Action::Command(c), &mut self.log)
-            .unwrap()
-    }
-
-    fn cmd(&mut self, c: Command) {
-        let r = self.try_cmd(c);
-        assert!(r.is_ok(), "{c:?}: {r:?}\n{}", self.log());
-    }
-
-    fn step(&mut self) {
-        self.exec.step(self.k * MS, &mut self.log).unwrap();
-        self.k += 1;
-    }
-
-    fn log(&self) -> String {
-        String::from_utf8_lossy(&self.log).into_owned()
-    }
-
-    fn status(&self) -> AxisStatus {
-        *self.exec.axis(AxisIndex(0)).unwrap().status()
-    }
-
-    fn state(&self) -> AxisState {
-        self.status().state
-    }
-
-    fn hyd(&self) -> HydraulicStatus {
-        self.exec
-            .axis(AxisIndex(0))
-            .unwrap()
-            .hydraulic_status()
-            .unwrap()
-    }
-
-    /// The valve's output word.
-    fn word(&self) -> i16 {
-        self.exec.analog_drive(0).unwrap().link.word
-    }
-
-    fn until(&mut self, max: usize, what: &str, f: impl Fn(&Self) -> bool) {
-        for _ in 0..max {
-            if f(self) {
-                return;
-            }
-            self.step();
-        }
-        panic!("{what}: not within {max} cycles\n{}", self.log());
-    }
-
-    fn move_to(&mut self, position: f64, velocity: f64) -> Result<Option<u32>, ErrorId> {
-        self.try_cmd(Command::MoveAbsolute {
-            position,
-            dynamics: Dynamics {
-                velocity,
-                acceleration: -1.0,
-                deceleration: -1.0,
-                jerk: -1.0,
-            },
-            direction: Direction::Shortest,
-        })
-    }
-
     /// Starts a move to 450 mm at 200 mm/s and steps into its travel phase.
     fn travelling(cell: &'c Cell) -> Self {
         let mut r = Self::enabled(cell);
-        r.move_to(450.0, 200.0).unwrap();
+        r.try_move_to(450.0, 200.0).unwrap();
         r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
         r
     }
@@ -181,7 +89,7 @@ fn emergency_stop_ramps_at_ref_velo_over_ramp_time_then_locks_the_valve_output()
         assert_eq!(r.state(), AxisState::Stopping);
     }
     assert!(r.status().actual_velocity.abs() < 1.0);
-    assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
+    assert_eq!(r.try_move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
     assert_eq!(
         r.try_cmd(Command::RampedStop { ramp_time: 1.0 }),
         Err(ErrorId::AxisLocked)
@@ -195,7 +103,7 @@ fn emergency_stop_ramps_at_ref_velo_over_ramp_time_then_locks_the_valve_output()
     r.step();
     assert_ne!(r.word(), 0);
     assert_eq!(r.state(), AxisState::Standstill);
-    r.move_to(300.0, 100.0).unwrap();
+    r.try_move_to(300.0, 100.0).unwrap();
     r.until(8000, "landed", |r| r.job().is_none());
     assert!((r.status().actual_position - 300.0).abs() < 0.2);
 }
@@ -237,15 +145,15 @@ fn immediate_stop_writes_0_at_once_and_locks() {
         assert_eq!(r.word(), 0);
     }
     assert!(r.status().actual_velocity.abs() < 1.0);
-    assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
+    assert_eq!(r.try_move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
     // Execute FALSE of the other stop does not release it.
     r.cmd(Command::EmergencyStop {
         execute: false,
         ramp_time: 0.0,
     });
-    assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
+    assert_eq!(r.try_move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
     r.cmd(Command::ImmediateStop { execute: false });
-    r.move_to(300.0, 100.0).unwrap();
+    r.try_move_to(300.0, 100.0).unwrap();
     r.until(8000, "landed", |r| r.job().is_none());
     assert!((r.status().actual_position - 300.0).abs() < 0.2);
 }
@@ -266,10 +174,10 @@ fn ramped_stop_is_a_time_ramp_without_a_lock() {
     r.step();
     assert_eq!(r.job(), None);
     assert_eq!(r.state(), AxisState::Standstill);
-    r.move_to(150.0, 100.0).unwrap();
+    r.try_move_to(150.0, 100.0).unwrap();
     r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
     r.cmd(Command::RampedStop { ramp_time: 1.5 });
-    r.move_to(120.0, 100.0).unwrap();
+    r.try_move_to(120.0, 100.0).unwrap();
     assert_eq!(r.job(), Some(Instruction::MoveAbsolute));
     r.until(8000, "landed", |r| r.job().is_none());
     assert!((r.status().actual_position - 120.0).abs() < 0.2);
@@ -378,16 +286,16 @@ fn set_reference_flag_sets_and_clears_homed() {
     r.cmd(Command::SetReferenceFlag {
         reference_flag: false,
     });
-    assert_eq!(r.move_to(200.0, 100.0), Err(ErrorId::NotHomed));
+    assert_eq!(r.try_move_to(200.0, 100.0), Err(ErrorId::NotHomed));
     r.cmd(Command::HydSetPosition {
         position: 10.0,
         relative: false,
     });
-    assert_eq!(r.move_to(200.0, 100.0), Err(ErrorId::NotHomed));
+    assert_eq!(r.try_move_to(200.0, 100.0), Err(ErrorId::NotHomed));
     r.cmd(Command::SetReferenceFlag {
         reference_flag: true,
     });
-    r.move_to(60.0, 100.0).unwrap();
+    r.try_move_to(60.0, 100.0).unwrap();
     r.until(8000, "landed", |r| r.job().is_none());
     assert!((r.status().actual_position - 60.0).abs() < 0.2);
 }
@@ -408,7 +316,7 @@ fn reset_and_stop_stops_with_its_deceleration_and_is_done_at_rest() {
         assert_eq!(r.job(), Some(Instruction::ResetAndStop));
         r.step();
         assert_eq!(r.state(), AxisState::Stopping);
-        assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
+        assert_eq!(r.try_move_to(300.0, 100.0), Err(ErrorId::AxisLocked));
         let steps = r.ramp_down(5000);
         for d in &steps[..steps.len() - 1] {
             assert!((d - per_cycle).abs() < 1e-9, "{d} per cycle");
@@ -417,7 +325,7 @@ fn reset_and_stop_stops_with_its_deceleration_and_is_done_at_rest() {
         assert_eq!(r.job(), None);
         assert_eq!(r.state(), AxisState::Standstill);
         assert_ne!(r.word(), 0, "the position controller acts");
-        r.move_to(300.0, 100.0).unwrap();
+        r.try_move_to(300.0, 100.0).unwrap();
         r.until(8000, "landed", |r| r.job().is_none());
         r.cmd(Command::ResetAndStop {
             deceleration: 0.0,
@@ -554,10 +462,10 @@ fn reset_and_stop_acknowledges_an_alarm() {
     );
     let cell = tandem_config::parse("hydraulic.toml", &s).unwrap();
     let mut r = Run::enabled(&cell);
-    r.move_to(450.0, 200.0).unwrap();
+    r.try_move_to(450.0, 200.0).unwrap();
     r.until(3000, "alarm", |r| r.state() == AxisState::ErrorStop);
     assert_ne!(r.status().error_word, 0);
-    assert_eq!(r.move_to(300.0, 100.0), Err(ErrorId::NotEnabled));
+    assert_eq!(r.try_move_to(300.0, 100.0), Err(ErrorId::NotEnabled));
     r.until(3000, "stood", |r| r.status().actual_velocity.abs() < 0.5);
     r.cmd(Command::ResetAndStop {
         deceleration: 0.0,
