@@ -941,9 +941,80 @@ fn buffered_move(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
     }))
 }
 
+/// The Beckhoff hydraulic library's single-axis instructions (`*_BkPlcMc`); `None` for another.
+fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
+    Ok(Some(match a.spec.name {
+        "MC_Power_BkPlcMc" => Command::HydPower {
+            enable: a.flag("enable")?,
+            enable_positive: a.flag("enable_positive")?,
+            enable_negative: a.flag("enable_negative")?,
+        },
+        "MC_AxCtrlPressure_BkPlcMc" => Command::PressureControl {
+            enable: a.flag("enable")?,
+            set_value: a.num("set_value")?,
+            kp: a.num("kp")?,
+            tn: a.num("tn")?,
+            preset: a.num("preset")?,
+            windup_limit: a.num("windup_limit")?,
+            force: a.flag("force")?,
+        },
+        "MC_AxCtrlAutoZero_BkPlcMc" => Command::AutoZero {
+            enable: a.flag("enable")?,
+            params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {
+                enable_on_moving: a.flag("enable_on_moving")?,
+                offset_limit: a.num("offset_limit")?,
+                tn: a.num("tn")?,
+                threshold: a.num("threshold")?,
+                filter: a.num("filter")?,
+            },
+        },
+        "MC_EmergencyStop_BkPlcMc" => Command::EmergencyStop {
+            execute: a.flag("execute")?,
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_ImmediateStop_BkPlcMc" => Command::ImmediateStop {
+            execute: a.flag("execute")?,
+        },
+        "MC_RampedStop_BkPlcMc" => Command::RampedStop {
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_ResetAndStop_BkPlcMc" => Command::ResetAndStop {
+            deceleration: a.num("deceleration")?,
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_MoveJog_BkPlcMc" => Command::HydMoveJog {
+            forward: a.flag("jog_forward")?,
+            backward: a.flag("jog_backwards")?,
+            mode: a.choice(
+                "mode",
+                &[
+                    (0, HydJogMode::StandardSlow),
+                    (1, HydJogMode::StandardFast),
+                    (2, HydJogMode::Continuous),
+                    (3, HydJogMode::Inching),
+                ],
+                "0 STANDARD_SLOW, 1 STANDARD_FAST, 2 CONTINUOUS, 3 INCHING",
+            )?,
+            position: a.num("position")?,
+            dynamics: a.dynamics("velocity")?,
+        },
+        "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
+            position: a.num("position")?,
+            relative: a.flag("mode")?,
+        },
+        "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
+            reference_flag: a.flag("reference_flag")?,
+        },
+        _ => return Ok(None),
+    }))
+}
+
 /// The single-axis instructions (power, homing, stop, moves, monitoring).
 fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
     if let Some(c) = buffered_move(a)? {
+        return Ok(c);
+    }
+    if let Some(c) = hydraulic_command(a)? {
         return Ok(c);
     }
     let name = a.spec.name;
@@ -1005,67 +1076,6 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
         },
         "MC_SetOverride" => Command::SetOverride {
             velocity: a.num("velocity")?,
-        },
-        "MC_Power_BkPlcMc" => Command::HydPower {
-            enable: a.flag("enable")?,
-            enable_positive: a.flag("enable_positive")?,
-            enable_negative: a.flag("enable_negative")?,
-        },
-        "MC_AxCtrlPressure_BkPlcMc" => Command::PressureControl {
-            enable: a.flag("enable")?,
-            set_value: a.num("set_value")?,
-            kp: a.num("kp")?,
-            tn: a.num("tn")?,
-            preset: a.num("preset")?,
-            windup_limit: a.num("windup_limit")?,
-            force: a.flag("force")?,
-        },
-        "MC_AxCtrlAutoZero_BkPlcMc" => Command::AutoZero {
-            enable: a.flag("enable")?,
-            params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {
-                enable_on_moving: a.flag("enable_on_moving")?,
-                offset_limit: a.num("offset_limit")?,
-                tn: a.num("tn")?,
-                threshold: a.num("threshold")?,
-                filter: a.num("filter")?,
-            },
-        },
-        "MC_EmergencyStop_BkPlcMc" => Command::EmergencyStop {
-            execute: a.flag("execute")?,
-            ramp_time: a.num("ramp_time")?,
-        },
-        "MC_ImmediateStop_BkPlcMc" => Command::ImmediateStop {
-            execute: a.flag("execute")?,
-        },
-        "MC_RampedStop_BkPlcMc" => Command::RampedStop {
-            ramp_time: a.num("ramp_time")?,
-        },
-        "MC_ResetAndStop_BkPlcMc" => Command::ResetAndStop {
-            deceleration: a.num("deceleration")?,
-            ramp_time: a.num("ramp_time")?,
-        },
-        "MC_MoveJog_BkPlcMc" => Command::HydMoveJog {
-            forward: a.flag("jog_forward")?,
-            backward: a.flag("jog_backwards")?,
-            mode: a.choice(
-                "mode",
-                &[
-                    (0, HydJogMode::StandardSlow),
-                    (1, HydJogMode::StandardFast),
-                    (2, HydJogMode::Continuous),
-                    (3, HydJogMode::Inching),
-                ],
-                "0 STANDARD_SLOW, 1 STANDARD_FAST, 2 CONTINUOUS, 3 INCHING",
-            )?,
-            position: a.num("position")?,
-            dynamics: a.dynamics("velocity")?,
-        },
-        "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
-            position: a.num("position")?,
-            relative: a.flag("mode")?,
-        },
-        "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
-            reference_flag: a.flag("reference_flag")?,
         },
         "MC_MotionInPosition" => Command::MotionInPosition {
             enable: a.flag("enable")?,

@@ -16,7 +16,7 @@
 //!
 //! [`DriveOutputs::position_controlled`]: crate::plant::link::DriveOutputs::position_controlled
 
-use super::{Axis, Goal};
+use super::{Axis, Command, Goal, StartMode, StopMode};
 use crate::catalog::error_id::ErrorId;
 use crate::hydraulic::auto_zero::{AutoZero, AutoZeroInput, AutoZeroParams, AutoZeroStatus};
 use crate::hydraulic::controller::HydControllerParams;
@@ -449,6 +449,46 @@ impl Axis {
                 locked: h.cmds.outputs_locked(),
             },
             None => HydValveOutputs::default(),
+        }
+    }
+
+    /// MC_Power_BkPlcMc, MC_AxCtrlPressure_BkPlcMc and MC_AxCtrlAutoZero_BkPlcMc (each refuses
+    /// an electric axis with its own code); any other command is refused (16#8002).
+    pub(super) fn apply_hyd_control(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
+        match *cmd {
+            Command::HydPower {
+                enable,
+                enable_positive,
+                enable_negative,
+            } => {
+                self.hyd_set_feed_enables(enable_positive, enable_negative)?;
+                Ok(self.cmd_power(enable, StartMode::PositionControlled, StopMode::Emergency))
+            }
+            Command::PressureControl {
+                enable,
+                set_value,
+                kp,
+                tn,
+                preset,
+                windup_limit,
+                force,
+            } => self.cmd_pressure_control(
+                enable,
+                set_value,
+                crate::hydraulic::pressure::PressureParams {
+                    kp,
+                    tn,
+                    preset,
+                    windup_limit,
+                    reading: if force {
+                        crate::hydraulic::pressure::PressureReading::Force
+                    } else {
+                        crate::hydraulic::pressure::PressureReading::Pressure
+                    },
+                },
+            ),
+            Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
+            _ => Err(ErrorId::IllegalObject),
         }
     }
 }

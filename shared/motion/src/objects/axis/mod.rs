@@ -1061,38 +1061,9 @@ impl Axis {
             | Command::Offset { .. }
             | Command::Phasing { .. } => self.apply_sync(cmd),
             Command::SetOverride { velocity } => self.cmd_set_override(velocity),
-            Command::HydPower {
-                enable,
-                enable_positive,
-                enable_negative,
-            } => {
-                self.hyd_set_feed_enables(enable_positive, enable_negative)?;
-                Ok(self.cmd_power(enable, StartMode::PositionControlled, StopMode::Emergency))
-            }
-            Command::PressureControl {
-                enable,
-                set_value,
-                kp,
-                tn,
-                preset,
-                windup_limit,
-                force,
-            } => self.cmd_pressure_control(
-                enable,
-                set_value,
-                crate::hydraulic::pressure::PressureParams {
-                    kp,
-                    tn,
-                    preset,
-                    windup_limit,
-                    reading: if force {
-                        crate::hydraulic::pressure::PressureReading::Force
-                    } else {
-                        crate::hydraulic::pressure::PressureReading::Pressure
-                    },
-                },
-            ),
-            Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
+            Command::HydPower { .. }
+            | Command::PressureControl { .. }
+            | Command::AutoZero { .. } => self.apply_hyd_control(cmd),
             Command::EmergencyStop { .. }
             | Command::ImmediateStop { .. }
             | Command::RampedStop { .. }
@@ -1100,6 +1071,15 @@ impl Axis {
             | Command::SetReferenceFlag { .. }
             | Command::ResetAndStop { .. }
             | Command::HydMoveJog { .. } => self.apply_hyd_command(cmd),
+            Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
+                self.apply_motion_in(cmd)
+            }
+        }
+    }
+
+    /// MC_MotionInPosition and MC_MotionInVelocity; any other command is refused (16#8002).
+    fn apply_motion_in(&mut self, cmd: &Command) -> Result<JobId, ErrorId> {
+        match *cmd {
             Command::MotionInPosition {
                 enable,
                 position,
@@ -1129,6 +1109,7 @@ impl Axis {
                 acceleration,
                 position_controlled,
             ),
+            _ => Err(ErrorId::IllegalObject),
         }
     }
 
