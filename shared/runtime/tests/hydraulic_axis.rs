@@ -741,3 +741,44 @@ fn bad_valve_output_settings_are_refused_naming_the_key() {
         assert!(e.to_string().contains(key), "{to}: {e}");
     }
 }
+
+/// fReposDistance on the simulated cylinder: without a position controller at standstill
+/// (fLagAmp 0) a valve whose offset is a little beyond its overlap lets the ram drift away
+/// from its target after the move; with fReposDistance 1 mm the generator starts again to the
+/// same target whenever the drift exceeds it, and the ram stays near its target.
+#[test]
+fn automatic_repositioning_brings_a_drifting_ram_back_to_its_target() {
+    let drifting = [
+        ("offset = 0.01 ", "offset = 0.062 "),
+        ("fLagAmp = 50.0", "fLagAmp = 0.0"),
+    ];
+    let run = |repos: &str| {
+        let mut edits = drifting.to_vec();
+        edits.push(("fMonTargetFilter = 0.2", repos));
+        let cell = cell(&edits);
+        let mut r = Run::enabled(&cell);
+        r.move_to(300.0, 120.0);
+        r.run_move(8000);
+        let (mut starts, mut worst, mut idle) = (0, 0.0_f64, true);
+        for _ in 0..8000 {
+            r.step();
+            let now_idle = r.in_state(HydState::Idle);
+            if idle && !now_idle {
+                starts += 1;
+            }
+            idle = now_idle;
+            worst = worst.max((r.status().actual_position - 300.0).abs());
+        }
+        (starts, worst)
+    };
+    let (starts, worst) = run("fMonTargetFilter = 0.2\nfReposDistance = 1.0");
+    assert!(
+        starts >= 1 && worst < 1.5,
+        "{starts} starts, {worst} mm away"
+    );
+    let (starts, worst) = run("fMonTargetFilter = 0.2");
+    assert!(
+        starts == 0 && worst > 3.0,
+        "{starts} starts, {worst} mm away"
+    );
+}
