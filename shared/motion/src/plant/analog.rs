@@ -613,6 +613,10 @@ pub struct AnalogConnection {
     /// The simulated plant's switches (physical), read as digital inputs at the sample.
     plant: Plant,
     status: AnalogStatus,
+    /// A hydraulic axis: the set position of the last command, the reference of its following
+    /// error (the library's lag `fSetPos - fActPos`; the speed controller's balancing filter
+    /// does not run for it).
+    hyd_set_position: f64,
 }
 
 impl AnalogConnection {
@@ -636,6 +640,7 @@ impl AnalogConnection {
             enable_do: false,
             plant,
             status: AnalogStatus::default(),
+            hyd_set_position: p0,
         })
     }
 
@@ -722,7 +727,11 @@ impl AnalogConnection {
             actual: Actual {
                 p,
                 v,
-                balanced: self.controller.balanced(),
+                balanced: if self.hydraulic.is_some() {
+                    self.hyd_set_position
+                } else {
+                    self.controller.balanced()
+                },
             },
             // The simulated plant latches the cam's edge and the zero mark exactly, as an
             // encoder's or a drive's measuring input would (homing modes 2, 3, 5, 8, 10).
@@ -792,6 +801,7 @@ impl AnalogConnection {
     fn hydraulic_output(&mut self, active: bool, out: &DriveOutputs) -> ControllerOutput {
         let dt = self.params.controller.cycle();
         let actual = self.actual;
+        self.hyd_set_position = out.position;
         let Some(h) = self.hydraulic.as_mut() else {
             return ControllerOutput::default();
         };
