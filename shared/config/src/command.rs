@@ -235,6 +235,15 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         params: &[("position", None), ("mode", Some(Value::Bool(false)))],
     },
     InstructionSpec {
+        name: "MC_MoveJoySticked_BkPlcMc",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("joystick", Some(Value::Num(0.0))),
+            ("acceleration", Some(Value::Num(0.0))),
+            ("deceleration", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
         name: "MC_SetReferenceFlag_BkPlcMc",
         params: &[("reference_flag", Some(Value::Bool(true)))],
     },
@@ -1001,6 +1010,12 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
         "MC_SetPosition_BkPlcMc" => Command::HydSetPosition {
             position: a.num("position")?,
             relative: a.flag("mode")?,
+        },
+        "MC_MoveJoySticked_BkPlcMc" => Command::MoveJoySticked {
+            execute: a.flag("execute")?,
+            joystick: a.num("joystick")?,
+            acceleration: a.num("acceleration")?,
+            deceleration: a.num("deceleration")?,
         },
         "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
             reference_flag: a.flag("reference_flag")?,

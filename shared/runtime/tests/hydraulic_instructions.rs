@@ -226,6 +226,12 @@ fn refusals_of_the_library_instructions() {
             deceleration: 0.0,
             ramp_time: 0.0,
         },
+        Command::MoveJoySticked {
+            execute: true,
+            joystick: 0.1,
+            acceleration: 0.0,
+            deceleration: 0.0,
+        },
     ] {
         let out = exec
             .apply_at(0, 0, "slide", "test", Action::Command(c), &mut log)
@@ -475,4 +481,93 @@ fn reset_and_stop_acknowledges_an_alarm() {
     r.step();
     assert_eq!(r.status().error_word, 0);
     assert_eq!(r.state(), AxisState::Disabled);
+}
+
+impl Run<'_> {
+    fn joystick(&mut self, execute: bool, joystick: f64) -> Result<Option<u32>, ErrorId> {
+        self.try_cmd(Command::MoveJoySticked {
+            execute,
+            joystick,
+            acceleration: 0.0,
+            deceleration: 0.0,
+        })
+    }
+}
+
+/// MC_MoveJoySticked_BkPlcMc: the set velocity ramps at fMaxAcc (400 mm/s², 0.4 mm/s a cycle)
+/// to JoyStick · fRefVelo, follows a new JoyStick through zero, the ram follows in closed loop,
+/// the axis shows SynchronizedMotion; Execute = FALSE stops with fRefVelo / fStopRamp and the
+/// job is Done at standstill.
+#[test]
+fn move_joysticked_ramps_to_the_joystick_velocity_and_stops_with_the_stop_ramp() {
+    let cell = cell("hydraulic.toml");
+    let mut r = Run::enabled(&cell);
+    r.joystick(true, 0.3).unwrap();
+    let target = 0.3 * REF_VELO;
+    let mut last = 0.0;
+    for _ in 0..300 {
+        r.step();
+        let v = r.status().velocity;
+        // The ramp starts the cycle after the command.
+        assert!(
+            (v - last - 0.4).abs() < 1e-9 || (v - target).abs() < 1e-9 || v == 0.0,
+            "{last} -> {v}"
+        );
+        last = v;
+    }
+    assert_eq!(last, target);
+    assert_eq!(r.state(), AxisState::SynchronizedMotion);
+    assert_eq!(r.job(), Some(Instruction::MoveJoySticked));
+    for _ in 0..500 {
+        r.step();
+    }
+    let s = r.status();
+    assert!((s.actual_velocity - target).abs() < 2.0, "{s:?}");
+    // Another JoyStick: down at 0.4 mm/s a cycle through 0 to -0.2 · fRefVelo.
+    r.joystick(true, -0.2).unwrap();
+    r.until(1000, "reversed", |r| r.status().velocity == -0.2 * REF_VELO);
+    assert_eq!(r.job(), Some(Instruction::MoveJoySticked));
+    // Execute = FALSE: the stop ramp, 327.06 mm/s² (0.32706 mm/s a cycle), then Done.
+    r.joystick(false, 0.0).unwrap();
+    let mut last = r.status().velocity;
+    while r.job().is_some() {
+        r.step();
+        let v = r.status().velocity;
+        assert!((v - last).abs() <= REF_VELO * 1e-3 + 1e-9, "{last} -> {v}");
+        last = v;
+    }
+    assert_eq!((last, r.state()), (0.0, AxisState::Standstill));
+    assert!(r.log().contains("MC_MoveJoySticked_BkPlcMc"), "{}", r.log());
+}
+
+/// Towards an active software limit the joystick's velocity is limited by the remaining
+/// distance: the set position stops at the limit, no alarm. Bad inputs are refused (an
+/// electric axis is refused with the other instructions above).
+#[test]
+fn move_joysticked_stops_at_the_software_limit_and_refuses_bad_inputs() {
+    let src = std::fs::read_to_string(root().join("config/hydraulic.toml")).unwrap();
+    let src = format!("{src}\n[axes.ram.sw_limits]\nmin = 50.0\nmax = 180.0\n");
+    let cell = tandem_config::parse("hydraulic.toml", &src).unwrap();
+    let mut r = Run::enabled(&cell);
+    r.joystick(true, 0.5).unwrap();
+    for _ in 0..3000 {
+        r.step();
+        let s = r.status();
+        assert!(s.position <= 180.0 && s.error_word == 0, "{s:?}");
+    }
+    let s = r.status();
+    assert!(
+        (s.position - 180.0).abs() < 1e-6 && s.velocity.abs() < 1e-3,
+        "{s:?}"
+    );
+    assert_eq!(r.joystick(true, 1.5), Err(ErrorId::IllegalVelocity));
+    assert_eq!(
+        r.try_cmd(Command::MoveJoySticked {
+            execute: true,
+            joystick: 0.1,
+            acceleration: -1.0,
+            deceleration: 0.0,
+        }),
+        Err(ErrorId::IllegalAcceleration)
+    );
 }

@@ -62,6 +62,8 @@ pub enum Instruction {
     ResetAndStop,
     /// `MC_MoveJog_BkPlcMc` (Beckhoff hydraulic library): jog in its four modes.
     HydMoveJog,
+    /// `MC_MoveJoySticked_BkPlcMc` (Beckhoff hydraulic library): velocity from a joystick.
+    MoveJoySticked,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -116,6 +118,7 @@ impl Instruction {
             Self::SetReferenceFlag => "MC_SetReferenceFlag_BkPlcMc",
             Self::ResetAndStop => "MC_ResetAndStop_BkPlcMc",
             Self::HydMoveJog => "MC_MoveJog_BkPlcMc",
+            Self::MoveJoySticked => "MC_MoveJoySticked_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

@@ -538,6 +538,19 @@ pub enum Command {
         /// the continuous and inching modes).
         dynamics: Dynamics,
     },
+    /// `MC_MoveJoySticked_BkPlcMc` (Beckhoff hydraulic library, 4.2.14): a motion at
+    /// `joystick · fRefVelo`, sent again with the current inputs; `execute = false` stops it.
+    #[doc(alias = "MC_MoveJoySticked_BkPlcMc")]
+    MoveJoySticked {
+        /// `Execute`.
+        execute: bool,
+        /// `JoyStick` (±1.0).
+        joystick: f64,
+        /// `Acceleration` (mm/s², 0: `fMaxAcc`).
+        acceleration: f64,
+        /// `Deceleration` (mm/s², 0: `fMaxAcc`).
+        deceleration: f64,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

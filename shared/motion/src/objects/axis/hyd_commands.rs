@@ -71,6 +71,8 @@ pub(super) struct HydCommands {
     /// MC_MoveJog_BkPlcMc's inputs of the last command (for the rising edges).
     jog_inputs: (bool, bool),
     jog: Option<JogRun>,
+    /// A running MC_MoveJoySticked_BkPlcMc.
+    pub(super) joystick: Option<super::hyd_joystick::JoyRun>,
 }
 
 impl HydCommands {
@@ -81,6 +83,7 @@ impl HydCommands {
             jog_velo,
             jog_inputs: (false, false),
             jog: None,
+            joystick: None,
         }
     }
 
@@ -118,6 +121,12 @@ impl Axis {
                 position,
                 dynamics,
             } => self.cmd_hyd_jog(forward, backward, mode, position, &dynamics),
+            Command::MoveJoySticked {
+                execute,
+                joystick,
+                acceleration,
+                deceleration,
+            } => self.cmd_joystick(execute, joystick, acceleration, deceleration),
             Command::SetReferenceFlag { reference_flag } => {
                 Ok(self.instant_job(Instruction::SetReferenceFlag, |ax| {
                     ax.homed = reference_flag;
@@ -301,6 +310,7 @@ impl Axis {
         if let Some(l) = h.cmds.lock {
             self.hyd_lock_cycle(l);
         }
+        self.hyd_joystick_cycle();
         let Some(m) = self.main else {
             return;
         };

@@ -11,6 +11,7 @@ mod buffer;
 mod command;
 mod config;
 mod hyd_commands;
+mod hyd_joystick;
 mod hydraulic;
 mod step;
 mod sync;
@@ -1070,7 +1071,8 @@ impl Axis {
             | Command::HydSetPosition { .. }
             | Command::SetReferenceFlag { .. }
             | Command::ResetAndStop { .. }
-            | Command::HydMoveJog { .. } => self.apply_hyd_command(cmd),
+            | Command::HydMoveJog { .. }
+            | Command::MoveJoySticked { .. } => self.apply_hyd_command(cmd),
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
