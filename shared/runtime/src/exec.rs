@@ -184,6 +184,9 @@ struct LeaderSource {
 struct LeaderRead {
     id: LeaderId,
     source: Option<LeaderSource>,
+    /// The value is that of the read before it in the plan (the same leader read directly,
+    /// which has not stepped since): known when planning, so the step compares no sources.
+    again: bool,
 }
 
 /// One owned axis in the step order, with the leaders it reads: `reads` entries of
@@ -1275,9 +1278,9 @@ impl<'c> Executive<'c> {
         }
         // The plan is read in place while the axes step (taken out, put back below).
         let mut plan = std::mem::take(&mut self.plan);
-        // The last leader read directly (without a buffer) and its value: the followers of one
-        // leader come one after another, and the value changes only when the leader steps.
-        let mut last: Option<(LeaderSource, Option<LeadingValue>)> = None;
+        // The value of the last leader read directly (without a buffer): the followers of one
+        // leader come one after another and read it again (`LeaderRead::again`).
+        let mut last: Option<LeadingValue> = None;
         let mut holds = true;
         // Every axis is due when every node is (one node, or the cycles meet).
         let all_due = self.due.iter().all(|d| *d);
@@ -1290,14 +1293,11 @@ impl<'c> Executive<'c> {
             };
             for read in reads {
                 let lv = match read.source {
-                    Some(src) if src.buffer.is_none() => match last {
-                        Some((s, v)) if s == src => v,
-                        _ => {
-                            let v = self.leading_value(src, t);
-                            last = Some((src, v));
-                            v
-                        }
-                    },
+                    _ if read.again => last,
+                    Some(src) if src.buffer.is_none() => {
+                        last = self.leading_value(src, t);
+                        last
+                    }
                     Some(src) => self.leading_value(src, t),
                     None => None,
                 };
@@ -1307,9 +1307,6 @@ impl<'c> Executive<'c> {
             }
             if all_due || self.due[self.node_of[i]] {
                 holds &= self.step_axis(i, t, &plan);
-                if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
-                    last = None;
-                }
             } else if let Some(stale) = self.stale.get_mut(i) {
                 // Not stepped: its status is copied when read (a command may have changed it).
                 *stale = true;
@@ -1361,6 +1358,8 @@ impl<'c> Executive<'c> {
         plan.leaders.extend(self.axes.iter().map(Axis::leaders));
         let mut taken = std::mem::take(&mut plan.taken);
         taken.fill(false);
+        // The last leader read directly, as the step will see it (`LeaderRead::again`).
+        let mut last: Option<LeaderSource> = None;
         for _pass in 0..=n_axes {
             let mut progress = false;
             for i in 0..n_axes {
@@ -1378,11 +1377,18 @@ impl<'c> Executive<'c> {
                 // (Within the capacity of two reads per axis: no allocation. Indices of axes
                 // and reads fit in u32: a cell's axes are counted in thousands.)
                 let first = plan.reads.len() as u32;
-                plan.reads
-                    .extend(needs.iter().flatten().map(|&id| LeaderRead {
-                        id,
-                        source: cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
-                    }));
+                plan.reads.extend(needs.iter().flatten().map(|&id| {
+                    let source = cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j));
+                    let again = source.is_some_and(|s| s.buffer.is_none() && last == Some(s));
+                    if source.is_some_and(|s| s.buffer.is_none()) {
+                        last = source;
+                    }
+                    LeaderRead { id, source, again }
+                }));
+                // The axis steps after its reads: a value read from it is new after that.
+                if last.is_some_and(|s| s.leader == Leader::Axis(AxisIndex(i))) {
+                    last = None;
+                }
                 plan.order.push(Planned {
                     axis: i as u32,
                     first,
