@@ -1306,7 +1306,10 @@ impl<'c> Executive<'c> {
                 }
             }
             if all_due || self.due[self.node_of[i]] {
-                holds &= self.step_axis(i, t, &plan);
+                // An axis planned without leaders has none after its step: a step ends a
+                // synchronous job or lets the pending one take over, only a command starts one
+                // (and the plan notes it: `StepPlan::note`).
+                holds &= self.step_axis(i, t, (n != 0).then_some(&plan));
             } else if let Some(stale) = self.stale.get_mut(i) {
                 // Not stepped: its status is copied when read (a command may have changed it).
                 *stale = true;
@@ -1316,7 +1319,7 @@ impl<'c> Executive<'c> {
         // axis then runs without its leading value and raises "leader missing".
         for &i in &plan.unreached {
             if all_due || self.due[self.node_of[i]] {
-                holds &= self.step_axis(i, t, &plan);
+                holds &= self.step_axis(i, t, Some(&plan));
             } else if let Some(stale) = self.stale.get_mut(i) {
                 *stale = true;
             }
@@ -1328,11 +1331,12 @@ impl<'c> Executive<'c> {
 
     /// Steps owned axis `i` at `t` and notes what the step changed: job events or alarms to
     /// look at, its status (copied now when [`Executive::want_status`] asked, else stale: copied
-    /// when read). Whether the axis still has the leaders `plan` was made with.
+    /// when read). Whether the axis still has the leaders `plan` was made with (not looked at
+    /// without a plan).
     // Inlined into both loops of `step_axes` (called out of line it costs 20 instructions per
     // axis more: the loops' state spills around the call).
     #[inline(always)]
-    fn step_axis(&mut self, i: usize, t: i64, plan: &StepPlan) -> bool {
+    fn step_axis(&mut self, i: usize, t: i64, plan: Option<&StepPlan>) -> bool {
         let Some(axis) = self.axes.get_mut(i) else {
             return true;
         };
@@ -1342,7 +1346,7 @@ impl<'c> Executive<'c> {
             self.status[i] = axis.status_value();
         }
         self.stale[i] = !self.copy_status;
-        plan.planned_with(i, axis)
+        plan.is_none_or(|plan| plan.planned_with(i, axis))
     }
 
     /// Plans the order of the owned axes from their current leaders: passes over the axes in
