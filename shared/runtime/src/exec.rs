@@ -184,6 +184,9 @@ struct LeaderSource {
 struct LeaderRead {
     id: LeaderId,
     source: Option<LeaderSource>,
+    /// The value is that of the read before it in the plan (the same leader read directly,
+    /// which has not stepped since): known when planning, so the step compares no sources.
+    again: bool,
 }
 
 /// One owned axis in the step order, with the leaders it reads: `reads` entries of
@@ -1275,9 +1278,9 @@ impl<'c> Executive<'c> {
         }
         // The plan is read in place while the axes step (taken out, put back below).
         let mut plan = std::mem::take(&mut self.plan);
-        // The last leader read directly (without a buffer) and its value: the followers of one
-        // leader come one after another, and the value changes only when the leader steps.
-        let mut last: Option<(LeaderSource, Option<LeadingValue>)> = None;
+        // The value of the last leader read directly (without a buffer): the followers of one
+        // leader come one after another and read it again (`LeaderRead::again`).
+        let mut last: Option<LeadingValue> = None;
         let mut holds = true;
         // Every axis is due when every node is (one node, or the cycles meet).
         let all_due = self.due.iter().all(|d| *d);
@@ -1290,14 +1293,11 @@ impl<'c> Executive<'c> {
             };
             for read in reads {
                 let lv = match read.source {
-                    Some(src) if src.buffer.is_none() => match last {
-                        Some((s, v)) if s == src => v,
-                        _ => {
-                            let v = self.leading_value(src, t);
-                            last = Some((src, v));
-                            v
-                        }
-                    },
+                    _ if read.again => last,
+                    Some(src) if src.buffer.is_none() => {
+                        last = self.leading_value(src, t);
+                        last
+                    }
                     Some(src) => self.leading_value(src, t),
                     None => None,
                 };
@@ -1306,10 +1306,10 @@ impl<'c> Executive<'c> {
                 }
             }
             if all_due || self.due[self.node_of[i]] {
-                holds &= self.step_axis(i, t, &plan);
-                if last.is_some_and(|(s, _)| s.leader == Leader::Axis(AxisIndex(i))) {
-                    last = None;
-                }
+                // An axis planned without leaders has none after its step: a step ends a
+                // synchronous job or lets the pending one take over, only a command starts one
+                // (and the plan notes it: `StepPlan::note`).
+                holds &= self.step_axis(i, t, (n != 0).then_some(&plan));
             } else if let Some(stale) = self.stale.get_mut(i) {
                 // Not stepped: its status is copied when read (a command may have changed it).
                 *stale = true;
@@ -1319,7 +1319,7 @@ impl<'c> Executive<'c> {
         // axis then runs without its leading value and raises "leader missing".
         for &i in &plan.unreached {
             if all_due || self.due[self.node_of[i]] {
-                holds &= self.step_axis(i, t, &plan);
+                holds &= self.step_axis(i, t, Some(&plan));
             } else if let Some(stale) = self.stale.get_mut(i) {
                 *stale = true;
             }
@@ -1331,11 +1331,12 @@ impl<'c> Executive<'c> {
 
     /// Steps owned axis `i` at `t` and notes what the step changed: job events or alarms to
     /// look at, its status (copied now when [`Executive::want_status`] asked, else stale: copied
-    /// when read). Whether the axis still has the leaders `plan` was made with.
+    /// when read). Whether the axis still has the leaders `plan` was made with (not looked at
+    /// without a plan).
     // Inlined into both loops of `step_axes` (called out of line it costs 20 instructions per
     // axis more: the loops' state spills around the call).
     #[inline(always)]
-    fn step_axis(&mut self, i: usize, t: i64, plan: &StepPlan) -> bool {
+    fn step_axis(&mut self, i: usize, t: i64, plan: Option<&StepPlan>) -> bool {
         let Some(axis) = self.axes.get_mut(i) else {
             return true;
         };
@@ -1345,7 +1346,7 @@ impl<'c> Executive<'c> {
             self.status[i] = axis.status_value();
         }
         self.stale[i] = !self.copy_status;
-        plan.planned_with(i, axis)
+        plan.is_none_or(|plan| plan.planned_with(i, axis))
     }
 
     /// Plans the order of the owned axes from their current leaders: passes over the axes in
@@ -1361,6 +1362,8 @@ impl<'c> Executive<'c> {
         plan.leaders.extend(self.axes.iter().map(Axis::leaders));
         let mut taken = std::mem::take(&mut plan.taken);
         taken.fill(false);
+        // The last leader read directly, as the step will see it (`LeaderRead::again`).
+        let mut last: Option<LeaderSource> = None;
         for _pass in 0..=n_axes {
             let mut progress = false;
             for i in 0..n_axes {
@@ -1378,11 +1381,18 @@ impl<'c> Executive<'c> {
                 // (Within the capacity of two reads per axis: no allocation. Indices of axes
                 // and reads fit in u32: a cell's axes are counted in thousands.)
                 let first = plan.reads.len() as u32;
-                plan.reads
-                    .extend(needs.iter().flatten().map(|&id| LeaderRead {
-                        id,
-                        source: cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j)),
-                    }));
+                plan.reads.extend(needs.iter().flatten().map(|&id| {
+                    let source = cell.leader(id).map(|j| self.leader_source(AxisIndex(i), j));
+                    let again = source.is_some_and(|s| s.buffer.is_none() && last == Some(s));
+                    if source.is_some_and(|s| s.buffer.is_none()) {
+                        last = source;
+                    }
+                    LeaderRead { id, source, again }
+                }));
+                // The axis steps after its reads: a value read from it is new after that.
+                if last.is_some_and(|s| s.leader == Leader::Axis(AxisIndex(i))) {
+                    last = None;
+                }
                 plan.order.push(Planned {
                     axis: i as u32,
                     first,

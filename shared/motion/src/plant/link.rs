@@ -178,6 +178,9 @@ pub struct SimPlant {
     inputs: SwitchInputs,
     /// The reference cam's level at the last sample (for an input signal's edge).
     cam_level: bool,
+    /// Neither the plant nor an input signal gives a switch or a mark: every sample's
+    /// signals are all off (set with the plant and the inputs, so a sample skips the sensors).
+    no_sensors: bool,
 }
 
 impl SimPlant {
@@ -192,16 +195,23 @@ impl SimPlant {
     ) -> Self {
         Self {
             drive: SimDrive::new(model, cycle, stop_deceleration, p0),
-            plant,
             last: p0,
             inputs: SwitchInputs::default(),
             cam_level: false,
+            no_sensors: Self::without_sensors(&plant, &SwitchInputs::default()),
+            plant,
         }
+    }
+
+    /// Whether `plant` and `inputs` give no switch and no mark at all.
+    fn without_sensors(plant: &Plant, inputs: &SwitchInputs) -> bool {
+        *plant == Plant::default() && *inputs == SwitchInputs::default()
     }
 
     /// Takes the switches given as input signals for the coming samples.
     pub fn set_switch_inputs(&mut self, s: SwitchInputs) {
         self.inputs = s;
+        self.no_sensors = Self::without_sensors(&self.plant, &s);
     }
 
     /// Whether the reference cam is active now: its input signal, or the plant's cam at the
@@ -228,6 +238,16 @@ impl SimPlant {
         let actual = self.drive.actual();
         let (prev, p) = (self.last, actual.p);
         self.last = p;
+        if self.no_sensors {
+            // No switch and no mark: what `of_plant` gives for a plant without sensors.
+            self.cam_level = false;
+            return DriveInputs {
+                actual,
+                signals: AxisSignals::default(),
+                state: DriveState::Operational,
+                in_limitation: false,
+            };
+        }
         let inputs = self.inputs;
         let mut signals = AxisSignals::of_plant(&self.plant, prev, p);
         if let Some(level) = inputs.reference_cam {
