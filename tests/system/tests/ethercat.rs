@@ -533,19 +533,21 @@ fn one_percent_of_frames_dropped_is_counted_and_the_motion_goes_on_without_a_jum
         .find(|l| l.contains("EtherCAT segment:"))
         .unwrap_or_else(|| panic!("no end line:\n{up_log}"));
     assert!(end.contains(", 0 alarms;"), "{end}");
-    // Every frame the emulator dropped is a miss of the node. The emulator drops from OP on,
-    // so a drop may also hit one of the node's few frames between OP and its first cyclic
-    // exchange (retried there, not a miss), and a frame the starved emulator answers later
-    // than 3/4 of a cycle is a miss it did not drop: one either way is allowed.
+    // Every miss of the node is a frame the emulator dropped or one a starved emulator
+    // answered after its verdict (the node counts those answers). The emulator drops from OP
+    // on, so a drop may also hit one of the node's few frames between OP and its first cyclic
+    // exchange (retried there, not a miss): one is allowed for that.
     let dropped = std::fs::read_to_string(&drops).unwrap().lines().count() as u64;
+    let late = count_before(end, " answers after their verdict");
     let misses = count_before(end, " missed exchanges");
     let exchanges = count_before(end, " exchanges, ");
     eprintln!("{end}\nthe emulator dropped {dropped} frames");
     assert!(dropped >= 10, "1 % of some 3,000 frames: {dropped}");
     assert!(misses > 0, "the drops are not counted: {end}");
     assert!(
-        misses.abs_diff(dropped) <= 1,
-        "{dropped} frames dropped, {misses} misses counted: {end}"
+        misses.abs_diff(dropped + late) <= 1,
+        "{dropped} frames dropped, {late} answered after their verdict, {misses} misses \
+         counted: {end}"
     );
     assert!(exchanges + misses >= 2900, "{end}");
     // No jump in the axis' setpoints: their second difference within what its acceleration
