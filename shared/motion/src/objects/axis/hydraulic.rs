@@ -412,6 +412,10 @@ impl Axis {
     /// with the axis enabled and no pressure or force control running; idle when the setpoint
     /// stands with the position controller acting.
     pub(super) fn hyd_auto_zero(&mut self) {
+        // Electric axes and hydraulic ones without AutoZero return before any cyclic work.
+        if self.hyd.as_deref().is_none_or(|h| h.auto_zero.is_none()) {
+            return;
+        }
         let (enabled, position_control) = (self.enabled, self.hyd_position_control());
         let total = self.total();
         let (actual_p, actual_v, dt) = (self.actual_p, self.actual_v, self.cfg.cycle);
