@@ -30,6 +30,10 @@ pub struct InstructionSpec {
     pub params: &'static [(&'static str, Option<Value>)],
 }
 
+/// The defaults of `MC_AxCtrlAutoZero_BkPlcMc`'s inputs.
+const AUTO_ZERO: tandem_motion::hydraulic::auto_zero::AutoZeroParams =
+    tandem_motion::hydraulic::auto_zero::AutoZeroParams::DEFAULT;
+
 /// `BufferMode` (PLCopen Motion Control Part 1): 0 Aborting (default) .. 5 BlendingHigh; a
 /// script or command line may also give the name (`buffer_mode = "BlendingLow"`), see
 /// [`named_value`].
@@ -175,17 +179,20 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("force", Some(Value::Bool(true))),
         ],
     },
-    // The Beckhoff hydraulic library's automatic zero compensation (defaults as
-    // `AutoZeroParams::default`).
+    // The Beckhoff hydraulic library's automatic zero compensation (defaults:
+    // `AutoZeroParams::DEFAULT`).
     InstructionSpec {
         name: "MC_AxCtrlAutoZero_BkPlcMc",
         params: &[
             ("enable", Some(Value::Bool(true))),
-            ("enable_on_moving", Some(Value::Bool(false))),
-            ("offset_limit", Some(Value::Num(1.0))),
-            ("tn", Some(Value::Num(100.0))),
-            ("threshold", Some(Value::Num(0.1))),
-            ("filter", Some(Value::Num(0.1))),
+            (
+                "enable_on_moving",
+                Some(Value::Bool(AUTO_ZERO.enable_on_moving)),
+            ),
+            ("offset_limit", Some(Value::Num(AUTO_ZERO.offset_limit))),
+            ("tn", Some(Value::Num(AUTO_ZERO.tn))),
+            ("threshold", Some(Value::Num(AUTO_ZERO.threshold))),
+            ("filter", Some(Value::Num(AUTO_ZERO.filter))),
         ],
     },
     // The Beckhoff hydraulic library's stops (a hydraulic axis): `execute = false` releases the

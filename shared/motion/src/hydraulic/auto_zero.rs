@@ -50,18 +50,23 @@ pub struct AutoZeroParams {
     pub filter: f64,
 }
 
-impl Default for AutoZeroParams {
+impl AutoZeroParams {
     /// The library's defaults for `Threshold` (0.1 V) and `Filter` (0.1 s); `OffsetLimit` 1 V
     /// and `Tn` 100 s (the library's defaults, 0.0, are refused: they give no compensation and
-    /// a division by zero).
+    /// a division by zero). The instruction's defaults in a script are these.
+    pub const DEFAULT: Self = Self {
+        enable_on_moving: false,
+        offset_limit: 1.0,
+        tn: 100.0,
+        threshold: 0.1,
+        filter: 0.1,
+    };
+}
+
+impl Default for AutoZeroParams {
+    /// [`AutoZeroParams::DEFAULT`].
     fn default() -> Self {
-        Self {
-            enable_on_moving: false,
-            offset_limit: 1.0,
-            tn: 100.0,
-            threshold: 0.1,
-            filter: 0.1,
-        }
+        Self::DEFAULT
     }
 }
 
