@@ -367,26 +367,12 @@ fn connection_disables_with_a_zero_word_before_the_enable_drops() {
         let t = k as f64 * 1e-3;
         l.cycle(50.0 * t, 50.0, true);
     }
-    assert!(l.written.word > 0);
+    assert!(l.written.words.word > 0);
     l.cycle(5.0, 50.0, false);
     // The command of the cycle the enable is removed is 0; the DO is still on.
-    assert_eq!(
-        l.written,
-        AnalogCommand {
-            enable: true,
-            word: 0,
-            ..AnalogCommand::default()
-        }
-    );
+    assert_eq!(l.written, AnalogCommand::new(true, 0));
     l.cycle(5.0, 0.0, false);
-    assert_eq!(
-        l.written,
-        AnalogCommand {
-            enable: false,
-            word: 0,
-            ..AnalogCommand::default()
-        }
-    );
+    assert_eq!(l.written, AnalogCommand::new(false, 0));
 }
 
 #[test]
@@ -426,7 +412,7 @@ fn inverse_drive_inverts_the_command_and_the_load_still_follows() {
         let t = k as f64 * 1e-3;
         last = Some(l.cycle(100.0 * t, 100.0, true));
     }
-    assert!(l.written.word < 0, "{:?}", l.written);
+    assert!(l.written.words.word < 0, "{:?}", l.written);
     assert!((l.drive.velocity() - 100.0).abs() < 0.05);
     let a = last.unwrap().actual;
     assert!((a.balanced - a.p).abs() < 1e-3, "{a:?}");
@@ -441,11 +427,7 @@ fn simulated_drive_speed_loop_is_a_first_order_lag_with_a_limit() {
         ..SimAnalogParams::example()
     };
     let mut d = SimAnalogDrive::new(params, s).unwrap();
-    d.exchange(&AnalogCommand {
-        enable: true,
-        word: 13824,
-        ..AnalogCommand::default()
-    });
+    d.exchange(&AnalogCommand::new(true, 13824));
     // 50 % of 3000/min, after one time constant 63.2 % of it.
     d.advance(4 * MS);
     let expected = 1500.0 * (1.0 - (-1.0_f64).exp());
@@ -455,11 +437,7 @@ fn simulated_drive_speed_loop_is_a_first_order_lag_with_a_limit() {
     assert!((d.position() - 10.0 * revs).abs() < 1e-12);
     assert!(d.feedback().ready);
     // The overrange asks 117.6 % = 3527/min; the limit is 3300/min.
-    d.exchange(&AnalogCommand {
-        enable: true,
-        word: OVERRANGE_WORD,
-        ..AnalogCommand::default()
-    });
+    d.exchange(&AnalogCommand::new(true, OVERRANGE_WORD));
     d.advance(1000 * MS);
     assert!((d.speed() - 3300.0).abs() < 1e-6, "{}", d.speed());
     // Without enable: the stop ramp, 3000/min in 0.1 s: 3300/min takes 0.11 s.
@@ -482,11 +460,7 @@ fn simulated_drive_ready_delay_offset_and_fault_latch() {
         ..SimAnalogParams::example()
     };
     let mut d = SimAnalogDrive::new(params, s).unwrap();
-    d.exchange(&AnalogCommand {
-        enable: true,
-        word: 0,
-        ..AnalogCommand::default()
-    });
+    d.exchange(&AnalogCommand::new(true, 0));
     d.advance(9 * MS);
     assert!(!d.feedback().ready, "ready 10 ms after the enable");
     d.advance(MS);

@@ -294,7 +294,7 @@ fn disable_drops_the_enable_output_only_after_a_zero_setpoint() {
         r.step();
     }
     // The drive reads a nonzero command.
-    assert!(r.drive().latched.word > 0);
+    assert!(r.drive().latched.words.word > 0);
     // MC_Power Enable FALSE with an emergency stop: the axis brakes on its setpoints, then
     // removes the enable. Record what the drive latched at each boundary.
     r.power(false);
@@ -306,9 +306,9 @@ fn disable_drops_the_enable_output_only_after_a_zero_setpoint() {
     let off = seen.iter().position(|c| !c.enable).unwrap();
     assert!(off > 0);
     // The boundary before the enable dropped, the drive already had a 0 setpoint.
-    assert_eq!(seen[off - 1].word, 0, "{:?}", &seen[..=off]);
+    assert_eq!(seen[off - 1].words.word, 0, "{:?}", &seen[..=off]);
     assert!(seen[off - 1].enable);
-    assert!(seen[off..].iter().all(|c| !c.enable && c.word == 0));
+    assert!(seen[off..].iter().all(|c| !c.enable && c.words.word == 0));
     assert_eq!(r.state(), AxisState::Disabled);
     assert!(!r.log().contains("alarm"), "{}", r.log());
 }

@@ -7,11 +7,10 @@
 //! position is continuous in position and velocity; the actual position follows it.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod hyd_rig;
 use tandem_motion::objects::axis::sync_status;
 use tandem_runtime::exec::Executive;
 use tandem_testkit::workspace::root;
-
-const MS: i64 = 1_000_000;
 
 const LEADER: &str = r#"
 [axes.upper]
@@ -126,19 +125,9 @@ fn run(
     let script = tandem_config::script::parse_cell("flying.toml", script, cell).unwrap();
     let mut exec = Executive::new(cell, None).unwrap();
     let mut log = Vec::new();
-    let (mut next, mut flags, mut worst_lag) = (0, 0u8, 0.0_f64);
+    let (mut flags, mut worst_lag) = (0u8, 0.0_f64);
     let mut prev: Option<(f64, f64)> = None;
-    let end = script.duration_ns / MS;
-    for k in 0..=end {
-        let t = k * MS;
-        while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
-            next += 1;
-            let r = exec
-                .apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log)
-                .unwrap();
-            assert!(r.is_ok(), "{r:?}\n{}", String::from_utf8_lossy(&log));
-        }
-        exec.step(t, &mut log).unwrap();
+    hyd_rig::replay(&mut exec, &script, &mut log, |k, exec| {
         let [ram, leader] = [exec.status()[0], exec.status()[1]];
         let (y, v, x) = (
             ram.position_unwrapped,
@@ -165,7 +154,7 @@ fn run(
         prev = Some((y, v));
         flags |= ram.sync_status_word;
         worst_lag = worst_lag.max((ram.actual_position - y).abs());
-    }
+    });
     let ram = exec.status()[0];
     Seen {
         flags,

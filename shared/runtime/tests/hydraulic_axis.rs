@@ -263,18 +263,9 @@ fn the_press_holds_its_force_under_the_force_controller_and_returns() {
         tandem_config::script::parse_cell("hydraulic-press-script.toml", &src, &cell).unwrap();
     let mut exec = Executive::new(&cell, None).unwrap();
     let mut log = Vec::new();
-    let (mut next, mut worst_20k, mut worst_2k) = (0, 0.0_f64, 0.0_f64);
+    let (mut worst_20k, mut worst_2k) = (0.0_f64, 0.0_f64);
     let mut controlled = 0;
-    for k in 0..=script.duration_ns / MS {
-        let t = k * MS;
-        while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
-            next += 1;
-            let r = exec
-                .apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, &mut log)
-                .unwrap();
-            assert!(r.is_ok(), "{r:?}");
-        }
-        exec.step(t, &mut log).unwrap();
+    hyd_rig::replay(&mut exec, &script, &mut log, |k, exec| {
         let h = exec.axis(AxisIndex(0)).unwrap().hydraulic_status().unwrap();
         let force = h.actual.expect("pressure inputs").force;
         if h.pressure_control.is_some() {
@@ -286,7 +277,7 @@ fn the_press_holds_its_force_under_the_force_controller_and_returns() {
         if (4300..4500).contains(&k) {
             worst_2k = worst_2k.max((force - 2_000.0).abs() / 2_000.0);
         }
-    }
+    });
     let log = String::from_utf8(log).unwrap();
     eprintln!(
         "20 kN: {:.3} %, 2 kN: {:.3} %",
@@ -677,13 +668,16 @@ fn each_valve_output_form_positions_a_valve_wired_for_it() {
             r.until(3000, "travel", |r| r.hyd().state == HydState::ConstVelo);
             let c = r.exec.analog_drive(0).unwrap().latched;
             match (valve, positive) {
-                ("two_coil", true) => assert!(c.word > 0 && c.word_b == 0, "{c:?}"),
-                ("two_coil", false) => assert!(c.word == 0 && c.word_b > 0, "{c:?}"),
-                ("one_coil", true) => assert!(c.word > 16384, "{c:?}"),
-                ("one_coil", false) => assert!((0..16384).contains(&c.word), "{c:?}"),
-                _ => assert!(c.word > 0, "{c:?}"),
+                ("two_coil", true) => assert!(c.words.word > 0 && c.words.word_b == 0, "{c:?}"),
+                ("two_coil", false) => assert!(c.words.word == 0 && c.words.word_b > 0, "{c:?}"),
+                ("one_coil", true) => assert!(c.words.word > 16384, "{c:?}"),
+                ("one_coil", false) => assert!((0..16384).contains(&c.words.word), "{c:?}"),
+                _ => assert!(c.words.word > 0, "{c:?}"),
             }
-            assert_eq!((c.move_positive, c.move_negative), (positive, !positive));
+            assert_eq!(
+                (c.words.move_positive, c.words.move_negative),
+                (positive, !positive)
+            );
             r.run_move(8000);
             let s = r.exec.status()[0];
             assert!(

@@ -525,16 +525,24 @@ impl AnalogEnable {
 pub struct AnalogCommand {
     /// The enable digital output.
     pub enable: bool,
-    /// The analog output word ([`output_word`]); a hydraulic axis' valve output in the form of
-    /// its drive stage (coil A's current with two coils, [`crate::hydraulic::drive_output`]).
+    /// The output words: `word` is the analog output word ([`output_word`]); a hydraulic axis'
+    /// valve output in the form of its drive stage (coil A's current with two coils, coil B's
+    /// in `word_b`, the direction bits; [`crate::hydraulic::drive_output`]).
     #[doc(alias = "NSET")]
-    pub word: i16,
-    /// A hydraulic axis with two coils: coil B's current word (0 otherwise).
-    pub word_b: i16,
-    /// A hydraulic axis: the control value is positive (`bMovePos`).
-    pub move_positive: bool,
-    /// A hydraulic axis: the control value is negative (`bMoveNeg`).
-    pub move_negative: bool,
+    pub words: ValveWords,
+}
+
+impl AnalogCommand {
+    /// The enable output and a single ±10 V output word (an electric axis' speed setpoint).
+    pub fn new(enable: bool, word: i16) -> Self {
+        Self {
+            enable,
+            words: ValveWords {
+                word,
+                ..ValveWords::default()
+            },
+        }
+    }
 }
 
 /// What the node reads of an analog drive and its encoder: its process image inputs.
@@ -786,10 +794,7 @@ impl AnalogConnection {
         };
         AnalogCommand {
             enable: self.enable_do,
-            word,
-            word_b: words.word_b,
-            move_positive: words.move_positive,
-            move_negative: words.move_negative,
+            words,
         }
     }
 }
@@ -835,14 +840,8 @@ pub enum AnalogConnectionError {
     Timeout(InvalidReadyTimeout),
     /// A hydraulic axis' position controller or Finish parameter.
     Hydraulic(crate::hydraulic::finish::FinishError),
-    /// A simulated valve and cylinder's parameter out of its range (`CylinderError` of
-    /// `plant::hydraulic`, which builds on this module: its name and value).
-    Cylinder {
-        /// The parameter's name.
-        name: &'static str,
-        /// Its value.
-        value: f64,
-    },
+    /// A simulated valve and cylinder's parameter out of its range.
+    Cylinder(super::cylinder_error::CylinderError),
     /// The scaling of a hydraulic axis' pressure inputs.
     Pressure(crate::hydraulic::pressure::PressureError),
 }
@@ -853,10 +852,7 @@ impl fmt::Display for AnalogConnectionError {
             Self::Params(e) => write!(f, "{e}"),
             Self::Timeout(e) => write!(f, "analog drive: {e}"),
             Self::Hydraulic(e) => write!(f, "hydraulic axis: {e}"),
-            Self::Cylinder { name, value } => write!(
-                f,
-                "valve and cylinder: cylinder parameter `{name}` = {value} is out of its range"
-            ),
+            Self::Cylinder(e) => write!(f, "valve and cylinder: {e}"),
             Self::Pressure(e) => write!(f, "pressure inputs: {e}"),
         }
     }
@@ -1077,7 +1073,7 @@ impl SimAnalogDrive {
         let dt = dt_ns.max(0) as f64 * 1e-9;
         let reference = self.params.reference_speed / 60.0;
         if self.amplifier.on() {
-            let volts = word_to_normalized(self.amplifier.command().word) * NOMINAL_VOLTAGE
+            let volts = word_to_normalized(self.amplifier.command().words.word) * NOMINAL_VOLTAGE
                 + self.params.offset;
             let limit = self.params.max_speed / 60.0;
             let target = (volts / NOMINAL_VOLTAGE * reference).clamp(-limit, limit);

@@ -31,9 +31,8 @@
 //! is stiff). Pure: no IO, no clock (the cycle time is an input), no allocation.
 
 use super::analog::{Amplifier, AnalogCommand, AnalogFeedback};
+pub use super::cylinder_error::CylinderError;
 use super::mechanics::Scaling;
-use crate::catalog::hyd_error::HydErrorCode;
-use crate::hydraulic::drive_output::ValveWords;
 /// Integration steps per [`SimCylinder::step`] call, at least (more when the call is long: no
 /// sub-step exceeds [`MAX_SUBSTEP`]).
 pub const SUBSTEPS: u32 = 20;
@@ -199,38 +198,6 @@ impl CylinderParams {
         }
     }
 }
-
-/// A parameter of the simulated cylinder out of its range.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub struct CylinderError {
-    /// The parameter's name (a field of [`CylinderParams`]).
-    pub name: &'static str,
-    /// Its value.
-    pub value: f64,
-}
-
-impl CylinderError {
-    /// The library's error code: `dwTcHydErrIllegalAreas` for the areas, else
-    /// `dwTcHydAdsErrIllegalValue`.
-    pub fn code(&self) -> HydErrorCode {
-        match self.name {
-            "area_a" | "area_b" => HydErrorCode::ILLEGAL_AREAS,
-            _ => HydErrorCode::ILLEGAL_VALUE,
-        }
-    }
-}
-
-impl core::fmt::Display for CylinderError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "cylinder parameter `{}` = {} is out of its range",
-            self.name, self.value
-        )
-    }
-}
-
-impl std::error::Error for CylinderError {}
 
 /// What the simulated axis shows after a step.
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
@@ -479,13 +446,7 @@ impl SimValveCylinder {
     pub fn advance(&mut self, dt_ns: i64) {
         let dt = dt_ns.max(0) as f64 * 1e-9;
         let u = if self.amplifier.on() {
-            let c = self.amplifier.command();
-            self.input.decode(&ValveWords {
-                word: c.word,
-                word_b: c.word_b,
-                move_positive: c.move_positive,
-                move_negative: c.move_negative,
-            })
+            self.input.decode(&self.amplifier.command().words)
         } else {
             0.0
         };

@@ -7,6 +7,7 @@
 pub mod analog;
 pub mod analog_word;
 pub mod cia402;
+pub mod cylinder_error;
 pub mod drive;
 pub mod hydraulic;
 pub mod link;

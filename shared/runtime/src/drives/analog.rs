@@ -192,12 +192,8 @@ impl AnalogDrives {
                     .map_err(|e| refused(AnalogConnectionError::Params(e)))?,
                 ),
                 DeviceKind::SimValveCylinder(params) => AnalogDevice::Cylinder(
-                    SimValveCylinder::new(*params, scaling, p0).map_err(|e| {
-                        refused(AnalogConnectionError::Cylinder {
-                            name: e.name,
-                            value: e.value,
-                        })
-                    })?,
+                    SimValveCylinder::new(*params, scaling, p0)
+                        .map_err(|e| refused(AnalogConnectionError::Cylinder(e)))?,
                 ),
                 // Refused by the configuration: an analog axis's device is an analog drive.
                 _ => continue,

@@ -4,6 +4,7 @@
 // Each test crate that includes this module uses a part of it.
 #![allow(dead_code)]
 
+use tandem_config::script::Script;
 use tandem_config::{AxisIndex, Cell};
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::hydraulic::generator::HydState;
@@ -126,5 +127,29 @@ impl<'c> Run<'c> {
     /// Whether the generator is in `state`.
     pub fn in_state(&self, state: HydState) -> bool {
         self.hyd().state == state
+    }
+}
+
+/// Steps `exec` through `script` a millisecond at a time from 0 to its duration: the entries
+/// due at a cycle are applied before its step (each must be accepted), then `each(k, exec)`
+/// looks at cycle `k`.
+pub fn replay(
+    exec: &mut Executive<'_>,
+    script: &Script,
+    log: &mut Vec<u8>,
+    mut each: impl FnMut(i64, &mut Executive<'_>),
+) {
+    let mut next = 0;
+    for k in 0..=script.duration_ns / MS {
+        let t = k * MS;
+        while let Some(e) = script.entries.get(next).filter(|e| e.t_ns <= t) {
+            next += 1;
+            let r = exec
+                .apply_at(t, e.t_ns, &e.axis, e.instruction, e.action, log)
+                .unwrap();
+            assert!(r.is_ok(), "{r:?}\n{}", String::from_utf8_lossy(log));
+        }
+        exec.step(t, log).unwrap();
+        each(k, exec);
     }
 }
