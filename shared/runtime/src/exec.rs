@@ -12,6 +12,7 @@
 //! After [`Executive::new`], nothing here allocates: the log lines are formatted into the
 //! caller's writer (a fixed ring in a node).
 
+mod hyd_trace;
 mod retain;
 
 use crate::drives::Drives;
@@ -20,6 +21,7 @@ pub use crate::inputs::{InputDeviceStatus, InputSignalEdge, INPUT_EDGES};
 pub use crate::notes::{seconds, Describe, IoNote, JobNote, Secs, NOTES};
 pub use crate::outputs::{OutputDeviceStatus, OutputSwitch, LOOK_AHEAD_CYCLES, SWITCHES};
 pub use crate::values::{InputSignalValue, SignalValue, ValueDeviceStatus, INPUT_VALUES};
+pub use hyd_trace::{HYDRAULIC_COLUMNS, PRESSURE_COLUMNS};
 pub use retain::{AdjustmentChange, RestoreError, Restored};
 
 use crate::inputs::Inputs;
@@ -514,6 +516,8 @@ pub struct Executive<'c> {
     inputs: Inputs,
     /// The analog and counter terminals of the process image (`integer`, `float` signals).
     values: Values,
+    /// The row of [`Executive::objects_row`] (its capacity kept from row to row).
+    trace_row: String,
 }
 
 impl<'c> Executive<'c> {
@@ -595,6 +599,7 @@ impl<'c> Executive<'c> {
             extrapolated: 0,
             commands: 0,
             rejected: 0,
+            trace_row: String::new(),
         })
     }
 
@@ -657,13 +662,23 @@ impl<'c> Executive<'c> {
         self.axes.get(i.0)
     }
 
-    /// The objects' columns of a trace row (output cams, cam tracks, measuring inputs).
+    /// The columns of a trace row after the axes' and encoders': the hydraulic axes' signals
+    /// ([`HYDRAULIC_COLUMNS`]), then the objects' (output cams, cam tracks, measuring inputs).
     pub fn objects_row(&mut self) -> &str {
-        self.objects.row()
+        self.trace_row.clear();
+        hyd_trace::row(
+            self.cell,
+            &self.axes,
+            &self.drives.analog,
+            &mut self.trace_row,
+        );
+        self.trace_row.push_str(self.objects.row());
+        &self.trace_row
     }
 
-    /// Writes the objects' trace column names (each prefixed with `,`).
+    /// Writes the column names of [`Executive::objects_row`] (each prefixed with `,`).
     pub fn objects_header(cell: &Cell, out: &mut impl Write) -> io::Result<()> {
+        hyd_trace::header(cell, out)?;
         Objects::header(cell, out)
     }
 

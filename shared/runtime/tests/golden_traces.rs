@@ -229,3 +229,91 @@ fn the_gantry_cylinders_on_two_nodes_move_together() {
         "the bridge reached 400 mm"
     );
 }
+
+/// The text of column `name` of every row of a trace.
+fn text_column(trace: &[u8], name: &str) -> Vec<String> {
+    let text = std::str::from_utf8(trace).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = header.iter().position(|h| *h == name).unwrap();
+    lines
+        .map(|l| l.split(',').nth(at).unwrap().to_owned())
+        .collect()
+}
+
+/// `config/hydraulic.toml`'s trace carries the library's scope signals (its FAQ #15): the
+/// generator's states in the order of the two positionings, `fTargetPos`, and
+/// `fLagCtrlOutput` = fLagAmp · (fSetPos − fActPos) = 50 · lag (mm/s) while the controller
+/// acts (Idle, no I part), 0 during a move in the displacement mode.
+#[test]
+fn the_hydraulic_trace_shows_the_generator_state_and_the_controller_output() {
+    let (trace, _) = simulate("hydraulic");
+    let states = text_column(&trace, "ram.hyd_state");
+    let mut seen: Vec<&str> = Vec::new();
+    for s in &states {
+        if seen.last() != Some(&s.as_str()) {
+            seen.push(s);
+        }
+    }
+    let p = |d: &str| format!("iTcHydState{d}");
+    let expected: Vec<String> = [
+        "Idle",
+        "TcAccP",
+        "ConstVeloP",
+        "PcDecP",
+        "CreepVeloP",
+        "Idle",
+        "TcAccM",
+        "ConstVeloM",
+        "PcDecM",
+        "CreepVeloM",
+        "Idle",
+    ]
+    .iter()
+    .map(|d| p(d))
+    .collect();
+    assert_eq!(seen, expected);
+    let rows = columns(
+        &trace,
+        &[
+            "ram.position",
+            "ram.actual_position",
+            "ram.target_position",
+            "ram.lag_ctrl_output",
+        ],
+    );
+    let mut acting = 0;
+    for (k, (r, s)) in rows.iter().zip(&states).enumerate().skip(1) {
+        let (set, actual, lag_out) = (r[0], r[1], r[3]);
+        if s == "iTcHydStateIdle" {
+            let expected = 50.0 * (set - actual);
+            assert!(
+                (lag_out - expected).abs() <= 1e-9,
+                "row {k}: {lag_out} {expected}"
+            );
+            acting += 1;
+        } else {
+            assert_eq!(lag_out, 0.0, "row {k}: {s}");
+        }
+    }
+    assert!(acting > 1000, "{acting}");
+    // The target of the second positioning from its start on.
+    let target = rows.iter().zip(&states).find(|(_, s)| s.ends_with('M'));
+    assert_eq!(target.map(|(r, _)| r[2]), Some(120.0));
+}
+
+/// `config/hydraulic-press.toml`'s trace: the force column is the force on the ram from the
+/// two pressure columns and the areas of `[axes.ram.hydraulic]` (1 bar = 0.1 N/mm²).
+#[test]
+fn the_press_trace_shows_the_pressures_and_the_force_from_them() {
+    let (trace, _) = simulate("hydraulic-press");
+    let rows = columns(&trace, &["ram.pressure_a", "ram.pressure_b", "ram.force"]);
+    let mut worst = 0.0_f64;
+    for r in &rows {
+        let f = 0.1 * (r[0] * 3117.2 - r[1] * 1526.8);
+        assert!((f - r[2]).abs() <= 1e-6 * f.abs().max(1.0), "{r:?}");
+        worst = worst.max(r[2]);
+    }
+    // The force controller holds 20 kN.
+    assert!(worst > 19_000.0, "{worst}");
+}

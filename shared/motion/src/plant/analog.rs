@@ -590,6 +590,10 @@ pub struct AnalogStatus {
     pub control_difference: f64,
     /// The command was clamped.
     pub saturated: bool,
+    /// A hydraulic axis: the position controller's output `fLagCtrlOutput` (normalised, P and
+    /// I part) of the last cycle; 0 while it does not act, and for an electric axis.
+    #[doc(alias = "fLagCtrlOutput")]
+    pub lag_ctrl_output: f64,
 }
 
 /// An axis's connection to an analog drive: the encoder, the handshake and tandem's position
@@ -812,6 +816,7 @@ impl AnalogConnection {
         };
         if !active || out.hydraulic.locked {
             h.reset();
+            self.status.lag_ctrl_output = 0.0;
             return ControllerOutput::default();
         }
         let o = h.step(&HydControlInput {
@@ -823,6 +828,7 @@ impl AnalogConnection {
             zero_compensation: out.hydraulic.zero_compensation,
             dt,
         });
+        self.status.lag_ctrl_output = o.lag_ctrl_output;
         ControllerOutput {
             normalized: o.output,
             control_difference: out.position - actual,

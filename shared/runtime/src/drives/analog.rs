@@ -277,6 +277,14 @@ impl AnalogDrives {
     }
 
     /// The state of analog drive `device` and its link.
+    /// The last cycle of the link of axis `axis` (an owned axis on an analog drive).
+    pub(crate) fn link_status(&self, axis: usize) -> Option<&AnalogStatus> {
+        self.links
+            .iter()
+            .find(|l| l.axis == axis)
+            .map(|l| l.connection.status())
+    }
+
     pub(crate) fn status(&self, device: usize) -> Option<AnalogDriveStatus> {
         let slot = self.slots.get(device)?.as_ref()?;
         let link = self.links.iter().find(|l| l.device == device)?;
