@@ -259,6 +259,21 @@ pub struct HydraulicSection {
     pub fLagAmpDx: Option<f64>,
     /// Limit of the I part (normalised; 0: full scale).
     pub fLagAmpWuL: Option<f64>,
+    /// tandem's: the position controller, `default` (`MC_AxRtController_BkPlcMc`) or
+    /// `extended` (`MC_AxRtPosPiControllerEx_BkPlcMc`: the D part and condition feedback).
+    pub position_controller: Option<String>,
+    /// Extended controller: the D part's gain on the velocity error (1; 0: no D part).
+    pub fLagAmpTd: Option<f64>,
+    /// Extended controller: the D part's damping time (s).
+    pub fLagAmpTdd: Option<f64>,
+    /// Extended controller: the weight of the actual velocity feedback (1; 0: none).
+    pub fLagAmpCfb_kV: Option<f64>,
+    /// Extended controller: the filter time of the actual velocity feedback (s).
+    pub fLagAmpCfb_tV: Option<f64>,
+    /// Extended controller: the weight of the actual acceleration feedback (s; 0: none).
+    pub fLagAmpCfb_kA: Option<f64>,
+    /// Extended controller: the filter time of the actual acceleration feedback (s).
+    pub fLagAmpCfb_tA: Option<f64>,
     /// Weight of the set velocity in the output (1.0: full feed forward).
     pub fFeedForward: Option<f64>,
     /// Area ratio A:B (velocity ratio of the two directions).

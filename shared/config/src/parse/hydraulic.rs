@@ -6,6 +6,7 @@ use super::FieldError;
 use crate::error::Problem;
 use crate::schema::{CylinderSection, DeviceSection, HydraulicSection};
 use tandem_motion::hydraulic::controller::{HydController, HydControllerParams};
+use tandem_motion::hydraulic::controller_ex::PosPiControllerExParams;
 use tandem_motion::hydraulic::drive_output::{DriveOutputParams, ValveOutput};
 use tandem_motion::hydraulic::finish::{FinishError, FinishParams};
 use tandem_motion::hydraulic::generator::{
@@ -45,7 +46,7 @@ const VALVE_INPUTS: [(&str, (ValveOutput, bool)); 4] = [
 
 /// The keys of `[axes.<name>.hydraulic]` the generator, the target window and the position
 /// controller with Finish check, as paths from the axis.
-const PROFILE_KEYS: [&str; 39] = [
+const PROFILE_KEYS: [&str; 46] = [
     "hydraulic.fRefVelo",
     "hydraulic.fMaxVelo",
     "hydraulic.fAcc",
@@ -72,6 +73,13 @@ const PROFILE_KEYS: [&str; 39] = [
     "hydraulic.fLagAmpTi",
     "hydraulic.fLagAmpDx",
     "hydraulic.fLagAmpWuL",
+    "hydraulic.position_controller",
+    "hydraulic.fLagAmpTd",
+    "hydraulic.fLagAmpTdd",
+    "hydraulic.fLagAmpCfb_kV",
+    "hydraulic.fLagAmpCfb_tV",
+    "hydraulic.fLagAmpCfb_kA",
+    "hydraulic.fLagAmpCfb_tA",
     "hydraulic.fFeedForward",
     "hydraulic.fAreaRatio",
     "hydraulic.fValve_OverlapCompP",
@@ -209,6 +217,7 @@ pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, Fi
         lag_amp_ti: h.fLagAmpTi.unwrap_or(0.0),
         lag_amp_dx: h.fLagAmpDx.unwrap_or(0.0),
         lag_amp_wul: h.fLagAmpWuL.unwrap_or(0.0),
+        extended: extended_controller(h)?,
         finish: FinishParams {
             ref_velo: h.fRefVelo.unwrap_or(d.ref_velo),
             feed_forward: h.fFeedForward.unwrap_or(d.feed_forward),
@@ -244,6 +253,50 @@ pub(super) fn controller(h: &HydraulicSection) -> Result<HydControllerParams, Fi
         ),
     })?;
     Ok(params)
+}
+
+/// `position_controller` (tandem's key) and the extended controller's parameters: `None` for
+/// the default controller, which refuses them (they would have no effect).
+fn extended_controller(
+    h: &HydraulicSection,
+) -> Result<Option<PosPiControllerExParams>, FieldError> {
+    let extended = match h.position_controller.as_deref() {
+        None => false,
+        Some(v) => super::pick(
+            "position_controller",
+            v,
+            &[("default", false), ("extended", true)],
+        )?,
+    };
+    let keys = [
+        ("fLagAmpTd", h.fLagAmpTd),
+        ("fLagAmpTdd", h.fLagAmpTdd),
+        ("fLagAmpCfb_kV", h.fLagAmpCfb_kV),
+        ("fLagAmpCfb_tV", h.fLagAmpCfb_tV),
+        ("fLagAmpCfb_kA", h.fLagAmpCfb_kA),
+        ("fLagAmpCfb_tA", h.fLagAmpCfb_tA),
+    ];
+    if !extended {
+        return match keys.iter().find(|(_, v)| v.is_some()) {
+            Some((name, _)) => Err((
+                name,
+                Problem::Invalid(
+                    "a parameter of the extended controller: only with \
+                     `position_controller = \"extended\"`",
+                ),
+            )),
+            None => Ok(None),
+        };
+    }
+    let [td, tdd, cfb_kv, cfb_tv, cfb_ka, cfb_ta] = keys.map(|(_, v)| v.unwrap_or(0.0));
+    Ok(Some(PosPiControllerExParams {
+        td,
+        tdd,
+        cfb_kv,
+        cfb_tv,
+        cfb_ka,
+        cfb_ta,
+    }))
 }
 
 /// The parameters of a `sim_valve_cylinder` device: `load` and `[devices.<name>.cylinder]`

@@ -18,8 +18,13 @@
 //! ±`fLagAmpWuL` (±1.0, full scale, when 0); within the window it holds. While the controller
 //! does not act (a move in the displacement mode) the I part holds and the output is 0; without
 //! the drive's enable it is cleared ([`HydController::reset`]), as the extended controller
-//! documents. The sum is limited by `fLagAmpOutL`. Not built yet: the extended controller
-//! `MC_AxRtPosPiControllerEx_BkPlcMc`.
+//! documents. The sum is limited by `fLagAmpOutL`.
+//!
+//! With [`HydControllerParams::extended`] the controller is `MC_AxRtPosPiControllerEx_BkPlcMc`:
+//! the same P and I parts plus the D part and the condition feedback of [`super::controller_ex`]
+//! (normalised by `fRefVelo`), which act whenever the drive is enabled, also during a move in
+//! the displacement mode (inferred: they feed back velocities, not the lag); the sum is limited
+//! by `fLagAmpOutL`. Its output `InWindup` is [`HydControlOutput::in_windup`].
 //!
 //! [`HydControlInput::zero_compensation`] writes `fZeroCompensation` into Finish's parameters,
 //! as `MC_AxCtrlAutoZero_BkPlcMc` writes it into `ST_TcHydAxParam`
@@ -27,6 +32,7 @@
 //!
 //! [`Setpoint::position_control`]: super::generator::Setpoint::position_control
 
+use super::controller_ex::{ExInput, PosPiControllerEx, PosPiControllerExParams};
 use super::finish::{Finish, FinishError, FinishInput, FinishParams};
 use super::valve_table::ValveTable;
 
@@ -48,6 +54,10 @@ pub struct HydControllerParams {
     /// The drive stage after Finish (the valve's output form, `bDrive_AbsoluteOutput`,
     /// `bDrive_Reversed`); the drive connection applies it.
     pub drive: super::drive_output::DriveOutputParams,
+    /// The extended controller `MC_AxRtPosPiControllerEx_BkPlcMc` in place of the default
+    /// one: its D part and condition feedback; `None`: the default controller.
+    #[doc(alias = "MC_AxRtPosPiControllerEx_BkPlcMc")]
+    pub extended: Option<PosPiControllerExParams>,
 }
 
 impl Default for HydControllerParams {
@@ -61,6 +71,7 @@ impl Default for HydControllerParams {
             lag_amp_wul: 0.0,
             finish: FinishParams::default(),
             drive: super::drive_output::DriveOutputParams::default(),
+            extended: None,
         }
     }
 }
@@ -74,6 +85,8 @@ pub struct HydControlInput {
     pub set_velocity: f64,
     /// `fActPos` (mm).
     pub actual_position: f64,
+    /// `fActVelo` (mm/s): the extended controller's D part and feedback use it.
+    pub actual_velocity: f64,
     /// The position controller acts this cycle.
     pub position_control: bool,
     /// `fClampingOutput` (V): the pressing output of target clamping.
@@ -95,6 +108,8 @@ pub struct HydControlOutput {
     pub output: f64,
     /// The overlap compensation in the output.
     pub active_overlap: f64,
+    /// `InWindup`: the I part is at its limit.
+    pub in_windup: bool,
 }
 
 /// The position controller and Finish of one hydraulic axis; with a characteristic curve, the
@@ -107,6 +122,8 @@ pub struct HydController {
     table: Option<Box<ValveTable>>,
     /// The I part (normalised).
     i_part: f64,
+    /// The extended controller's D part and condition feedback.
+    ex: Option<PosPiControllerEx>,
 }
 
 impl HydController {
@@ -133,17 +150,32 @@ impl HydController {
             }
         }
         params.drive.check().map_err(FinishError::DriveOutput)?;
+        let ex = match params.extended {
+            Some(e) => Some(PosPiControllerEx::new(e).map_err(|(parameter, value)| {
+                FinishError::OutOfRange {
+                    parameter,
+                    value,
+                    min: 0.0,
+                    max: f64::MAX,
+                }
+            })?),
+            None => None,
+        };
         Ok(Self {
             finish: Finish::new(params.finish)?,
             params,
             table: table.map(Box::new),
             i_part: 0.0,
+            ex,
         })
     }
 
-    /// Clears the I part (the drive is not enabled).
+    /// Clears the I part and the extended controller's states (the drive is not enabled).
     pub fn reset(&mut self) {
         self.i_part = 0.0;
+        if let Some(ex) = &mut self.ex {
+            ex.reset();
+        }
     }
 
     /// The parameters.
@@ -158,6 +190,7 @@ impl HydController {
             i.set_position,
             i.set_velocity,
             i.actual_position,
+            i.actual_velocity,
             i.clamping_output,
             i.dt,
             i.zero_compensation.unwrap_or(0.0),
@@ -170,10 +203,21 @@ impl HydController {
         if let Some(z) = i.zero_compensation {
             self.finish.set_zero_compensation(z);
         }
-        let lag = if i.position_control {
+        let pi = if i.position_control {
             self.lag_ctrl_output(i.set_position - i.actual_position, i.dt)
         } else {
             0.0
+        };
+        let ex = self.ex.as_mut().map_or(0.0, |ex| {
+            ex.step(&ExInput {
+                set_velocity: i.set_velocity,
+                actual_velocity: i.actual_velocity,
+                dt: i.dt,
+            })
+        }) / self.params.finish.ref_velo;
+        let lag = match self.params.lag_out_limit {
+            l if l > 0.0 => (pi + ex).clamp(-l, l),
+            _ => pi + ex,
         };
         let input = FinishInput {
             set_velocity: i.set_velocity,
@@ -189,27 +233,28 @@ impl HydController {
             i_part: self.i_part,
             output: out.output,
             active_overlap: out.active_overlap,
+            in_windup: self.params.lag_amp_ti > 0.0 && self.i_part.abs() >= self.i_limit(),
         }
     }
 
-    /// `fLagCtrlOutput` for `lag` (mm): the P part, the I part grown beyond the response
-    /// window, the sum limited.
+    /// The I part's limit: `fLagAmpWuL`, full scale when 0.
+    fn i_limit(&self) -> f64 {
+        match self.params.lag_amp_wul {
+            l if l > 0.0 => l,
+            _ => 1.0,
+        }
+    }
+
+    /// The P part and the I part grown beyond the response window for `lag` (mm), before the
+    /// output limit.
     fn lag_ctrl_output(&mut self, lag: f64, dt: f64) -> f64 {
         let p = &self.params;
         let ref_velo = p.finish.ref_velo;
         if p.lag_amp_ti > 0.0 && lag.abs() > p.lag_amp_dx {
-            let limit = if p.lag_amp_wul > 0.0 {
-                p.lag_amp_wul
-            } else {
-                1.0
-            };
+            let limit = self.i_limit();
             self.i_part = (self.i_part + p.lag_amp_ti * lag * dt / ref_velo).clamp(-limit, limit);
         }
-        let u = p.lag_amp * lag / ref_velo + self.i_part;
-        match p.lag_out_limit {
-            l if l > 0.0 => u.clamp(-l, l),
-            _ => u,
-        }
+        self.params.lag_amp * lag / ref_velo + self.i_part
     }
 }
 

@@ -15,6 +15,8 @@
 //! - [`valve_table`]: the characteristic curve of a valve and cylinder, read from the library's
 //!   table file format and checked;
 //! - [`controller`]: the position controller (`fLagAmp`, the I part) and Finish as one stage;
+//! - [`controller_ex`]: the extended controller's D part and condition feedback
+//!   (`MC_AxRtPosPiControllerEx_BkPlcMc`), a discrete linear system the controller adds;
 //! - [`auto_zero`]: the automatic zero compensation `MC_AxCtrlAutoZero_BkPlcMc`;
 //! - [`drive_output`]: the drive stage `MC_AxRtDrive_BkPlcMc` (±10 V, two coils, one coil,
 //!   absolute output with direction bits, reversal);
@@ -26,6 +28,7 @@
 pub mod auto_zero;
 pub mod autoident;
 pub mod controller;
+pub mod controller_ex;
 pub mod drive_output;
 pub mod finish;
 pub mod generator;

@@ -618,6 +618,8 @@ pub struct AnalogConnection {
     previous_count: i64,
     /// The actual position of the last sample (physical).
     actual: f64,
+    /// The actual velocity of the last sample (physical, the count's change over the cycle).
+    actual_velocity: f64,
     /// The enable request of the last command.
     request: bool,
     /// The enable DO decided with the last inputs.
@@ -648,6 +650,7 @@ impl AnalogConnection {
             counter: None,
             previous_count: 0,
             actual: p0,
+            actual_velocity: 0.0,
             request: false,
             enable_do: false,
             plant,
@@ -729,6 +732,7 @@ impl AnalogConnection {
         }
         let p = scaling.position(count);
         let prev = std::mem::replace(&mut self.actual, p);
+        self.actual_velocity = v;
         let out = self
             .enable
             .step(t, self.request, fb.ready, self.status.word == 0);
@@ -823,6 +827,7 @@ impl AnalogConnection {
             set_position: out.position,
             set_velocity: out.velocity,
             actual_position: actual,
+            actual_velocity: self.actual_velocity,
             position_control: out.position_controlled,
             clamping_output: out.hydraulic.clamping_output,
             zero_compensation: out.hydraulic.zero_compensation,
