@@ -208,13 +208,17 @@ impl HydController {
         } else {
             0.0
         };
-        let ex = self.ex.as_mut().map_or(0.0, |ex| {
-            ex.step(&ExInput {
-                set_velocity: i.set_velocity,
-                actual_velocity: i.actual_velocity,
-                dt: i.dt,
-            })
-        }) / self.params.finish.ref_velo;
+        let ex = match &mut self.ex {
+            Some(ex) => {
+                let response = ex.step(&ExInput {
+                    set_velocity: i.set_velocity,
+                    actual_velocity: i.actual_velocity,
+                    dt: i.dt,
+                });
+                response / self.params.finish.ref_velo
+            }
+            None => 0.0,
+        };
         let lag = match self.params.lag_out_limit {
             l if l > 0.0 => (pi + ex).clamp(-l, l),
             _ => pi + ex,
