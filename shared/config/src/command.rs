@@ -195,6 +195,19 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("filter", Some(Value::Num(AUTO_ZERO.filter))),
         ],
     },
+    // The Beckhoff hydraulic library's slowing down on pressure: `set_point` (bar, or N with
+    // `force`; its sign the working direction), `kp` (mm/s per bar or N).
+    InstructionSpec {
+        name: "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("enable_relief", Some(Value::Bool(false))),
+            ("set_point", None),
+            ("kp", None),
+            ("feed_velocity", Some(Value::Num(0.0))),
+            ("force", Some(Value::Bool(true))),
+        ],
+    },
     // The Beckhoff hydraulic library's stops (a hydraulic axis): `execute = false` releases the
     // lock of MC_EmergencyStop_BkPlcMc / MC_ImmediateStop_BkPlcMc; ramp_time 0: the
     // parameter's ramp.
@@ -984,6 +997,20 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
                 filter: a.num("filter")?,
             },
         },
+        "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc" => Command::SlowDownOnPressure {
+            enable: a.flag("enable")?,
+            params: tandem_motion::hydraulic::slow_down::SlowDownParams {
+                enable_relief: a.flag("enable_relief")?,
+                set_point: a.num("set_point")?,
+                kp: a.num("kp")?,
+                feed_velocity: a.num("feed_velocity")?,
+                reading: if a.flag("force")? {
+                    tandem_motion::hydraulic::pressure::PressureReading::Force
+                } else {
+                    tandem_motion::hydraulic::pressure::PressureReading::Pressure
+                },
+            },
+        },
         "MC_EmergencyStop_BkPlcMc" => Command::EmergencyStop {
             execute: a.flag("execute")?,
             ramp_time: a.num("ramp_time")?,
@@ -1249,6 +1276,38 @@ mod tests {
                 },
             }
         );
+    }
+
+    #[test]
+    fn slow_down_on_pressure_takes_the_library_inputs() {
+        let c = parse(
+            "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc",
+            &[
+                p("set_point", Value::Num(10_000.0)),
+                p("kp", Value::Num(0.01)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::SlowDownOnPressure {
+                enable: true,
+                params: tandem_motion::hydraulic::slow_down::SlowDownParams {
+                    enable_relief: false,
+                    set_point: 10_000.0,
+                    kp: 0.01,
+                    feed_velocity: 0.0,
+                    reading: tandem_motion::hydraulic::pressure::PressureReading::Force,
+                },
+            }
+        );
+        assert!(parse(
+            "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc",
+            &[p("kp", Value::Num(0.01))],
+            Refs::default()
+        )
+        .is_err());
     }
 
     #[test]

@@ -265,6 +265,11 @@ pub struct CtrlBasedGenerator {
     feed: [bool; 2],
     /// Automatic starts by `fReposDistance`.
     repositioned: u64,
+    /// The limit of the set velocity's magnitude during a move (mm/s; +∞: none; negative:
+    /// backing off), MC_AxCtrlSlowDownOnPressureEx_BkPlcMc's permissible velocity.
+    velocity_limit: f64,
+    /// The last cycle's set velocity was cut to `velocity_limit`.
+    limited: bool,
 }
 
 impl CtrlBasedGenerator {
@@ -327,6 +332,8 @@ impl CtrlBasedGenerator {
                 brake_point: 0.0,
             },
             reverse_pending: false,
+            velocity_limit: f64::INFINITY,
+            limited: false,
             stop_dec: p.ref_velo / p.stop_ramp,
             feed: [true; 2],
             repositioned: 0,
@@ -526,6 +533,7 @@ impl CtrlBasedGenerator {
 
     /// The state machine of one cycle.
     fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
+        self.limited = false;
         let sign = if self.positive { 1.0 } else { -1.0 };
         let approach = *self.approach(self.positive);
         let speed = self.velocity.abs();
@@ -607,7 +615,23 @@ impl CtrlBasedGenerator {
             };
             s
         };
-        self.set(s * sign, dt);
+        self.limited = s > self.velocity_limit;
+        self.set(s.min(self.velocity_limit) * sign, dt);
+    }
+
+    /// Limits the magnitude of the set velocity of the moves from the next cycle on to
+    /// `limit` (mm/s; `f64::INFINITY`: no limit; a negative limit backs off against the move's
+    /// direction). Stops and the idle state are not limited. A non-finite limit other than
+    /// +∞ is ignored.
+    pub fn limit_velocity(&mut self, limit: f64) {
+        if limit.is_finite() || limit == f64::INFINITY {
+            self.velocity_limit = limit;
+        }
+    }
+
+    /// Whether the last cycle's set velocity of a move was cut by [`Self::limit_velocity`].
+    pub fn limited(&self) -> bool {
+        self.limited
     }
 
     /// Sets the set velocity and integrates the set position.

@@ -22,6 +22,8 @@
 //!   absolute output with direction bits, reversal);
 //! - [`pressure`]: the pressures and force from two inputs (`MC_AxRtReadForceDiff_BkPlcMc`) and
 //!   the pressure or force controller (`MC_AxCtrlPressure_BkPlcMc`);
+//! - [`slow_down`]: slowing down on pressure, `MC_AxCtrlSlowDownOnPressureEx_BkPlcMc` (a
+//!   permissible velocity from the margin to a set pressure or force);
 //! - [`autoident`]: the automatic identification `MC_AxUtiAutoIdent_BkPlcMc` (end of travel,
 //!   overlap and offset, area ratio, characteristic curve).
 
@@ -34,5 +36,6 @@ pub mod finish;
 pub mod generator;
 pub mod monitor;
 pub mod pressure;
+pub mod slow_down;
 pub mod time_ramp;
 pub mod valve_table;

@@ -46,6 +46,9 @@ pub enum Instruction {
     PressureControl,
     /// `MC_AxCtrlAutoZero_BkPlcMc` (Beckhoff hydraulic library): automatic zero compensation.
     AutoZero,
+    /// `MC_AxCtrlSlowDownOnPressureEx_BkPlcMc` (Beckhoff hydraulic library): slowing down on
+    /// pressure.
+    SlowDownOnPressure,
     /// `MC_EmergencyStop_BkPlcMc` (Beckhoff hydraulic library): stop on the emergency ramp,
     /// outputs locked while Execute.
     EmergencyStop,
@@ -111,6 +114,7 @@ impl Instruction {
             Self::MotionInVelocity => "MC_MotionInVelocity",
             Self::PressureControl => "MC_AxCtrlPressure_BkPlcMc",
             Self::AutoZero => "MC_AxCtrlAutoZero_BkPlcMc",
+            Self::SlowDownOnPressure => "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc",
             Self::EmergencyStop => "MC_EmergencyStop_BkPlcMc",
             Self::ImmediateStop => "MC_ImmediateStop_BkPlcMc",
             Self::RampedStop => "MC_RampedStop_BkPlcMc",

@@ -469,6 +469,16 @@ pub enum Command {
         /// `EnableOnMoving`, `OffsetLimit`, `Tn`, `Threshold`, `Filter`.
         params: crate::hydraulic::auto_zero::AutoZeroParams,
     },
+    /// `MC_AxCtrlSlowDownOnPressureEx_BkPlcMc` (Beckhoff TwinCAT PLC Hydraulic Positioning
+    /// library, 4.4.1.5): with `enable` the hydraulic axis' moves are braked so that the
+    /// actual pressure or force does not pass `params.set_point`; without, the limit ends.
+    #[doc(alias = "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc")]
+    SlowDownOnPressure {
+        /// `Enable`.
+        enable: bool,
+        /// `EnableRelief`, `Setpoint`, `kP`, `FeedVelocity` and the reading.
+        params: crate::hydraulic::slow_down::SlowDownParams,
+    },
     /// `MC_EmergencyStop_BkPlcMc` (Beckhoff TwinCAT PLC Hydraulic Positioning library, from
     /// V3.0.5): the set velocity ramps to 0 on the generator (`RampTime` from `fRefVelo`, else
     /// `fEmergencyRamp`); once it is 0 the valve output is suppressed while `execute` stays

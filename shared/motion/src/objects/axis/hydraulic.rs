@@ -23,6 +23,7 @@ use crate::hydraulic::controller::HydControllerParams;
 use crate::hydraulic::generator::{CtrlBasedGenerator, HydState, Setpoint};
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
 use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
+use crate::hydraulic::slow_down::{SlowDownParams, SlowDownStatus};
 use crate::kinematics::profile::{Profile, State};
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 use crate::plant::link::HydValveOutputs;
@@ -35,13 +36,13 @@ pub(super) struct HydAxis {
     /// The generator computes the basic setpoint.
     pub(super) engaged: bool,
     /// The generator's output of the last cycle.
-    last: Setpoint,
+    pub(super) last: Setpoint,
     /// The target window of the last cycle.
     window: TargetStatus,
     /// `fRefVelo` (mm/s): the velocity of a control value of 1.0.
     pub(super) ref_velo: f64,
     /// The pressures and the force of the last sample; `None` without pressure inputs.
-    actual: Option<ActualForce>,
+    pub(super) actual: Option<ActualForce>,
     /// The running MC_AxCtrlPressure_BkPlcMc job.
     pressure: Option<PressureJob>,
     /// The position controller's and Finish's parameters (AutoZero's basis).
@@ -50,6 +51,9 @@ pub(super) struct HydAxis {
     auto_zero: Option<(AutoZero, bool)>,
     /// The library's stop and jog instructions' state (`super::hyd_commands`).
     pub(super) cmds: super::hyd_commands::HydCommands,
+    /// MC_AxCtrlSlowDownOnPressureEx_BkPlcMc while enabled, with its last cycle
+    /// (`super::hyd_slow_down`).
+    pub(super) slow_down: Option<(SlowDownParams, SlowDownStatus)>,
 }
 
 /// A running pressure or force control.
@@ -87,6 +91,9 @@ pub struct HydraulicStatus {
     /// MC_AxCtrlAutoZero_BkPlcMc's outputs and `fZeroCompensation`, once it has been enabled,
     /// with its `Enable`.
     pub auto_zero: Option<(AutoZeroStatus, bool)>,
+    /// MC_AxCtrlSlowDownOnPressureEx_BkPlcMc while enabled: `Busy`, `Active` and the
+    /// permissible velocity of the last cycle.
+    pub slow_down: Option<SlowDownStatus>,
 }
 
 impl HydAxis {
@@ -113,6 +120,7 @@ impl HydAxis {
             controller: cfg.controller,
             auto_zero: None,
             cmds: super::hyd_commands::HydCommands::new(cfg.jog_velo),
+            slow_down: None,
         }))
     }
 }
@@ -189,7 +197,9 @@ impl Axis {
         if !h.engaged {
             return false;
         }
+        h.slow_down_before();
         let sp = h.gen.step(dt, actual, actual_v);
+        h.slow_down_after();
         h.last = sp;
         h.window = h
             .monitor
@@ -372,6 +382,7 @@ impl Axis {
             actual: h.actual,
             pressure_control: h.pressure.map(|p| (p.set, p.last)),
             auto_zero: h.auto_zero.map(|(a, on)| (a.status(), on)),
+            slow_down: h.slow_down.map(|(_, s)| s),
         })
     }
 
@@ -492,6 +503,7 @@ impl Axis {
                 },
             ),
             Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
+            Command::SlowDownOnPressure { enable, params } => self.cmd_slow_down(enable, params),
             _ => Err(ErrorId::IllegalObject),
         }
     }

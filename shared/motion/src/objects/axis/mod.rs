@@ -12,6 +12,7 @@ mod command;
 mod config;
 mod hyd_commands;
 mod hyd_joystick;
+mod hyd_slow_down;
 mod hydraulic;
 mod step;
 mod sync;
@@ -1064,7 +1065,8 @@ impl Axis {
             Command::SetOverride { velocity } => self.cmd_set_override(velocity),
             Command::HydPower { .. }
             | Command::PressureControl { .. }
-            | Command::AutoZero { .. } => self.apply_hyd_control(cmd),
+            | Command::AutoZero { .. }
+            | Command::SlowDownOnPressure { .. } => self.apply_hyd_control(cmd),
             Command::EmergencyStop { .. }
             | Command::ImmediateStop { .. }
             | Command::RampedStop { .. }
