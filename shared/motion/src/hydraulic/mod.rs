@@ -29,6 +29,7 @@ pub mod controller;
 pub mod drive_output;
 pub mod finish;
 pub mod generator;
+pub mod jerk_generator;
 pub mod monitor;
 pub mod pressure;
 pub mod time_ramp;
