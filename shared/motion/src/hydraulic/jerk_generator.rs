@@ -854,6 +854,161 @@ impl JerkBasedGenerator {
     }
 }
 
+/// The generator `nProfileType` selects, behind one interface (the axis runs either).
+#[doc(alias = "nProfileType")]
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Generator {
+    /// `iTcMc_ProfileCtrlBased`.
+    CtrlBased(CtrlBasedGenerator),
+    /// `iTcMc_ProfileJerkBased`.
+    JerkBased(JerkBasedGenerator),
+}
+
+impl Generator {
+    /// The generator `sel` selects with parameters `p`, idle at position `x`.
+    pub fn new(sel: &ProfileSelection, p: GeneratorParams, x: f64) -> Result<Self, GeneratorError> {
+        Ok(match sel.profile_type {
+            ProfileType::CtrlBased => Self::CtrlBased(CtrlBasedGenerator::new(p, x)?),
+            ProfileType::JerkBased => Self::JerkBased(JerkBasedGenerator::new(p, sel.jerk, x)?),
+        })
+    }
+
+    /// Which one it is.
+    pub fn profile_type(&self) -> ProfileType {
+        match self {
+            Self::CtrlBased(_) => ProfileType::CtrlBased,
+            Self::JerkBased(_) => ProfileType::JerkBased,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &GeneratorParams {
+        match self {
+            Self::CtrlBased(g) => g.params(),
+            Self::JerkBased(g) => g.params(),
+        }
+    }
+
+    /// The state.
+    pub fn state(&self) -> HydState {
+        match self {
+            Self::CtrlBased(g) => g.state(),
+            Self::JerkBased(g) => g.state(),
+        }
+    }
+
+    /// `fTargetPos`.
+    pub fn target(&self) -> f64 {
+        match self {
+            Self::CtrlBased(g) => g.target(),
+            Self::JerkBased(g) => g.target(),
+        }
+    }
+
+    /// Automatic starts by `fReposDistance`.
+    pub fn repositioned(&self) -> u64 {
+        match self {
+            Self::CtrlBased(g) => g.repositioned(),
+            Self::JerkBased(g) => g.repositioned(),
+        }
+    }
+
+    /// The remaining distance at which the braking ramp of the running move begins.
+    pub fn brake_point(&self) -> f64 {
+        match self {
+            Self::CtrlBased(g) => g.brake_point(),
+            Self::JerkBased(g) => g.brake_point(),
+        }
+    }
+
+    /// A move as [`CtrlBasedGenerator::move_absolute`] (the jerk-based one with `fMaxJerk`).
+    pub fn move_absolute(
+        &mut self,
+        target: f64,
+        velocity: f64,
+        acceleration: f64,
+        deceleration: f64,
+        actual: f64,
+    ) -> Result<(), GeneratorError> {
+        self.move_with_jerk(target, velocity, (acceleration, deceleration, 0.0), actual)
+    }
+
+    /// A move with the command's acceleration, deceleration and jerk (the displacement-based
+    /// generator has no use for the jerk).
+    pub fn move_with_jerk(
+        &mut self,
+        target: f64,
+        velocity: f64,
+        (acceleration, deceleration, jerk): (f64, f64, f64),
+        actual: f64,
+    ) -> Result<(), GeneratorError> {
+        match self {
+            Self::CtrlBased(g) => {
+                g.move_absolute(target, velocity, acceleration, deceleration, actual)
+            }
+            Self::JerkBased(g) => {
+                g.move_absolute(target, velocity, (acceleration, deceleration, jerk), actual)
+            }
+        }
+    }
+
+    /// The feed enables of the two directions.
+    pub fn set_feed_enables(&mut self, positive: bool, negative: bool) {
+        match self {
+            Self::CtrlBased(g) => g.set_feed_enables(positive, negative),
+            Self::JerkBased(g) => g.set_feed_enables(positive, negative),
+        }
+    }
+
+    /// Whether direction `positive` has its feed enable.
+    pub fn feed_enabled(&self, positive: bool) -> bool {
+        match self {
+            Self::CtrlBased(g) => g.feed_enabled(positive),
+            Self::JerkBased(g) => g.feed_enabled(positive),
+        }
+    }
+
+    /// A regular stop with `fStopRamp`.
+    pub fn stop(&mut self) {
+        match self {
+            Self::CtrlBased(g) => g.stop(),
+            Self::JerkBased(g) => g.stop(),
+        }
+    }
+
+    /// A stop with the command's deceleration.
+    pub fn stop_with(&mut self, deceleration: f64) {
+        match self {
+            Self::CtrlBased(g) => g.stop_with(deceleration),
+            Self::JerkBased(g) => g.stop_with(deceleration),
+        }
+    }
+
+    /// Takes over another generator's setpoint.
+    pub fn take_over(&mut self, position: f64, velocity: f64) {
+        match self {
+            Self::CtrlBased(g) => g.take_over(position, velocity),
+            Self::JerkBased(g) => g.take_over(position, velocity),
+        }
+    }
+
+    /// An emergency stop with `fEmergencyRamp`.
+    pub fn emergency_stop(&mut self) {
+        match self {
+            Self::CtrlBased(g) => g.emergency_stop(),
+            Self::JerkBased(g) => g.emergency_stop(),
+        }
+    }
+
+    /// One cycle.
+    pub fn step(&mut self, dt: f64, actual: f64, actual_velocity: f64) -> Setpoint {
+        match self {
+            Self::CtrlBased(g) => g.step(dt, actual, actual_velocity),
+            Self::JerkBased(g) => g.step(dt, actual, actual_velocity),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]

@@ -20,7 +20,8 @@ use super::{Axis, Command, Goal, StartMode, StopMode};
 use crate::catalog::error_id::ErrorId;
 use crate::hydraulic::auto_zero::{AutoZero, AutoZeroInput, AutoZeroParams, AutoZeroStatus};
 use crate::hydraulic::controller::HydControllerParams;
-use crate::hydraulic::generator::{CtrlBasedGenerator, HydState, Setpoint};
+use crate::hydraulic::generator::{HydState, Setpoint};
+use crate::hydraulic::jerk_generator::Generator;
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
 use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
 use crate::kinematics::profile::{Profile, State};
@@ -30,7 +31,10 @@ use crate::plant::link::HydValveOutputs;
 /// The hydraulic part of an axis (boxed in the axis: allocated when it is built).
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct HydAxis {
-    pub(super) gen: CtrlBasedGenerator,
+    pub(super) gen: Generator,
+    /// `bTimeBased`: the generator runs on the set position and the position controller acts
+    /// during the move.
+    time_based: bool,
     monitor: TargetMonitor,
     /// The generator computes the basic setpoint.
     pub(super) engaged: bool,
@@ -92,7 +96,7 @@ pub struct HydraulicStatus {
 impl HydAxis {
     /// The hydraulic part of an axis at position `p0`, from its validated configuration.
     pub(super) fn new(cfg: &super::config::HydraulicProfile, p0: f64) -> Option<Box<Self>> {
-        let gen = CtrlBasedGenerator::new(cfg.generator, p0).ok()?;
+        let gen = Generator::new(&cfg.profile, cfg.generator, p0).ok()?;
         let monitor = TargetMonitor::new(cfg.monitor).ok()?;
         Some(Box::new(Self {
             gen,
@@ -113,6 +117,7 @@ impl HydAxis {
             controller: cfg.controller,
             auto_zero: None,
             cmds: super::hyd_commands::HydCommands::new(cfg.jog_velo),
+            time_based: cfg.profile.time_based,
         }))
     }
 }
@@ -131,7 +136,7 @@ impl Axis {
                 h.gen.take_over(basic.p, basic.v);
                 if ovr > 0.0 {
                     h.gen
-                        .move_absolute(target, lim.vel * ovr, lim.acc, lim.dec, actual)
+                        .move_with_jerk(target, lim.vel * ovr, (lim.acc, lim.dec, lim.jerk), actual)
                         .is_ok()
                 } else {
                     h.gen.stop_with(lim.dec);
@@ -176,6 +181,7 @@ impl Axis {
         }
         let dt = self.cfg.cycle;
         let (actual, actual_v, v0) = (self.actual_p, self.actual_v, self.basic.v);
+        let basic = self.basic;
         let its_goal = matches!(
             self.goal,
             Goal::Position { .. } | Goal::Stop { .. } | Goal::Hold
@@ -189,7 +195,15 @@ impl Axis {
         if !h.engaged {
             return false;
         }
-        let sp = h.gen.step(dt, actual, actual_v);
+        // bTimeBased: while it moves the generator runs on its own set position and velocity of
+        // the last cycle, so its profile is a function of time (the braking too); idle, on the
+        // actual position (the automatic repositioning).
+        let (x, xv) = if h.time_based && h.gen.state() != HydState::Idle {
+            (basic.p, basic.v)
+        } else {
+            (actual, actual_v)
+        };
+        let sp = h.gen.step(dt, x, xv);
         h.last = sp;
         h.window = h
             .monitor
@@ -225,6 +239,11 @@ impl Axis {
     pub(super) fn hyd_position_control(&self) -> bool {
         match self.hyd.as_deref() {
             Some(h) if h.pressure.is_some() => false,
+            // bTimeBased: "The position controller is always active" (at the target too,
+            // except where target clamping replaces it).
+            Some(h) if h.engaged && h.time_based => {
+                h.last.position_control || h.last.state != HydState::Idle
+            }
             Some(h) if h.engaged => h.last.position_control,
             _ => true,
         }
