@@ -1127,7 +1127,7 @@ mod tests {
         // reads the distance a cycle late: 500·(1 + 2·500·dt/v)).
         for w in out.windows(2) {
             let (v0, v1) = (w[0].s.velocity, w[1].s.velocity);
-            assert!(v1 <= 100.0 + 1e-12 && v1 >= 0.0);
+            assert!((0.0..=100.0 + 1e-12).contains(&v1));
             assert!(w[1].a.abs() <= 500.0 + 1e-9, "{w:?}");
             let slack = 1.0 + 2.0 * 500.0 * DT / v1.abs().max(1.0);
             assert!((v1 - v0).abs() / DT <= 500.0 * slack + 1e-9, "{w:?}");
