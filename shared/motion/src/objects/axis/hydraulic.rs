@@ -14,6 +14,12 @@
 //! loop only at standstill); a positioning is Done when the generator is idle and the target
 //! window monitoring reports InTargRng and InTarget.
 //!
+//! `nProfileType` selects the generator: the displacement-based one or the jerk-based one
+//! (`iTcMc_ProfileJerkBased`, [`crate::hydraulic::jerk_generator`]), behind one
+//! [`Generator`]. With `bTimeBased` the generator runs on its own set position and velocity of
+//! the last cycle while it moves (a function of time), and the position controller acts
+//! throughout the move.
+//!
 //! [`DriveOutputs::position_controlled`]: crate::plant::link::DriveOutputs::position_controlled
 
 use super::{Axis, Command, Goal, StartMode, StopMode};
