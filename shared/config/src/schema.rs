@@ -318,6 +318,29 @@ pub struct HydraulicSection {
     pub ScaleArreaA: Option<f64>,
     /// The annulus area for the force (mm²; default 1).
     pub ScaleArreaB: Option<f64>,
+    /// The generator of the positionings (`E_TcMcProfileType`): the library's name
+    /// (`iTcMc_ProfileCtrlBased`, the default; `iTcMc_ProfileJerkBased`;
+    /// `iTcMc_ProfileConstAcc`, the old name of the first) or its number (3, 5, 0).
+    pub nProfileType: Option<ProfileTypeValue>,
+    /// The jerk of the jerk-based generator (mm/s³; default 1000).
+    pub fMaxJerk: Option<f64>,
+    /// Which transitions of the jerk-based profile are jerk-limited (a WORD; default
+    /// `0x0101`): `0x0001` the build-up of the acceleration, `0x0002` its reduction,
+    /// `0x0100` the end into the target.
+    pub nJerkEnabled: Option<i64>,
+    /// The time-based mode: the profile runs in time on the set position and the position
+    /// controller acts during the move (default false: displacement-based).
+    pub bTimeBased: Option<bool>,
+}
+
+/// `nProfileType`: the library's enumeration name or its number.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ProfileTypeValue {
+    /// A name of `E_TcMcProfileType`.
+    Name(String),
+    /// Its number.
+    Number(i64),
 }
 
 /// `[signals.<name>]`: a named signal on a channel of a device. Its type comes from the

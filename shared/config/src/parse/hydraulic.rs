@@ -4,13 +4,16 @@
 
 use super::FieldError;
 use crate::error::Problem;
-use crate::schema::{CylinderSection, DeviceSection, HydraulicSection};
+use crate::schema::{CylinderSection, DeviceSection, HydraulicSection, ProfileTypeValue};
 use tandem_motion::hydraulic::controller::{HydController, HydControllerParams};
 use tandem_motion::hydraulic::controller_ex::PosPiControllerExParams;
 use tandem_motion::hydraulic::drive_output::{DriveOutputParams, ValveOutput};
 use tandem_motion::hydraulic::finish::{FinishError, FinishParams};
 use tandem_motion::hydraulic::generator::{
     Approach, CtrlBasedGenerator, GeneratorError, GeneratorParams,
+};
+use tandem_motion::hydraulic::jerk_generator::{
+    JerkParams, ProfileSelection, ProfileType, JERK_ENABLED_BITS,
 };
 use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
 use tandem_motion::hydraulic::pressure::ForceScaling;
@@ -108,7 +111,8 @@ fn profile_key(name: &str) -> &'static str {
 /// of range.
 pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldError> {
     let controller = controller(h).map_err(|(name, problem)| (profile_key(name), problem))?;
-    let p = unchecked_profile(h, controller);
+    let mut p = unchecked_profile(h, controller);
+    p.profile = profile_selection(h)?;
     CtrlBasedGenerator::new(p.generator, 0.0).map_err(|e| {
         let name = match e {
             GeneratorError::Invalid { name, .. } => name,
@@ -192,7 +196,70 @@ fn unchecked_profile(h: &HydraulicSection, controller: HydControllerParams) -> H
             h.fJogVeloSlow.unwrap_or(JOG_VELO_DEFAULTS[0]),
             h.fJogVeloFast.unwrap_or(JOG_VELO_DEFAULTS[1]),
         ],
+        profile: ProfileSelection::default(),
     }
+}
+
+/// `nProfileType`, `fMaxJerk`, `nJerkEnabled` and `bTimeBased` of section `h`, checked: the
+/// key out of range. The generators a cell can select are the displacement-based and the
+/// jerk-based one; the library's other types (`iTcMc_ProfileTimeRamp` 4, the obsolete 1 and 2,
+/// the reserved 6, 7, 100) are refused.
+fn profile_selection(h: &HydraulicSection) -> Result<ProfileSelection, FieldError> {
+    let names = || {
+        vec![
+            "iTcMc_ProfileConstAcc (0)",
+            "iTcMc_ProfileCtrlBased (3)",
+            "iTcMc_ProfileJerkBased (5)",
+        ]
+    };
+    let profile_type = match &h.nProfileType {
+        None => ProfileType::default(),
+        Some(ProfileTypeValue::Name(n)) => ProfileType::from_name(n).ok_or_else(|| {
+            (
+                "hydraulic.nProfileType",
+                Problem::NotOneOf {
+                    value: n.clone(),
+                    options: names(),
+                },
+            )
+        })?,
+        Some(ProfileTypeValue::Number(k)) => ProfileType::from_number(*k).ok_or_else(|| {
+            (
+                "hydraulic.nProfileType",
+                Problem::NotOneOf {
+                    value: k.to_string(),
+                    options: names(),
+                },
+            )
+        })?,
+    };
+    let d = JerkParams::default();
+    let max_jerk = h.fMaxJerk.unwrap_or(d.max_jerk);
+    if !(max_jerk.is_finite() && max_jerk > 0.0) {
+        return Err((
+            "hydraulic.fMaxJerk",
+            Problem::Invalid("must be a finite number above 0 (mm/s³; ST_TcHydAxParam)"),
+        ));
+    }
+    let bits = h.nJerkEnabled.unwrap_or(i64::from(d.jerk_enabled));
+    let jerk_enabled = u16::try_from(bits)
+        .ok()
+        .filter(|b| b & !JERK_ENABLED_BITS == 0)
+        .ok_or((
+            "hydraulic.nJerkEnabled",
+            Problem::Invalid(
+                "must be a combination of 0x0001 (acceleration built up with limited jerk), \
+                 0x0002 (reduced with limited jerk) and 0x0100 (the end into the target)",
+            ),
+        ))?;
+    Ok(ProfileSelection {
+        profile_type,
+        jerk: JerkParams {
+            max_jerk,
+            jerk_enabled,
+        },
+        time_based: h.bTimeBased.unwrap_or(false),
+    })
 }
 
 /// The position controller and Finish of section `h`, checked: the key of the parameter out

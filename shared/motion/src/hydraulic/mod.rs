@@ -34,6 +34,7 @@ pub mod controller_ex;
 pub mod drive_output;
 pub mod finish;
 pub mod generator;
+pub mod jerk_generator;
 pub mod monitor;
 pub mod pressure;
 pub mod slow_down;

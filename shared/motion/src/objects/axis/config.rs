@@ -239,6 +239,9 @@ pub struct HydraulicProfile {
     #[doc(alias = "fJogVeloSlow")]
     #[doc(alias = "fJogVeloFast")]
     pub jog_velo: [f64; 2],
+    /// `nProfileType` (the displacement-based or the jerk-based generator), `fMaxJerk`,
+    /// `nJerkEnabled` and `bTimeBased`.
+    pub profile: crate::hydraulic::jerk_generator::ProfileSelection,
 }
 
 /// `fJogVeloSlow` and `fJogVeloFast` by default (mm/s), as the library's `ST_TcHydAxParam`.

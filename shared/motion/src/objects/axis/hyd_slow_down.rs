@@ -9,6 +9,7 @@
 use super::hydraulic::HydAxis;
 use super::Axis;
 use crate::catalog::error_id::ErrorId;
+use crate::hydraulic::jerk_generator::ProfileType;
 use crate::hydraulic::slow_down::{SlowDownParams, SlowDownStatus};
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 
@@ -37,7 +38,8 @@ impl HydAxis {
 impl Axis {
     /// `MC_AxCtrlSlowDownOnPressureEx_BkPlcMc`: with `enable` the limiter runs with `params`
     /// (a running one takes them); without, it ends. Refused (16#80F5) on an axis without
-    /// pressure inputs and with inputs the library refuses (`kP` not above 0, `|Setpoint| ·
+    /// pressure inputs, a time-based one or one on the jerk-based generator, and with inputs
+    /// the library refuses (`kP` not above 0, `|Setpoint| ·
     /// kP` below the creep velocity), 16#8002 on an axis that is not hydraulic; nothing
     /// changes then. Done at once: the limiter's `Busy` and `Active` are in
     /// [`super::HydraulicStatus::slow_down`].
@@ -49,7 +51,10 @@ impl Axis {
         let h = self.hyd.as_deref_mut().ok_or(ErrorId::IllegalObject)?;
         if enable {
             let refused = ErrorId::IllegalControllerParameter;
-            if h.actual.is_none() {
+            // The library's prerequisites: pressure inputs, a displacement-controlled axis
+            // (not time-based); the limit is built for the displacement generator only.
+            let ctrl_based = h.gen.profile_type() == ProfileType::CtrlBased;
+            if h.actual.is_none() || h.time_based || !ctrl_based {
                 return Err(refused);
             }
             let g = h.gen.params();

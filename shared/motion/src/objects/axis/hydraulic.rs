@@ -14,13 +14,20 @@
 //! loop only at standstill); a positioning is Done when the generator is idle and the target
 //! window monitoring reports InTargRng and InTarget.
 //!
+//! `nProfileType` selects the generator: the displacement-based one or the jerk-based one
+//! (`iTcMc_ProfileJerkBased`, [`crate::hydraulic::jerk_generator`]), behind one
+//! [`Generator`]. With `bTimeBased` the generator runs on its own set position and velocity of
+//! the last cycle while it moves (a function of time), and the position controller acts
+//! throughout the move.
+//!
 //! [`DriveOutputs::position_controlled`]: crate::plant::link::DriveOutputs::position_controlled
 
 use super::{Axis, Command, Goal, StartMode, StopMode};
 use crate::catalog::error_id::ErrorId;
 use crate::hydraulic::auto_zero::{AutoZero, AutoZeroInput, AutoZeroParams, AutoZeroStatus};
 use crate::hydraulic::controller::HydControllerParams;
-use crate::hydraulic::generator::{CtrlBasedGenerator, HydState, Setpoint};
+use crate::hydraulic::generator::{HydState, Setpoint};
+use crate::hydraulic::jerk_generator::Generator;
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
 use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
 use crate::hydraulic::slow_down::{SlowDownParams, SlowDownStatus};
@@ -31,7 +38,10 @@ use crate::plant::link::HydValveOutputs;
 /// The hydraulic part of an axis (boxed in the axis: allocated when it is built).
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct HydAxis {
-    pub(super) gen: CtrlBasedGenerator,
+    pub(super) gen: Generator,
+    /// `bTimeBased`: the generator runs on the set position and the position controller acts
+    /// during the move.
+    pub(super) time_based: bool,
     monitor: TargetMonitor,
     /// The generator computes the basic setpoint.
     pub(super) engaged: bool,
@@ -99,7 +109,7 @@ pub struct HydraulicStatus {
 impl HydAxis {
     /// The hydraulic part of an axis at position `p0`, from its validated configuration.
     pub(super) fn new(cfg: &super::config::HydraulicProfile, p0: f64) -> Option<Box<Self>> {
-        let gen = CtrlBasedGenerator::new(cfg.generator, p0).ok()?;
+        let gen = Generator::new(&cfg.profile, cfg.generator, p0).ok()?;
         let monitor = TargetMonitor::new(cfg.monitor).ok()?;
         Some(Box::new(Self {
             gen,
@@ -121,6 +131,7 @@ impl HydAxis {
             auto_zero: None,
             cmds: super::hyd_commands::HydCommands::new(cfg.jog_velo),
             slow_down: None,
+            time_based: cfg.profile.time_based,
         }))
     }
 }
@@ -139,7 +150,7 @@ impl Axis {
                 h.gen.take_over(basic.p, basic.v);
                 if ovr > 0.0 {
                     h.gen
-                        .move_absolute(target, lim.vel * ovr, lim.acc, lim.dec, actual)
+                        .move_with_jerk(target, lim.vel * ovr, (lim.acc, lim.dec, lim.jerk), actual)
                         .is_ok()
                 } else {
                     h.gen.stop_with(lim.dec);
@@ -184,6 +195,7 @@ impl Axis {
         }
         let dt = self.cfg.cycle;
         let (actual, actual_v, v0) = (self.actual_p, self.actual_v, self.basic.v);
+        let basic = self.basic;
         let its_goal = matches!(
             self.goal,
             Goal::Position { .. } | Goal::Stop { .. } | Goal::Hold
@@ -198,7 +210,15 @@ impl Axis {
             return false;
         }
         h.slow_down_before();
-        let sp = h.gen.step(dt, actual, actual_v);
+        // bTimeBased: while it moves the generator runs on its own set position and velocity of
+        // the last cycle, so its profile is a function of time (the braking too); idle, on the
+        // actual position (the automatic repositioning).
+        let (x, xv) = if h.time_based && h.gen.state() != HydState::Idle {
+            (basic.p, basic.v)
+        } else {
+            (actual, actual_v)
+        };
+        let sp = h.gen.step(dt, x, xv);
         h.slow_down_after();
         h.last = sp;
         h.window = h
@@ -235,6 +255,11 @@ impl Axis {
     pub(super) fn hyd_position_control(&self) -> bool {
         match self.hyd.as_deref() {
             Some(h) if h.pressure.is_some() => false,
+            // bTimeBased: "The position controller is always active" (at the target too,
+            // except where target clamping replaces it).
+            Some(h) if h.engaged && h.time_based => {
+                h.last.position_control || h.last.state != HydState::Idle
+            }
             Some(h) if h.engaged => h.last.position_control,
             _ => true,
         }
