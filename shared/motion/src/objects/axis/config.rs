@@ -239,6 +239,9 @@ pub struct HydraulicProfile {
     #[doc(alias = "fJogVeloSlow")]
     #[doc(alias = "fJogVeloFast")]
     pub jog_velo: [f64; 2],
+    /// The homing members (`nEnc_HomingType`, `fEnc_RefIndexVelo` …) and `fBlockDetectDelay`:
+    /// MC_Home_BkPlcMc.
+    pub homing: super::hyd_home::HydHomingParams,
 }
 
 /// `fJogVeloSlow` and `fJogVeloFast` by default (mm/s), as the library's `ST_TcHydAxParam`.
@@ -460,6 +463,7 @@ impl AxisConfig {
             })
         })?;
         crate::hydraulic::monitor::TargetMonitor::new(h.monitor).map_err(|e| refused(e.name))?;
+        h.homing.check().map_err(|e| refused(e.name))?;
         Ok(())
     }
 

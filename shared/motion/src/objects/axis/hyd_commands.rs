@@ -73,6 +73,8 @@ pub(super) struct HydCommands {
     jog: Option<JogRun>,
     /// A running MC_MoveJoySticked_BkPlcMc.
     pub(super) joystick: Option<super::hyd_joystick::JoyRun>,
+    /// A running MC_Home_BkPlcMc.
+    pub(super) home: Option<super::hyd_home::HomeRun>,
 }
 
 impl HydCommands {
@@ -84,6 +86,7 @@ impl HydCommands {
             jog_inputs: (false, false),
             jog: None,
             joystick: None,
+            home: None,
         }
     }
 
@@ -127,6 +130,7 @@ impl Axis {
                 acceleration,
                 deceleration,
             } => self.cmd_joystick(execute, joystick, acceleration, deceleration),
+            Command::HydHome(ref inputs) => self.cmd_hyd_home(inputs),
             Command::SetReferenceFlag { reference_flag } => {
                 Ok(self.instant_job(Instruction::SetReferenceFlag, |ax| {
                     ax.homed = reference_flag;
@@ -311,6 +315,7 @@ impl Axis {
             self.hyd_lock_cycle(l);
         }
         self.hyd_joystick_cycle();
+        self.hyd_home_cycle();
         let Some(m) = self.main else {
             return;
         };

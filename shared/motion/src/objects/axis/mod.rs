@@ -11,6 +11,7 @@ mod buffer;
 mod command;
 mod config;
 mod hyd_commands;
+mod hyd_home;
 mod hyd_joystick;
 mod hydraulic;
 mod step;
@@ -27,6 +28,11 @@ pub use config::{
     FollowingErrorMonitoring, HomingConfig, HomingMark, HydraulicProfile, MotionType,
     PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
     JOG_VELO_DEFAULTS,
+};
+pub use hyd_home::{
+    resolve as resolve_hyd_homing, HomingAxis, HomingInput, HomingMethod, HomingOutput,
+    HomingPhase, HomingSequence, HydHomeInputs, HydHomeRefusal, HydHomingMode, HydHomingParams,
+    HydHomingParamsError, HydHomingType, BLOCK_DETECT_DELAY_DEFAULT,
 };
 pub use hydraulic::HydraulicStatus;
 pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
@@ -1072,7 +1078,8 @@ impl Axis {
             | Command::SetReferenceFlag { .. }
             | Command::ResetAndStop { .. }
             | Command::HydMoveJog { .. }
-            | Command::MoveJoySticked { .. } => self.apply_hyd_command(cmd),
+            | Command::MoveJoySticked { .. }
+            | Command::HydHome(_) => self.apply_hyd_command(cmd),
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
