@@ -14,10 +14,12 @@ use tandem_config::Cell;
 use tandem_motion::catalog::alarm::status_bit;
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::kinematics::dynamics::Dynamics;
+use tandem_motion::objects::action::Action;
 use tandem_motion::objects::axis::{
-    AxisState, Command, HydHomeInputs, HydHomingMode, VelocityDirection,
+    AxisState, Command, HydHomeInputs, HydHomingMode, StartMode, StopMode, VelocityDirection,
 };
 use tandem_motion::objects::job::Instruction;
+use tandem_runtime::exec::Executive;
 use tandem_testkit::workspace::root;
 
 /// fRefVelo of config/hydraulic.toml.
@@ -243,6 +245,41 @@ fn execute_dropped_does_not_stop_a_homing_and_the_calibration_cam_counts() {
     assert!(r.axis_value(x).abs() < 0.1, "{}", r.axis_value(x));
 }
 
+/// A positioning while the homing runs aborts it (CommandAborted); the axis stays not homed,
+/// the loop closes again and the positioning lands.
+#[test]
+fn a_positioning_aborts_a_homing() {
+    let cell = cell("", "");
+    let mut r = Run::enabled(&cell);
+    let id = r
+        .try_cmd(home(true, 0.0, HydHomingMode::Block))
+        .unwrap()
+        .unwrap();
+    for _ in 0..500 {
+        r.step();
+    }
+    let x = r.status().actual_position;
+    r.cmd(Command::MoveRelative {
+        distance: 20.0,
+        dynamics: Dynamics {
+            velocity: 50.0,
+            acceleration: -1.0,
+            deceleration: -1.0,
+            jerk: -1.0,
+        },
+    });
+    r.step();
+    assert!(r.logged(id, "CommandAborted"), "{}", r.log());
+    r.until(10_000, "landed", |r| r.status().motion_job.is_none());
+    let s = r.status();
+    assert!(!s.has(status_bit::HOMING_DONE));
+    assert!(
+        (s.actual_position - (x + 20.0)).abs() < 1.0,
+        "{s:?} from {x}"
+    );
+    assert_eq!(s.state, AxisState::Standstill);
+}
+
 /// The refusals, each changing nothing: a moving axis (the library's NotStartable 16#4B01;
 /// 16#8003), an unsupported mode (NotSupport 16#4107; 16#800A), an axis in an error state
 /// (NotReady 16#4B09; 16#80F3), a velocity below 1 % of fRefVelo (SetVelo 16#4359; 16#8003),
@@ -314,6 +351,36 @@ fn refusals_change_nothing() {
     );
     assert!((r.status().actual_position - before).abs() < 1.0);
     assert!(r.status().actual_position > 100.0);
+    // Not enabled.
+    let mut r = Run::enabled(&cell);
+    r.cmd(Command::Power {
+        enable: false,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Emergency,
+    });
+    r.until(1000, "disabled", |r| r.state() == AxisState::Disabled);
+    assert_eq!(
+        r.try_cmd(home(true, 0.0, HydHomingMode::Direct)),
+        Err(ErrorId::NotEnabled)
+    );
+
+    // An electric axis (config/analog.toml's slide).
+    let s = std::fs::read_to_string(root().join("config/analog.toml")).unwrap();
+    let electric = tandem_config::parse("analog.toml", &s).unwrap();
+    let mut exec = Executive::new(&electric, None).unwrap();
+    let mut log = Vec::new();
+    exec.step(0, &mut log).unwrap();
+    let out = exec
+        .apply_at(
+            0,
+            0,
+            "slide",
+            "test",
+            Action::Command(home(true, 0.0, HydHomingMode::Direct)),
+            &mut log,
+        )
+        .unwrap();
+    assert_eq!(out, Err(ErrorId::IllegalObject));
 }
 
 /// The cell file's keys: each out of its range is refused naming it; a bad nEnc_HomingType

@@ -663,13 +663,25 @@ impl Axis {
 
     /// One cycle of a running MC_Home_BkPlcMc: the sequence on this cycle's actual values and
     /// cam; at its end the actual value set, the homed status set, the loop closed, Done. A job
-    /// that is no longer the axis' (aborted) ends it.
+    /// that is no longer the axis' (aborted) ends it, and the loop closes again unless the job
+    /// that took over chose its own mode (a velocity motion).
     pub(super) fn hyd_home_cycle(&mut self) {
         let Some(mut run) = self.hyd.as_deref().and_then(|h| h.cmds.home) else {
             return;
         };
         let Some(m) = self.main.filter(|m| m.id == run.job) else {
             self.set_home_run(None);
+            let own_mode = self.main.is_some_and(|m| {
+                matches!(
+                    m.instr,
+                    Instruction::MoveVelocity
+                        | Instruction::MotionInVelocity
+                        | Instruction::MoveJog
+                )
+            });
+            if !own_mode {
+                self.set_position_control(true);
+            }
             return;
         };
         let input = HomingInput {
@@ -679,6 +691,9 @@ impl Axis {
             actual_velocity: self.actual_v,
         };
         let v0 = self.basic.v;
+        // Without position control the set position follows the actual one (an abort then
+        // closes the loop where the axis is).
+        self.basic.p = self.actual_p - self.sup.p;
         let out = run.seq.step(&input);
         self.goal = Goal::Direct {
             position: None,
