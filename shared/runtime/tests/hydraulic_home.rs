@@ -135,6 +135,34 @@ fn abs_switch_gives_the_cams_leaving_edge_the_position() {
     assert!((r.status().actual_position - 30.0).abs() < 0.2);
 }
 
+/// AbsSwitch on the reference cam as an input signal (`[axes.ram.inputs] reference_cam`, a
+/// simulated sensor on the ram at [60, 80] mm, a digital input sampled at the cycle boundary):
+/// the edge gets the value Position within two cycles' travel at the sync velocity (the
+/// input's sample adds up to one cycle) and the encoder's count.
+#[test]
+fn abs_switch_on_the_cams_input_signal() {
+    let cell = cell(
+        "fEnc_RefSyncVelo = 0.05",
+        "[devices.valve_io]\nnode = \"press\"\nkind = \"sim_digital_input\"\nchannels = 8\n\n\
+         [signals.ram_cam]\ndevice = \"valve_io\"\nchannel = 1\n\n\
+         [signals.ram_cam.sensor]\naxis = \"ram\"\nposition = 60.0\nwidth = 20.0\n\n\
+         [axes.ram.inputs]\nreference_cam = \"ram_cam\"\n",
+    );
+    let mut r = Run::enabled(&cell);
+    let id = r
+        .try_cmd(home(true, 10.0, HydHomingMode::AbsSwitch))
+        .unwrap()
+        .unwrap();
+    r.until_done(id, 20_000);
+    r.step();
+    let edge = r.axis_value(60.0);
+    let bound = 2.0 * 0.05 * REF_VELO * DT + 1e-3;
+    assert!(
+        (edge - 10.0).abs() <= bound,
+        "edge at {edge}, bound {bound}"
+    );
+}
+
 /// RefPulse: as AbsSwitch, then on at the sync velocity to the encoder's next zero pulse
 /// (every 10 mm at ..., 55, 45, ...): the pulse at 55 gets the value Position exactly (the
 /// latch is exact; the encoder's count of 1 µm remains).

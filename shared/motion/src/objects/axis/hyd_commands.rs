@@ -75,6 +75,8 @@ pub(super) struct HydCommands {
     pub(super) joystick: Option<super::hyd_joystick::JoyRun>,
     /// A running MC_Home_BkPlcMc.
     pub(super) home: Option<super::hyd_home::HomeRun>,
+    /// The reference cam's input signal (`[axes.<name>.inputs] reference_cam`).
+    pub(super) cam_input: bool,
 }
 
 impl HydCommands {
@@ -87,6 +89,7 @@ impl HydCommands {
             jog: None,
             joystick: None,
             home: None,
+            cam_input: false,
         }
     }
 

@@ -367,7 +367,7 @@ pub enum HomingPhase {
 /// What a homing sees in one cycle.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct HomingInput {
-    /// The cam: `CalibrationCam` or the axis' reference cam.
+    /// The cam: `CalibrationCam`, the plant's reference cam or the cam's input signal.
     pub cam: bool,
     /// The zero pulse latched in this cycle (physical position), if any.
     pub zero_mark: Option<f64>,
@@ -666,7 +666,11 @@ impl Axis {
     /// that is no longer the axis' (aborted) ends it, and the loop closes again unless the job
     /// that took over chose its own mode (a velocity motion).
     pub(super) fn hyd_home_cycle(&mut self) {
-        let Some(mut run) = self.hyd.as_deref().and_then(|h| h.cmds.home) else {
+        let Some((mut run, cam_input)) = self
+            .hyd
+            .as_deref()
+            .and_then(|h| h.cmds.home.map(|r| (r, h.cmds.cam_input)))
+        else {
             return;
         };
         let Some(m) = self.main.filter(|m| m.id == run.job) else {
@@ -685,7 +689,7 @@ impl Axis {
             return;
         };
         let input = HomingInput {
-            cam: run.calibration_cam || self.signals.reference_cam,
+            cam: run.calibration_cam || self.signals.reference_cam || cam_input,
             zero_mark: self.signals.zero_mark,
             actual: self.actual_p - self.offset,
             actual_velocity: self.actual_v,

@@ -1852,6 +1852,10 @@ impl Axis {
     pub fn set_switch_inputs(&mut self, s: crate::plant::link::SwitchInputs) {
         if let DriveLink::Simulation(p) = &mut self.link {
             p.set_switch_inputs(s);
+        } else if let Some(h) = self.hyd.as_deref_mut() {
+            // A hydraulic axis on its analog connection: the reference cam's input signal for
+            // MC_Home_BkPlcMc (the library's dwTcHydDcDwRefIndex).
+            h.cmds.cam_input = s.reference_cam.unwrap_or(false);
         }
     }
 
