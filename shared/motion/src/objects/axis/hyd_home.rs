@@ -43,7 +43,7 @@
 //! FB is called every cycle): `CalibrationCam` takes its new level; `Execute = FALSE` changes
 //! nothing ("execution of homing that had started continues unaffected").
 
-use super::{Axis, Goal};
+use super::{reduce, Axis, Goal};
 use crate::catalog::error_id::ErrorId;
 use crate::catalog::hyd_error::HydErrorCode;
 use crate::catalog::override_table::NewJob;
@@ -560,7 +560,7 @@ pub struct HydHomeInputs {
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub(super) struct HomeRun {
     job: JobId,
-    /// The reference position.
+    /// The reference position (reduced on a modulo axis).
     position: f64,
     calibration_cam: bool,
     seq: HomingSequence,
@@ -588,13 +588,14 @@ impl Axis {
             return Ok(0);
         }
         let position = i.position.unwrap_or(params.default_home_position);
+        let home = reduce(self.cfg.modulo, position);
         let method = self
             .check_hyd_home(i.mode, position, &params)
             .map_err(HydHomeRefusal::error_id)?;
         if method == HomingMethod::Direct {
             let id = self.new_id();
             self.emit(id, Instruction::HydHome, JobEventKind::Busy);
-            self.shift(position - self.actual_p);
+            self.shift(home - self.actual_p);
             self.homed = true;
             self.emit(id, Instruction::HydHome, JobEventKind::Done);
             return Ok(id);
@@ -625,7 +626,7 @@ impl Axis {
         let job = self.start_main(Instruction::HydHome, lim, goal);
         self.set_home_run(Some(HomeRun {
             job,
-            position,
+            position: home,
             calibration_cam: i.calibration_cam,
             seq,
         }));
