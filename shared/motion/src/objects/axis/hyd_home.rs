@@ -961,6 +961,47 @@ mod tests {
         assert_eq!(k, 2000);
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config {
+            cases: 500,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x40_4E5E),
+            failure_persistence: None,
+            ..proptest::test_runner::Config::default()
+        })]
+
+        /// AbsSwitch with any cam (wider than the index travel's stop), velocities and
+        /// directions: the mark lies beyond the edge the sync travel leaves (the lower end
+        /// going negative, the upper going positive) by at most one cycle's travel at the
+        /// sync velocity.
+        #[test]
+        fn abs_switch_marks_the_edge_within_one_cycle(
+            lo in -50.0..50.0f64,
+            width in 5.0..40.0f64,
+            index in 0.01..0.2f64,
+            sync in 0.01..0.2f64,
+            index_positive in proptest::bool::ANY,
+            sync_positive in proptest::bool::ANY,
+        ) {
+            let p = HydHomingParams {
+                ref_index_velo: index,
+                ref_sync_velo: sync,
+                ref_index_positive: index_positive,
+                ref_sync_positive: sync_positive,
+                ..HydHomingParams::default()
+            };
+            let hi = lo + width;
+            let start = if index_positive { lo - 30.0 } else { hi + 30.0 };
+            let mut s = HomingSequence::new(HomingMethod::AbsSwitch, &p, &AX);
+            let (m, _) = run(&mut s, start, (lo, hi), None);
+            let step = sync * AX.ref_velo * AX.dt + 1e-9;
+            if sync_positive {
+                proptest::prop_assert!(m > hi && m <= hi + step, "{m} after {hi}");
+            } else {
+                proptest::prop_assert!(m < lo && m >= lo - step, "{m} before {lo}");
+            }
+        }
+    }
+
     /// The ramps: up with the acceleration, down with the stop ramp's deceleration.
     #[test]
     fn the_velocity_ramps_with_the_axis_ramps() {
