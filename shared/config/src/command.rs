@@ -8,7 +8,8 @@ use core::fmt;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
     ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, FlyingGearParams,
-    HydJogMode, StartMode, StopMode, SyncDirection, SyncProfileReference, VelocityDirection,
+    HydHomeInputs, HydHomingMode, HydJogMode, StartMode, StopMode, SyncDirection,
+    SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::objects::leading::LeaderId;
 
@@ -261,6 +262,18 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("joystick", Some(Value::Num(0.0))),
             ("acceleration", Some(Value::Num(0.0))),
             ("deceleration", Some(Value::Num(0.0))),
+        ],
+    },
+    // MC_Home_BkPlcMc: `homing_mode` as MC_HomingMode_BkPlcMc (0 Default, 1 AbsSwitch,
+    // 2 LimitSwitch, 3 RefPulse, 4 Direct, 5 Absolute, 6 Block, 7 FlyingSwitch, 8
+    // FlyingRefPulse); without `position` the axis' fEnc_DefaultHomePosition.
+    InstructionSpec {
+        name: "MC_Home_BkPlcMc",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("position", None),
+            ("homing_mode", Some(Value::Num(0.0))),
+            ("calibration_cam", Some(Value::Bool(false))),
         ],
     },
     InstructionSpec {
@@ -644,6 +657,14 @@ impl Args<'_> {
         match self.get(key)? {
             Value::Num(x) => Ok(x),
             Value::Bool(_) => Err(self.wrong(key, Expected::Number)),
+        }
+    }
+
+    /// A number that may be left out (`None`).
+    fn optional_num(&self, key: &'static str) -> Result<Option<f64>, CommandError> {
+        match self.given.iter().rev().find(|(k, _)| k == key) {
+            Some(_) => self.num(key).map(Some),
+            None => Ok(None),
         }
     }
 
@@ -1051,6 +1072,19 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
             acceleration: a.num("acceleration")?,
             deceleration: a.num("deceleration")?,
         },
+        "MC_Home_BkPlcMc" => Command::HydHome(HydHomeInputs {
+            execute: a.flag("execute")?,
+            position: a.optional_num("position")?,
+            mode: HydHomingMode::from_number(a.code("homing_mode")?).ok_or(
+                CommandError::BadValue {
+                    instruction: a.spec.name,
+                    param: "homing_mode",
+                    allowed: "0 Default, 1 AbsSwitch, 2 LimitSwitch, 3 RefPulse, 4 Direct, \
+                              5 Absolute, 6 Block, 7 FlyingSwitch, 8 FlyingRefPulse",
+                },
+            )?,
+            calibration_cam: a.flag("calibration_cam")?,
+        }),
         "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
             reference_flag: a.flag("reference_flag")?,
         },
@@ -1464,6 +1498,56 @@ mod tests {
             parse("MC_FlyingGear_BkPlcMc", &off, refs),
             Err(CommandError::MissingParameter {
                 param: "slave_desync_position",
+                ..
+            })
+        ));
+    }
+
+    /// MC_Home_BkPlcMc: the library's mode numbers, `position` optional (the axis'
+    /// fEnc_DefaultHomePosition), a number beyond 8 refused naming the modes.
+    #[test]
+    fn mc_home_bkplcmc_parses_its_inputs() {
+        let c = parse(
+            "MC_Home_BkPlcMc",
+            &[
+                p("position", Value::Num(12.5)),
+                p("homing_mode", Value::Num(6.0)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::HydHome(HydHomeInputs {
+                execute: true,
+                position: Some(12.5),
+                mode: HydHomingMode::Block,
+                calibration_cam: false,
+            })
+        );
+        let c = parse(
+            "MC_Home_BkPlcMc",
+            &[p("calibration_cam", Value::Bool(true))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::HydHome(HydHomeInputs {
+                execute: true,
+                position: None,
+                mode: HydHomingMode::Default,
+                calibration_cam: true,
+            })
+        );
+        assert!(matches!(
+            parse(
+                "MC_Home_BkPlcMc",
+                &[p("homing_mode", Value::Num(9.0))],
+                Refs::default()
+            ),
+            Err(CommandError::BadValue {
+                param: "homing_mode",
                 ..
             })
         ));

@@ -274,6 +274,23 @@ pub struct HydraulicSection {
     pub fLagAmpCfb_kA: Option<f64>,
     /// Extended controller: the filter time of the actual acceleration feedback (s).
     pub fLagAmpCfb_tA: Option<f64>,
+    /// MC_Home_BkPlcMc's method in its default mode (`E_TcMcHomingType`):
+    /// `iTcMc_HomingOnBlock` (default), `iTcMc_HomingOnIndex`, `iTcMc_HomingOnSync`,
+    /// `iTcMc_HomingOnMultiSync`, `iTcMc_HomingOnExec`.
+    pub nEnc_HomingType: Option<String>,
+    /// Homing: the control value of the search for the cam, a fraction of `fRefVelo` (0..1,
+    /// default 0.1).
+    pub fEnc_RefIndexVelo: Option<f64>,
+    /// Homing: that of the search for the cam's end and the zero pulse (0..1, default 0.1).
+    pub fEnc_RefSyncVelo: Option<f64>,
+    /// Homing: the cam is searched in the positive direction (default false).
+    pub bEnc_RefIndexPositive: Option<bool>,
+    /// Homing: the cam's end and the zero pulse are searched positive (default false).
+    pub bEnc_RefSyncPositive: Option<bool>,
+    /// Homing: the reference position when MC_Home_BkPlcMc is given none (mm, default 0).
+    pub fEnc_DefaultHomePosition: Option<f64>,
+    /// Homing on block: the time without movement (s, >= 0, default 2; below the cycle: 2).
+    pub fBlockDetectDelay: Option<f64>,
     /// Weight of the set velocity in the output (1.0: full feed forward).
     pub fFeedForward: Option<f64>,
     /// Area ratio A:B (velocity ratio of the two directions).

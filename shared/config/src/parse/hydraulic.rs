@@ -18,7 +18,9 @@ use tandem_motion::hydraulic::jerk_generator::{
 use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
 use tandem_motion::hydraulic::pressure::ForceScaling;
 use tandem_motion::hydraulic::valve_table::{ValveTable, MAX_POINTS};
-use tandem_motion::objects::axis::{HydraulicProfile, JOG_VELO_DEFAULTS};
+use tandem_motion::objects::axis::{
+    HydHomingParams, HydHomingType, HydraulicProfile, JOG_VELO_DEFAULTS,
+};
 use tandem_motion::plant::hydraulic::{CylinderParams, SimValveCylinderParams};
 
 /// The axis kind of a hydraulic axis in the cell file.
@@ -129,6 +131,10 @@ pub(super) fn profile(h: &HydraulicSection) -> Result<HydraulicProfile, FieldErr
             Problem::Invalid("out of its range (ST_TcHydAxParam)"),
         )
     })?;
+    let p = HydraulicProfile {
+        homing: homing(h)?,
+        ..p
+    };
     for (name, v) in ["fJogVeloSlow", "fJogVeloFast"].into_iter().zip(p.jog_velo) {
         if !(v.is_finite() && v > 0.0) {
             return Err((
@@ -197,6 +203,7 @@ fn unchecked_profile(h: &HydraulicSection, controller: HydControllerParams) -> H
             h.fJogVeloFast.unwrap_or(JOG_VELO_DEFAULTS[1]),
         ],
         profile: ProfileSelection::default(),
+        homing: HydHomingParams::default(),
     }
 }
 
@@ -260,6 +267,64 @@ fn profile_selection(h: &HydraulicSection) -> Result<ProfileSelection, FieldErro
         },
         time_based: h.bTimeBased.unwrap_or(false),
     })
+}
+
+/// The values of `nEnc_HomingType` (`E_TcMcHomingType`, the library's names).
+const HOMING_TYPES: [(&str, HydHomingType); 5] = [
+    ("iTcMc_HomingOnBlock", HydHomingType::OnBlock),
+    ("iTcMc_HomingOnIndex", HydHomingType::OnIndex),
+    ("iTcMc_HomingOnSync", HydHomingType::OnSync),
+    ("iTcMc_HomingOnMultiSync", HydHomingType::OnMultiSync),
+    ("iTcMc_HomingOnExec", HydHomingType::OnExec),
+];
+
+/// The paths of MC_Home_BkPlcMc's keys, by the library's name.
+const HOMING_KEYS: [&str; 7] = [
+    "hydraulic.nEnc_HomingType",
+    "hydraulic.fEnc_RefIndexVelo",
+    "hydraulic.fEnc_RefSyncVelo",
+    "hydraulic.bEnc_RefIndexPositive",
+    "hydraulic.bEnc_RefSyncPositive",
+    "hydraulic.fEnc_DefaultHomePosition",
+    "hydraulic.fBlockDetectDelay",
+];
+
+/// MC_Home_BkPlcMc's parameters of section `h` over the library's defaults, checked: the path
+/// of the key out of range.
+fn homing(h: &HydraulicSection) -> Result<HydHomingParams, FieldError> {
+    let d = HydHomingParams::default();
+    let key = |name: &str| {
+        HOMING_KEYS
+            .iter()
+            .find(|k| k.strip_prefix("hydraulic.") == Some(name))
+            .copied()
+            .unwrap_or("hydraulic")
+    };
+    let homing_type = match &h.nEnc_HomingType {
+        Some(v) => super::pick("nEnc_HomingType", v, &HOMING_TYPES)
+            .map_err(|(_, p)| (key("nEnc_HomingType"), p))?,
+        None => d.homing_type,
+    };
+    let p = HydHomingParams {
+        homing_type,
+        ref_index_velo: h.fEnc_RefIndexVelo.unwrap_or(d.ref_index_velo),
+        ref_sync_velo: h.fEnc_RefSyncVelo.unwrap_or(d.ref_sync_velo),
+        ref_index_positive: h.bEnc_RefIndexPositive.unwrap_or(d.ref_index_positive),
+        ref_sync_positive: h.bEnc_RefSyncPositive.unwrap_or(d.ref_sync_positive),
+        default_home_position: h
+            .fEnc_DefaultHomePosition
+            .unwrap_or(d.default_home_position),
+        block_detect_delay: h.fBlockDetectDelay.unwrap_or(d.block_detect_delay),
+    };
+    p.check().map_err(|e| {
+        let why = match e.name {
+            "fBlockDetectDelay" => "must be a finite number >= 0 (s)",
+            "fEnc_DefaultHomePosition" => "must be a finite number (mm)",
+            _ => "must be a fraction of fRefVelo from 0 to 1 (ST_TcHydAxParam)",
+        };
+        (key(e.name), Problem::Invalid(why))
+    })?;
+    Ok(p)
 }
 
 /// The position controller and Finish of section `h`, checked: the key of the parameter out

@@ -67,6 +67,8 @@ pub enum Instruction {
     HydMoveJog,
     /// `MC_MoveJoySticked_BkPlcMc` (Beckhoff hydraulic library): velocity from a joystick.
     MoveJoySticked,
+    /// `MC_Home_BkPlcMc` (Beckhoff hydraulic library): homing in the library's modes.
+    HydHome,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -123,6 +125,7 @@ impl Instruction {
             Self::ResetAndStop => "MC_ResetAndStop_BkPlcMc",
             Self::HydMoveJog => "MC_MoveJog_BkPlcMc",
             Self::MoveJoySticked => "MC_MoveJoySticked_BkPlcMc",
+            Self::HydHome => "MC_Home_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

@@ -561,6 +561,11 @@ pub enum Command {
         /// `Deceleration` (mm/s², 0: `fMaxAcc`).
         deceleration: f64,
     },
+    /// `MC_Home_BkPlcMc` (Beckhoff hydraulic library, 4.2.11): homing in the library's modes
+    /// (AbsSwitch, RefPulse, Direct, Block) from an error-free standstill, sent again with the
+    /// current inputs while it runs.
+    #[doc(alias = "MC_Home_BkPlcMc")]
+    HydHome(super::hyd_home::HydHomeInputs),
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

@@ -242,6 +242,9 @@ pub struct HydraulicProfile {
     /// `nProfileType` (the displacement-based or the jerk-based generator), `fMaxJerk`,
     /// `nJerkEnabled` and `bTimeBased`.
     pub profile: crate::hydraulic::jerk_generator::ProfileSelection,
+    /// The homing members (`nEnc_HomingType`, `fEnc_RefIndexVelo` …) and `fBlockDetectDelay`:
+    /// MC_Home_BkPlcMc.
+    pub homing: super::hyd_home::HydHomingParams,
 }
 
 /// `fJogVeloSlow` and `fJogVeloFast` by default (mm/s), as the library's `ST_TcHydAxParam`.
@@ -463,6 +466,7 @@ impl AxisConfig {
             })
         })?;
         crate::hydraulic::monitor::TargetMonitor::new(h.monitor).map_err(|e| refused(e.name))?;
+        h.homing.check().map_err(|e| refused(e.name))?;
         Ok(())
     }
 

@@ -73,6 +73,10 @@ pub(super) struct HydCommands {
     jog: Option<JogRun>,
     /// A running MC_MoveJoySticked_BkPlcMc.
     pub(super) joystick: Option<super::hyd_joystick::JoyRun>,
+    /// A running MC_Home_BkPlcMc.
+    pub(super) home: Option<super::hyd_home::HomeRun>,
+    /// The reference cam's input signal (`[axes.<name>.inputs] reference_cam`).
+    pub(super) cam_input: bool,
 }
 
 impl HydCommands {
@@ -84,6 +88,8 @@ impl HydCommands {
             jog_inputs: (false, false),
             jog: None,
             joystick: None,
+            home: None,
+            cam_input: false,
         }
     }
 
@@ -127,6 +133,7 @@ impl Axis {
                 acceleration,
                 deceleration,
             } => self.cmd_joystick(execute, joystick, acceleration, deceleration),
+            Command::HydHome(ref inputs) => self.cmd_hyd_home(inputs),
             Command::SetReferenceFlag { reference_flag } => {
                 Ok(self.instant_job(Instruction::SetReferenceFlag, |ax| {
                     ax.homed = reference_flag;
@@ -311,6 +318,7 @@ impl Axis {
             self.hyd_lock_cycle(l);
         }
         self.hyd_joystick_cycle();
+        self.hyd_home_cycle();
         let Some(m) = self.main else {
             return;
         };

@@ -11,6 +11,7 @@ mod buffer;
 mod command;
 mod config;
 mod hyd_commands;
+mod hyd_home;
 mod hyd_joystick;
 mod hyd_slow_down;
 mod hydraulic;
@@ -28,6 +29,11 @@ pub use config::{
     FollowingErrorMonitoring, HomingConfig, HomingMark, HydraulicProfile, MotionType,
     PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
     JOG_VELO_DEFAULTS,
+};
+pub use hyd_home::{
+    resolve as resolve_hyd_homing, HomingAxis, HomingInput, HomingMethod, HomingOutput,
+    HomingPhase, HomingSequence, HydHomeInputs, HydHomeRefusal, HydHomingMode, HydHomingParams,
+    HydHomingParamsError, HydHomingType, BLOCK_DETECT_DELAY_DEFAULT,
 };
 pub use hydraulic::HydraulicStatus;
 pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
@@ -1074,7 +1080,8 @@ impl Axis {
             | Command::SetReferenceFlag { .. }
             | Command::ResetAndStop { .. }
             | Command::HydMoveJog { .. }
-            | Command::MoveJoySticked { .. } => self.apply_hyd_command(cmd),
+            | Command::MoveJoySticked { .. }
+            | Command::HydHome(_) => self.apply_hyd_command(cmd),
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
@@ -1847,6 +1854,10 @@ impl Axis {
     pub fn set_switch_inputs(&mut self, s: crate::plant::link::SwitchInputs) {
         if let DriveLink::Simulation(p) = &mut self.link {
             p.set_switch_inputs(s);
+        } else if let Some(h) = self.hyd.as_deref_mut() {
+            // A hydraulic axis on its analog connection: the reference cam's input signal for
+            // MC_Home_BkPlcMc (the library's dwTcHydDcDwRefIndex).
+            h.cmds.cam_input = s.reference_cam.unwrap_or(false);
         }
     }
 

@@ -881,6 +881,8 @@ impl Axis {
         } else {
             match main {
                 Some(Instruction::Home) => AxisState::Homing,
+                // The library's McState_Homing for MC_Home_BkPlcMc.
+                Some(Instruction::HydHome) => AxisState::Homing,
                 // The library's McState_Synchronizedmotion for MC_MoveJoySticked_BkPlcMc.
                 Some(Instruction::MoveJoySticked) => AxisState::SynchronizedMotion,
                 Some(
