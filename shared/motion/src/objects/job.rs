@@ -64,6 +64,10 @@ pub enum Instruction {
     HydMoveJog,
     /// `MC_MoveJoySticked_BkPlcMc` (Beckhoff hydraulic library): velocity from a joystick.
     MoveJoySticked,
+    /// `MC_AxRtSetDirectOutput_BkPlcMc` (Beckhoff hydraulic library): open-loop control value.
+    SetDirectOutput,
+    /// `MC_AxRtSetExtGenValues_BkPlcMc` (Beckhoff hydraulic library): external set values.
+    SetExtGenValues,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -119,6 +123,8 @@ impl Instruction {
             Self::ResetAndStop => "MC_ResetAndStop_BkPlcMc",
             Self::HydMoveJog => "MC_MoveJog_BkPlcMc",
             Self::MoveJoySticked => "MC_MoveJoySticked_BkPlcMc",
+            Self::SetDirectOutput => "MC_AxRtSetDirectOutput_BkPlcMc",
+            Self::SetExtGenValues => "MC_AxRtSetExtGenValues_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

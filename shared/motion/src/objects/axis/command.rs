@@ -551,6 +551,32 @@ pub enum Command {
         /// `Deceleration` (mm/s², 0: `fMaxAcc`).
         deceleration: f64,
     },
+    /// `MC_AxRtSetDirectOutput_BkPlcMc` (Beckhoff hydraulic library, 4.4.7.7): the control
+    /// value `out_value` output open loop, slewed with `ramp_time`; sent again with the current
+    /// inputs, `enable = false` ramps it to 0 and ends it.
+    #[doc(alias = "MC_AxRtSetDirectOutput_BkPlcMc")]
+    SetDirectOutput {
+        /// `Enable`.
+        enable: bool,
+        /// `OutValue` (normalised, ±1.0 = full scale).
+        out_value: f64,
+        /// `RampTime` (s for full scale; 0: at once).
+        ramp_time: f64,
+    },
+    /// `MC_AxRtSetExtGenValues_BkPlcMc` (Beckhoff hydraulic library, 4.4.7.8): set values from
+    /// outside the axis' generator, sent each cycle; `enable = false` ends it (a moving axis
+    /// stops with `fStopRamp`).
+    #[doc(alias = "MC_AxRtSetExtGenValues_BkPlcMc")]
+    SetExtGenValues {
+        /// `Enable`.
+        enable: bool,
+        /// `Position` (mm): the set position of this cycle.
+        position: f64,
+        /// `Velocity` (mm/s): the set velocity of this cycle.
+        velocity: f64,
+        /// `TargetPosition` (mm): the target of the current motion.
+        target_position: f64,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

@@ -73,6 +73,8 @@ pub(super) struct HydCommands {
     jog: Option<JogRun>,
     /// A running MC_MoveJoySticked_BkPlcMc.
     pub(super) joystick: Option<super::hyd_joystick::JoyRun>,
+    /// MC_AxRtSetDirectOutput_BkPlcMc and MC_AxRtSetExtGenValues_BkPlcMc.
+    pub(super) direct: super::hyd_direct::HydDirect,
 }
 
 impl HydCommands {
@@ -84,6 +86,7 @@ impl HydCommands {
             jog_inputs: (false, false),
             jog: None,
             joystick: None,
+            direct: super::hyd_direct::HydDirect::default(),
         }
     }
 

@@ -225,6 +225,8 @@ impl Axis {
     pub(super) fn hyd_position_control(&self) -> bool {
         match self.hyd.as_deref() {
             Some(h) if h.pressure.is_some() => false,
+            // MC_AxRtSetDirectOutput_BkPlcMc: open loop.
+            Some(_) if self.hyd_direct_output().is_some() => false,
             Some(h) if h.engaged => h.last.position_control,
             _ => true,
         }
@@ -366,7 +368,7 @@ impl Axis {
             state: h.last.state,
             positive: h.last.positive,
             engaged: h.engaged,
-            target: h.gen.target(),
+            target: self.hyd_ext_gen_target().unwrap_or_else(|| h.gen.target()),
             in_target_range: h.window.in_target_range,
             in_target: h.window.in_target,
             actual: h.actual,
@@ -447,6 +449,7 @@ impl Axis {
                 },
                 zero_compensation: h.auto_zero.map(|(a, _)| a.status().compensation),
                 locked: h.cmds.outputs_locked(),
+                direct_output: self.hyd_direct_output(),
             },
             None => HydValveOutputs::default(),
         }

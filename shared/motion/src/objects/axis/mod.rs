@@ -11,6 +11,7 @@ mod buffer;
 mod command;
 mod config;
 mod hyd_commands;
+mod hyd_direct;
 mod hyd_joystick;
 mod hydraulic;
 mod step;
@@ -1073,6 +1074,9 @@ impl Axis {
             | Command::ResetAndStop { .. }
             | Command::HydMoveJog { .. }
             | Command::MoveJoySticked { .. } => self.apply_hyd_command(cmd),
+            Command::SetDirectOutput { .. } | Command::SetExtGenValues { .. } => {
+                self.apply_hyd_direct(cmd)
+            }
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
