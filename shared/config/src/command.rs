@@ -263,6 +263,10 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         ],
     },
     InstructionSpec {
+        name: "MC_AxRtFollowUp_BkPlcMc",
+        params: &[("enable", Some(Value::Bool(true)))],
+    },
+    InstructionSpec {
         name: "MC_SetReferenceFlag_BkPlcMc",
         params: &[("reference_flag", Some(Value::Bool(true)))],
     },
@@ -1047,6 +1051,9 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
             velocity: a.num("velocity")?,
             target_position: a.num("target_position")?,
         },
+        "MC_AxRtFollowUp_BkPlcMc" => Command::FollowUp {
+            enable: a.flag("enable")?,
+        },
         "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
             reference_flag: a.flag("reference_flag")?,
         },
@@ -1309,6 +1316,13 @@ mod tests {
             Refs::default()
         )
         .is_err());
+        let c = parse(
+            "MC_AxRtFollowUp_BkPlcMc",
+            &[p("enable", Value::Bool(false))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(c, Command::FollowUp { enable: false });
     }
 
     #[test]

@@ -68,6 +68,8 @@ pub enum Instruction {
     SetDirectOutput,
     /// `MC_AxRtSetExtGenValues_BkPlcMc` (Beckhoff hydraulic library): external set values.
     SetExtGenValues,
+    /// `MC_AxRtFollowUp_BkPlcMc` (Beckhoff hydraulic library): set values follow the actual ones.
+    FollowUp,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -125,6 +127,7 @@ impl Instruction {
             Self::MoveJoySticked => "MC_MoveJoySticked_BkPlcMc",
             Self::SetDirectOutput => "MC_AxRtSetDirectOutput_BkPlcMc",
             Self::SetExtGenValues => "MC_AxRtSetExtGenValues_BkPlcMc",
+            Self::FollowUp => "MC_AxRtFollowUp_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

@@ -577,6 +577,14 @@ pub enum Command {
         /// `TargetPosition` (mm): the target of the current motion.
         target_position: f64,
     },
+    /// `MC_AxRtFollowUp_BkPlcMc` (Beckhoff hydraulic library, 4.4.9.3): while `enable`, the set
+    /// position follows the actual one with the position controller off; `enable = false`
+    /// closes the loop again at the actual position.
+    #[doc(alias = "MC_AxRtFollowUp_BkPlcMc")]
+    FollowUp {
+        /// `Enable`.
+        enable: bool,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

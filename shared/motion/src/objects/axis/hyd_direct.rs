@@ -66,14 +66,36 @@
 //! - A rising edge is refused as any motion is (not enabled, an alarm, a stop's lock); any
 //!   other motion command aborts it (CommandAborted, as the PLCopen override rules).
 //!
-//! Pure and allocation-free: the state is two small `Copy` records in the hydraulic part of
-//! the axis.
+//! # MC_AxRtFollowUp_BkPlcMc
+//! (4.4.9.3) "If Enable = TRUE, the actual position is copied to all target and set positions.
+//! Target velocity, lag error and position controller output are set to 0.0. With a falling
+//! edge at Enable, the axis will re-enable the position controller depending on parameters and
+//! enables at the current actual position. … Because the position control is disabled, the axis
+//! can drift. If the axis is to be moved by external actions, the required oil paths must be
+//! opened by the application."
+//!
+//! In tandem `enable = true` starts the follow-up and `enable = false` ends it (each command Done
+//! at once: the block has no outputs). While it is on, each cycle the set position (and the
+//! generator's target) is the actual position, the set velocity 0 and the position controller
+//! off, so Finish gives the valve only `fZeroCompensation` (the output that holds a compensated
+//! valve still; the overlap compensation is 0 with no commanded value). Decisions (inferred):
+//! - "should not be enabled for an axis that is performing an active movement": a running motion
+//!   is aborted (CommandAborted) when it is enabled (the library would overwrite its set values
+//!   every cycle); while it is on, motion is refused (16#80F0, as under a stop's lock, the
+//!   library's `dwTcHydErrCdNotReady`); on a coupled follower it is refused (16#80A1: decouple
+//!   first, as the library's stops).
+//! - The I part of the position controller is held, not cleared (the text names the
+//!   controller's output; `MC_AxUtiOffsetLatch_BkPlcMc` names the I part where it clears it).
+//! - The axis shows Standstill (no motion job) while it follows up.
+//!
+//! Pure and allocation-free: the state is two small `Copy` records and a flag in the hydraulic
+//! part of the axis.
 
 use super::{Axis, Command, Goal};
 use crate::catalog::error_id::ErrorId;
 use crate::catalog::override_table::NewJob;
 use crate::kinematics::profile::State;
-use crate::objects::job::{Instruction, JobId};
+use crate::objects::job::{Instruction, JobEventKind, JobId};
 
 /// A control value slewed towards its target at a rate of full scale (1.0) per `RampTime`
 /// (the library's `RampTime`: "the time in which the control value would reach full scale").
@@ -139,11 +161,13 @@ struct ExtGenRun {
     target: f64,
 }
 
-/// The state of the two instructions on one hydraulic axis.
+/// The state of the instructions of this module on one hydraulic axis.
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
 pub(super) struct HydDirect {
     direct: Option<DirectRun>,
     ext_gen: Option<ExtGenRun>,
+    /// MC_AxRtFollowUp_BkPlcMc's `Enable`.
+    follow_up: bool,
 }
 
 /// The largest `|OutValue|`: full scale.
@@ -168,6 +192,7 @@ impl Axis {
                 velocity,
                 target_position,
             } => self.cmd_ext_gen(enable, position, velocity, target_position),
+            Command::FollowUp { enable } => self.cmd_follow_up(enable),
             _ => Err(ErrorId::IllegalObject),
         }
     }
@@ -263,11 +288,18 @@ impl Axis {
             .map(|r| r.slew.value)
     }
 
-    /// One cycle's setpoint of a running MC_AxRtSetDirectOutput_BkPlcMc (before the generator):
-    /// the control value one slew step on, the set velocity `value · fRefVelo`, the set
-    /// position at the actual one. Returns whether it ran.
+    /// One cycle's setpoint of MC_AxRtFollowUp_BkPlcMc or of a running
+    /// MC_AxRtSetDirectOutput_BkPlcMc (before the generator): following up, the set position
+    /// at the actual one at rest; a direct output's control value one slew step on, the set
+    /// velocity `value · fRefVelo`, the set position at the actual one. Returns whether either
+    /// ran.
     pub(super) fn hyd_direct_generate(&mut self) -> bool {
-        let Some(mut run) = self.direct_state().direct else {
+        let state = self.direct_state();
+        if state.follow_up {
+            self.follow_actual();
+            return true;
+        }
+        let Some(mut run) = state.direct else {
             return false;
         };
         if !self.still_main(run.job) {
@@ -377,6 +409,51 @@ impl Axis {
         }
         self.finish_main(job, Instruction::SetExtGenValues);
         job
+    }
+
+    /// MC_AxRtFollowUp_BkPlcMc with its `Enable` of now (the module documentation): Done at
+    /// once.
+    fn cmd_follow_up(&mut self, enable: bool) -> Result<JobId, ErrorId> {
+        let on = self.direct_state().follow_up;
+        if enable && !on {
+            if self.sync.is_some() || self.sync_pending.is_some() {
+                return Err(ErrorId::SyncJobActive);
+            }
+            self.abort_main(JobEventKind::CommandAborted);
+            self.abort_sup(JobEventKind::CommandAborted);
+            self.hyd_disengage();
+            self.set_direct_state(|d| d.follow_up = true);
+            self.follow_actual();
+        } else if !enable && on {
+            // Position control again, at the actual position.
+            self.set_direct_state(|d| d.follow_up = false);
+            self.basic = State::rest(self.actual_p);
+            self.set_goal(Goal::Hold);
+        }
+        let id = self.new_id();
+        self.emit(id, Instruction::FollowUp, JobEventKind::Busy);
+        self.emit(id, Instruction::FollowUp, JobEventKind::Done);
+        Ok(id)
+    }
+
+    /// The set position (and the generator's) at the actual position, at rest.
+    fn follow_actual(&mut self) {
+        let p = self.actual_p;
+        self.basic = State::rest(p);
+        self.goal = Goal::Direct {
+            position: Some(p),
+            v: 0.0,
+            a: 0.0,
+        };
+        if let Some(h) = self.hyd.as_deref_mut() {
+            h.gen.take_over(p, 0.0);
+        }
+    }
+
+    /// MC_AxRtFollowUp_BkPlcMc is enabled: the position controller is off and motion is
+    /// refused.
+    pub(super) fn hyd_following_up(&self) -> bool {
+        self.direct_state().follow_up
     }
 
     /// `TargetPosition` of a running MC_AxRtSetExtGenValues_BkPlcMc.

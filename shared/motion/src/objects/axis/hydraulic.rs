@@ -225,8 +225,8 @@ impl Axis {
     pub(super) fn hyd_position_control(&self) -> bool {
         match self.hyd.as_deref() {
             Some(h) if h.pressure.is_some() => false,
-            // MC_AxRtSetDirectOutput_BkPlcMc: open loop.
-            Some(_) if self.hyd_direct_output().is_some() => false,
+            // MC_AxRtSetDirectOutput_BkPlcMc: open loop; MC_AxRtFollowUp_BkPlcMc: none.
+            Some(_) if self.hyd_direct_output().is_some() || self.hyd_following_up() => false,
             Some(h) if h.engaged => h.last.position_control,
             _ => true,
         }

@@ -937,7 +937,7 @@ impl Axis {
         if self.stopping_alarm_pending() {
             return Err(ErrorId::JobRejectedInErrorStop);
         }
-        if self.stop_lock || self.hyd_locked() {
+        if self.stop_lock || self.hyd_locked() || self.hyd_following_up() {
             return Err(ErrorId::AxisLocked);
         }
         Ok(())
@@ -1074,9 +1074,9 @@ impl Axis {
             | Command::ResetAndStop { .. }
             | Command::HydMoveJog { .. }
             | Command::MoveJoySticked { .. } => self.apply_hyd_command(cmd),
-            Command::SetDirectOutput { .. } | Command::SetExtGenValues { .. } => {
-                self.apply_hyd_direct(cmd)
-            }
+            Command::SetDirectOutput { .. }
+            | Command::SetExtGenValues { .. }
+            | Command::FollowUp { .. } => self.apply_hyd_direct(cmd),
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
