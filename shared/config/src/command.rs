@@ -267,6 +267,13 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         params: &[("enable", Some(Value::Bool(true)))],
     },
     InstructionSpec {
+        name: "MC_AxUtiOffsetLatch_BkPlcMc",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("offset_limit", Some(Value::Num(0.5))),
+        ],
+    },
+    InstructionSpec {
         name: "MC_SetReferenceFlag_BkPlcMc",
         params: &[("reference_flag", Some(Value::Bool(true)))],
     },
@@ -1054,6 +1061,10 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
         "MC_AxRtFollowUp_BkPlcMc" => Command::FollowUp {
             enable: a.flag("enable")?,
         },
+        "MC_AxUtiOffsetLatch_BkPlcMc" => Command::OffsetLatch {
+            execute: a.flag("execute")?,
+            offset_limit: a.num("offset_limit")?,
+        },
         "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
             reference_flag: a.flag("reference_flag")?,
         },
@@ -1323,6 +1334,14 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c, Command::FollowUp { enable: false });
+        let c = parse("MC_AxUtiOffsetLatch_BkPlcMc", &[], Refs::default()).unwrap();
+        assert_eq!(
+            c,
+            Command::OffsetLatch {
+                execute: true,
+                offset_limit: 0.5
+            }
+        );
     }
 
     #[test]

@@ -508,3 +508,116 @@ fn follow_up_aborts_a_running_motion() {
         .unwrap();
     assert_eq!(out, Err(ErrorId::IllegalObject));
 }
+
+impl Run<'_> {
+    fn offset_latch(&mut self, offset_limit: f64) -> Result<u32, ErrorId> {
+        self.try_cmd(Command::OffsetLatch {
+            execute: true,
+            offset_limit,
+        })
+        .map(|j| j.unwrap_or(0))
+    }
+}
+
+/// The ±10 V word of the drifting cell's Finish for the controller output `u` and the
+/// compensation `zc` (V): fAreaRatio 0.6947 divides a negative value, no overlap compensation.
+fn drifting_word(u: f64, zc: f64) -> i16 {
+    let v = if u < 0.0 { u / 0.6947 } else { u };
+    output_word((v + zc / 10.0).clamp(-1.0, 1.0))
+}
+
+/// MC_AxUtiOffsetLatch_BkPlcMc on the drifting valve held in position control: its standing
+/// lag's controller output, fLagAmp · lag / fRefVelo · 10 V, becomes fZeroCompensation (to
+/// 1e-12); the set position is the actual one at once, and the next words are Finish's of the
+/// new compensation and that cycle's P part to the bit; the standing lag falls to under a
+/// third of what it was.
+#[test]
+fn offset_latch_takes_the_controller_output_into_the_compensation() {
+    let cell = drifting();
+    let mut r = Run::enabled(&cell);
+    for _ in 0..1000 {
+        r.step();
+    }
+    let s = r.status();
+    let lag = s.position - s.actual_position;
+    assert!(lag.abs() > 0.02, "standing lag {lag}");
+    assert_eq!(r.hyd().zero_compensation, 0.0);
+    assert_eq!(r.word(), drifting_word(LAG_AMP * lag / REF_VELO, 0.0));
+    let expected = LAG_AMP * lag / REF_VELO * 10.0;
+    let job = r.offset_latch(0.5).unwrap();
+    assert!(job > 0);
+    let zc = r.hyd().zero_compensation;
+    assert!((zc - expected).abs() < 1e-12, "{zc} for {expected}");
+    assert_eq!(r.status().position, s.actual_position);
+    for k in 0..1000 {
+        r.step();
+        let s = r.status();
+        let u = LAG_AMP * (s.position - s.actual_position) / REF_VELO;
+        assert_eq!(r.word(), drifting_word(u, zc), "cycle {k}");
+    }
+    let s = r.status();
+    // 0.054 mm before, 0.013 mm after (measured): the friction held part of the offset.
+    assert!(
+        (s.position - s.actual_position).abs() < lag.abs() / 3.0,
+        "lag after the latch: {s:?}, before {lag}"
+    );
+    assert!(
+        r.log()
+            .contains(&format!("MC_AxUtiOffsetLatch_BkPlcMc job {job}: Done")),
+        "{}",
+        r.log()
+    );
+}
+
+/// The latch's refusals change nothing: an output beyond ±OffsetLimit and an OffsetLimit below
+/// 0 (16#80F5), a motion (16#80F0), a disabled axis (16#800F), an I part configured (16#80F5).
+#[test]
+fn offset_latch_refusals_change_nothing() {
+    let cell = drifting();
+    let mut r = Run::enabled(&cell);
+    for _ in 0..1000 {
+        r.step();
+    }
+    let position = r.status().position;
+    assert_eq!(
+        r.offset_latch(0.01),
+        Err(ErrorId::IllegalControllerParameter)
+    );
+    assert_eq!(
+        r.offset_latch(-1.0),
+        Err(ErrorId::IllegalControllerParameter)
+    );
+    assert_eq!(r.hyd().zero_compensation, 0.0);
+    assert_eq!(r.status().position, position);
+    r.move_to(150.0, 100.0);
+    r.step();
+    assert_eq!(r.offset_latch(0.5), Err(ErrorId::AxisLocked));
+    r.follow_up(true);
+    assert_eq!(r.offset_latch(0.5), Err(ErrorId::AxisLocked));
+    r.follow_up(false);
+    r.cmd(Command::Power {
+        enable: false,
+        start_mode: StartMode::PositionControlled,
+        stop_mode: StopMode::Emergency,
+    });
+    r.until(1000, "disabled", |r| r.state() == AxisState::Disabled);
+    assert_eq!(r.offset_latch(0.5), Err(ErrorId::NotEnabled));
+    assert_eq!(r.hyd().zero_compensation, 0.0);
+    let with_i = cell_with_i();
+    let mut r = Run::enabled(&with_i);
+    r.step();
+    assert_eq!(
+        r.offset_latch(0.5),
+        Err(ErrorId::IllegalControllerParameter)
+    );
+}
+
+/// The drifting cell with the position controller's I part.
+fn cell_with_i() -> Cell {
+    cell(&[
+        ("overlap = 0.05 ", "overlap = 0.0 "),
+        ("fValve_OverlapCompP = 0.05", "fValve_OverlapCompP = 0.0"),
+        ("fZeroCompensation = -0.1", "fZeroCompensation = 0.0"),
+        ("fLagAmp = 50.0", "fLagAmp = 50.0\nfLagAmpTi = 10.0"),
+    ])
+}

@@ -70,6 +70,9 @@ pub enum Instruction {
     SetExtGenValues,
     /// `MC_AxRtFollowUp_BkPlcMc` (Beckhoff hydraulic library): set values follow the actual ones.
     FollowUp,
+    /// `MC_AxUtiOffsetLatch_BkPlcMc` (Beckhoff hydraulic library): the controller's output
+    /// latched into the offset compensation.
+    OffsetLatch,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -128,6 +131,7 @@ impl Instruction {
             Self::SetDirectOutput => "MC_AxRtSetDirectOutput_BkPlcMc",
             Self::SetExtGenValues => "MC_AxRtSetExtGenValues_BkPlcMc",
             Self::FollowUp => "MC_AxRtFollowUp_BkPlcMc",
+            Self::OffsetLatch => "MC_AxUtiOffsetLatch_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

@@ -585,6 +585,15 @@ pub enum Command {
         /// `Enable`.
         enable: bool,
     },
+    /// `MC_AxUtiOffsetLatch_BkPlcMc` (Beckhoff hydraulic library, 4.4.9.5): with `execute`,
+    /// the position controller's output at standstill becomes part of `fZeroCompensation`.
+    #[doc(alias = "MC_AxUtiOffsetLatch_BkPlcMc")]
+    OffsetLatch {
+        /// `Execute` (each command with `true` is a rising edge).
+        execute: bool,
+        /// `OffsetLimit` (V, default 0.5): the largest controller output accepted.
+        offset_limit: f64,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

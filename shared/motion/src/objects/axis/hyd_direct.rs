@@ -88,12 +88,46 @@
 //!   controller's output; `MC_AxUtiOffsetLatch_BkPlcMc` names the I part where it clears it).
 //! - The axis shows Standstill (no motion job) while it follows up.
 //!
-//! Pure and allocation-free: the state is two small `Copy` records and a flag in the hydraulic
-//! part of the axis.
+//! # MC_AxUtiOffsetLatch_BkPlcMc
+//! (4.4.9.5) "With a rising edge at Execute, Offset is updated with the current output of the
+//! position controller", checked: "The axis must have a controller enable and must not be in an
+//! active motion state or error state (… iTcHydStateIdle) (dwTcHydAdsErrBusy)"; "The detected
+//! controller output must not be outside ±OffsetLimit (dwTcHydAdsErrIllegalValue)"; on an error
+//! "the compensation remains unchanged". "Otherwise, offset is applied as the new compensation
+//! value. Since from this point in time the part of the output value previously provided by the
+//! position controller is taken over by the compensation, the output of the controller must be
+//! canceled": once, the set and target positions := the actual one, the lag and the
+//! controller's output 0, the default controller's I part wiped.
+//!
+//! In tandem each command with `execute = true` is a rising edge (Done at once, the new
+//! `fZeroCompensation` in [`HydraulicStatus::zero_compensation`](super::HydraulicStatus));
+//! `execute = false` does nothing (the block's outputs reset). Decisions (inferred):
+//! - **Added, not replaced.** The controller's output (V: the normalised `fLagCtrlOutput` · 10 V)
+//!   is added to the compensation in effect, so that the valve output does not change in the
+//!   cycle of the latch: the text's reason ("the part … previously provided by the position
+//!   controller is taken over by the compensation") holds only so; "applied as the new
+//!   compensation" reads as the result. With the configured compensation 0 both readings agree.
+//! - **The controller's output** is the P part `fLagAmp · (fSetPos - fActPos) / fRefVelo`
+//!   (limited by `fLagAmpOutL`) of the cycle, as the analog connection computes it. With an I
+//!   part configured (`fLagAmpTi` > 0) the latch is refused with 16#80F5: the axis does not see
+//!   the I part the connection integrates, and latching without it would wipe the share the I
+//!   part carries (a deviation; AutoZero serves such axes).
+//! - **Refusals** in tandem's codes: not enabled 16#800F, an alarm 16#80F3, any motion or stop
+//!   running (a job, a set velocity, the generator not idle, a direct output, a follow-up, a
+//!   stop's lock) 16#80F0 (the library: `dwTcHydAdsErrBusy` 16#0708 for all of them);
+//!   `OffsetLimit` below 0 or not finite, or the output beyond ±`OffsetLimit`, 16#80F5 (the
+//!   library's `dwTcHydAdsErrIllegalValue` 16#0706). Each changes nothing.
+//! - With MC_AxCtrlAutoZero_BkPlcMc in use, the latch writes its value (AutoZero goes on from
+//!   it); AutoZero started later starts from the latched value.
+//!
+//! Pure and allocation-free: the state is two small `Copy` records, a flag and the latched
+//! compensation in the hydraulic part of the axis.
 
 use super::{Axis, Command, Goal};
 use crate::catalog::error_id::ErrorId;
 use crate::catalog::override_table::NewJob;
+use crate::hydraulic::finish::FULL_SCALE_V;
+use crate::hydraulic::generator::HydState;
 use crate::kinematics::profile::State;
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 
@@ -168,6 +202,17 @@ pub(super) struct HydDirect {
     ext_gen: Option<ExtGenRun>,
     /// MC_AxRtFollowUp_BkPlcMc's `Enable`.
     follow_up: bool,
+    /// `fZeroCompensation` (V) as MC_AxUtiOffsetLatch_BkPlcMc last latched it (without
+    /// AutoZero).
+    latched_zero: Option<f64>,
+}
+
+impl HydDirect {
+    /// `fZeroCompensation` (V) as MC_AxUtiOffsetLatch_BkPlcMc last latched it; `None`: never
+    /// (or into AutoZero's).
+    pub(super) fn latched_zero(&self) -> Option<f64> {
+        self.latched_zero
+    }
 }
 
 /// The largest `|OutValue|`: full scale.
@@ -193,6 +238,10 @@ impl Axis {
                 target_position,
             } => self.cmd_ext_gen(enable, position, velocity, target_position),
             Command::FollowUp { enable } => self.cmd_follow_up(enable),
+            Command::OffsetLatch {
+                execute,
+                offset_limit,
+            } => self.cmd_offset_latch(execute, offset_limit),
             _ => Err(ErrorId::IllegalObject),
         }
     }
@@ -454,6 +503,98 @@ impl Axis {
     /// refused.
     pub(super) fn hyd_following_up(&self) -> bool {
         self.direct_state().follow_up
+    }
+
+    /// `fZeroCompensation` in effect (V): AutoZero's, else the latched one, else the
+    /// configured one.
+    pub(super) fn hyd_zero_compensation(&self) -> f64 {
+        match self.hyd.as_deref() {
+            Some(h) => h
+                .auto_zero
+                .map(|(a, _)| a.status().compensation)
+                .or(h.cmds.direct.latched_zero)
+                .unwrap_or(h.controller.finish.zero_compensation),
+            None => 0.0,
+        }
+    }
+
+    /// The refusals of MC_AxUtiOffsetLatch_BkPlcMc's state checks (the module documentation).
+    fn check_offset_latch_idle(&self) -> Result<(), ErrorId> {
+        if !self.enabled || self.power.disabling {
+            return Err(ErrorId::NotEnabled);
+        }
+        if self.stopping_alarm_pending() {
+            return Err(ErrorId::JobRejectedInErrorStop);
+        }
+        let state = self.direct_state();
+        let generator_busy = self
+            .hyd
+            .as_deref()
+            .is_some_and(|h| h.engaged && h.gen.state() != HydState::Idle);
+        if self.main.is_some()
+            || self.sup_job.is_some()
+            || self.total().v != 0.0
+            || generator_busy
+            || state.follow_up
+            || state.direct.is_some()
+            || self.stop_lock
+            || self.hyd_locked()
+            || self.sync.is_some()
+        {
+            return Err(ErrorId::AxisLocked);
+        }
+        Ok(())
+    }
+
+    /// MC_AxUtiOffsetLatch_BkPlcMc's rising edge (`execute`), with `OffsetLimit` (V).
+    fn cmd_offset_latch(&mut self, execute: bool, offset_limit: f64) -> Result<JobId, ErrorId> {
+        let refused = ErrorId::IllegalControllerParameter;
+        if !execute {
+            return Ok(0);
+        }
+        if !(offset_limit.is_finite() && offset_limit >= 0.0) {
+            return Err(refused);
+        }
+        self.check_offset_latch_idle()?;
+        let (params, current) = match self.hyd.as_deref() {
+            Some(h) => (h.controller, self.hyd_zero_compensation()),
+            None => return Err(ErrorId::IllegalObject),
+        };
+        if params.lag_amp_ti > 0.0 {
+            return Err(refused);
+        }
+        // The controller acts (not while target clamping presses): its P part of this cycle.
+        let acting = self.pos_ctrl && self.hyd_position_control();
+        let lag = if acting {
+            self.total().p - self.actual_p
+        } else {
+            0.0
+        };
+        let u = params.lag_amp * lag / params.finish.ref_velo;
+        let u = match params.lag_out_limit {
+            l if l > 0.0 => u.clamp(-l, l),
+            _ => u,
+        };
+        let offset = u * FULL_SCALE_V;
+        if !(offset.is_finite() && offset.abs() <= offset_limit) {
+            return Err(refused);
+        }
+        let new = (current + offset).clamp(-FULL_SCALE_V, FULL_SCALE_V);
+        if let Some(h) = self.hyd.as_deref_mut() {
+            match h.auto_zero.as_mut() {
+                Some((a, _)) => a.set_compensation(new),
+                None => h.cmds.direct.latched_zero = Some(new),
+            }
+        }
+        let id = self.new_id();
+        self.emit(id, Instruction::OffsetLatch, JobEventKind::Busy);
+        // Once: the set and target positions at the actual one, the lag and the controller's
+        // output 0 (the generator, if it holds the axis, takes the position over).
+        self.fold_superimposed();
+        self.basic = State::rest(self.actual_p);
+        self.set_goal(Goal::Hold);
+        self.emit(id, Instruction::OffsetLatch, JobEventKind::Done);
+        Ok(id)
     }
 
     /// `TargetPosition` of a running MC_AxRtSetExtGenValues_BkPlcMc.

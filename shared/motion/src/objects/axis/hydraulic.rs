@@ -45,9 +45,9 @@ pub(super) struct HydAxis {
     /// The running MC_AxCtrlPressure_BkPlcMc job.
     pressure: Option<PressureJob>,
     /// The position controller's and Finish's parameters (AutoZero's basis).
-    controller: HydControllerParams,
+    pub(super) controller: HydControllerParams,
     /// MC_AxCtrlAutoZero_BkPlcMc, once it has been enabled; its `Enable`.
-    auto_zero: Option<(AutoZero, bool)>,
+    pub(super) auto_zero: Option<(AutoZero, bool)>,
     /// The library's stop and jog instructions' state (`super::hyd_commands`).
     pub(super) cmds: super::hyd_commands::HydCommands,
 }
@@ -87,6 +87,10 @@ pub struct HydraulicStatus {
     /// MC_AxCtrlAutoZero_BkPlcMc's outputs and `fZeroCompensation`, once it has been enabled,
     /// with its `Enable`.
     pub auto_zero: Option<(AutoZeroStatus, bool)>,
+    /// `fZeroCompensation` in effect (V): the configured one, or as MC_AxCtrlAutoZero_BkPlcMc
+    /// or MC_AxUtiOffsetLatch_BkPlcMc set it.
+    #[doc(alias = "fZeroCompensation")]
+    pub zero_compensation: f64,
 }
 
 impl HydAxis {
@@ -374,6 +378,7 @@ impl Axis {
             actual: h.actual,
             pressure_control: h.pressure.map(|p| (p.set, p.last)),
             auto_zero: h.auto_zero.map(|(a, on)| (a.status(), on)),
+            zero_compensation: self.hyd_zero_compensation(),
         })
     }
 
@@ -400,7 +405,15 @@ impl Axis {
                 Some((a, enable))
             }
             None => Some((
-                AutoZero::new(params, finish.zero_compensation).map_err(|_| refused)?,
+                AutoZero::new(
+                    params,
+                    // From the value MC_AxUtiOffsetLatch_BkPlcMc latched, if it did.
+                    h.cmds
+                        .direct
+                        .latched_zero()
+                        .unwrap_or(finish.zero_compensation),
+                )
+                .map_err(|_| refused)?,
                 enable,
             )),
         };
@@ -447,7 +460,10 @@ impl Axis {
                 } else {
                     0.0
                 },
-                zero_compensation: h.auto_zero.map(|(a, _)| a.status().compensation),
+                zero_compensation: h
+                    .auto_zero
+                    .map(|(a, _)| a.status().compensation)
+                    .or(h.cmds.direct.latched_zero()),
                 locked: h.cmds.outputs_locked(),
                 direct_output: self.hyd_direct_output(),
             },

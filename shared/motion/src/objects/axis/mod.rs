@@ -1076,7 +1076,8 @@ impl Axis {
             | Command::MoveJoySticked { .. } => self.apply_hyd_command(cmd),
             Command::SetDirectOutput { .. }
             | Command::SetExtGenValues { .. }
-            | Command::FollowUp { .. } => self.apply_hyd_direct(cmd),
+            | Command::FollowUp { .. }
+            | Command::OffsetLatch { .. } => self.apply_hyd_direct(cmd),
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
