@@ -215,6 +215,14 @@ impl HydDirect {
     }
 }
 
+/// Nothing running (an electric axis' state).
+const IDLE: HydDirect = HydDirect {
+    direct: None,
+    ext_gen: None,
+    follow_up: false,
+    latched_zero: None,
+};
+
 /// The largest `|OutValue|`: full scale.
 const FULL_SCALE: f64 = 1.0;
 
@@ -246,11 +254,9 @@ impl Axis {
         }
     }
 
-    fn direct_state(&self) -> HydDirect {
-        self.hyd
-            .as_deref()
-            .map(|h| h.cmds.direct)
-            .unwrap_or_default()
+    /// The state of this module's instructions (borrowed: looked at every cycle).
+    fn direct_state(&self) -> &HydDirect {
+        self.hyd.as_deref().map_or(&IDLE, |h| &h.cmds.direct)
     }
 
     fn set_direct_state(&mut self, f: impl FnOnce(&mut HydDirect)) {
@@ -343,7 +349,7 @@ impl Axis {
     /// velocity `value · fRefVelo`, the set position at the actual one. Returns whether either
     /// ran.
     pub(super) fn hyd_direct_generate(&mut self) -> bool {
-        let state = self.direct_state();
+        let state = *self.direct_state();
         if state.follow_up {
             self.follow_actual();
             return true;
@@ -377,7 +383,10 @@ impl Axis {
     /// actual position in position control); runs whose job is no longer the axis' (aborted)
     /// end.
     pub(super) fn hyd_direct_cycle(&mut self) {
-        let state = self.direct_state();
+        let state = *self.direct_state();
+        if state.direct.is_none() && state.ext_gen.is_none() {
+            return;
+        }
         if let Some(run) = state.direct {
             if !self.still_main(run.job) {
                 self.set_direct_state(|d| d.direct = None);
