@@ -621,3 +621,89 @@ fn cell_with_i() -> Cell {
         ("fLagAmp = 50.0", "fLagAmp = 50.0\nfLagAmpTi = 10.0"),
     ])
 }
+
+/// The node's command path (`tandem_config::script::parse_command`, what a node does with a
+/// command line from the network): leading values sent as text each cycle with their own
+/// parameter names are the axis' set values of that cycle, exactly as the command built in
+/// code; `enable false` ends it. Also MC_AxRtSetDirectOutput_BkPlcMc and
+/// MC_AxRtFollowUp_BkPlcMc / MC_AxUtiOffsetLatch_BkPlcMc by name.
+#[test]
+fn leading_values_arrive_each_cycle_through_the_nodes_command_path() {
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    let send = |r: &mut Run<'_>, instruction: &str, params: &[(&str, String)]| {
+        let params: Vec<(String, String)> = params
+            .iter()
+            .map(|(k, v)| ((*k).to_string(), v.clone()))
+            .collect();
+        let e = tandem_config::script::parse_command(&cell, "ram", instruction, &params).unwrap();
+        let t = r.k * hyd_rig::MS;
+        r.exec
+            .apply_at(t, t, &e.axis, e.instruction, e.action, &mut r.log)
+            .unwrap()
+    };
+    for k in 0..300 {
+        let (p, v) = leading(k);
+        let out = send(
+            &mut r,
+            "MC_AxRtSetExtGenValues_BkPlcMc",
+            &[
+                ("position", p.to_string()),
+                ("velocity", v.to_string()),
+                ("target_position", "400".into()),
+            ],
+        );
+        assert!(out.is_ok(), "{out:?}");
+        r.step();
+        let s = r.status();
+        assert!(
+            (s.position - p).abs() < 1e-9 && s.velocity == v,
+            "{k}: {s:?}"
+        );
+        assert_eq!(s.state, AxisState::SynchronizedMotion);
+    }
+    send(
+        &mut r,
+        "MC_AxRtSetExtGenValues_BkPlcMc",
+        &[("enable", "false".into())],
+    )
+    .unwrap();
+    r.step();
+    assert_eq!((r.job(), r.state()), (None, AxisState::Standstill));
+    r.until(3000, "idle", |r| r.hyd().state == HydState::Idle);
+    send(
+        &mut r,
+        "MC_AxRtSetDirectOutput_BkPlcMc",
+        &[("out_value", "-0.1".into()), ("ramp_time", "0".into())],
+    )
+    .unwrap();
+    r.step();
+    assert!((r.status().velocity + 0.1 * REF_VELO).abs() < 1e-9);
+    assert_eq!(r.job(), Some(Instruction::SetDirectOutput));
+    send(
+        &mut r,
+        "MC_AxRtSetDirectOutput_BkPlcMc",
+        &[("enable", "false".into())],
+    )
+    .unwrap();
+    r.step();
+    assert_eq!(r.job(), None);
+    send(&mut r, "MC_AxRtFollowUp_BkPlcMc", &[]).unwrap();
+    assert_eq!(r.try_move_to(150.0, 100.0), Err(ErrorId::AxisLocked));
+    send(
+        &mut r,
+        "MC_AxRtFollowUp_BkPlcMc",
+        &[("enable", "false".into())],
+    )
+    .unwrap();
+    for _ in 0..500 {
+        r.step();
+    }
+    let out = send(
+        &mut r,
+        "MC_AxUtiOffsetLatch_BkPlcMc",
+        &[("offset_limit", "-1".into())],
+    );
+    assert_eq!(out, Err(ErrorId::IllegalControllerParameter));
+    assert!(send(&mut r, "MC_AxUtiOffsetLatch_BkPlcMc", &[]).is_ok());
+}
