@@ -21,6 +21,8 @@ use tandem_motion::plant::analog::output_word;
 use tandem_runtime::exec::Executive;
 use tandem_testkit::workspace::root;
 
+tandem_testkit::counting_allocator!();
+
 /// fRefVelo of config/hydraulic.toml (mm/s).
 const REF_VELO: f64 = 327.06;
 /// Its fLagAmp (mm/s per mm).
@@ -706,4 +708,48 @@ fn leading_values_arrive_each_cycle_through_the_nodes_command_path() {
     );
     assert_eq!(out, Err(ErrorId::IllegalControllerParameter));
     assert!(send(&mut r, "MC_AxUtiOffsetLatch_BkPlcMc", &[]).is_ok());
+}
+
+/// The cyclic path does not allocate with these instructions running: 1,000 cycles of leading
+/// values applied and stepped, a direct output slewing out and released to its Done, a
+/// follow-up: 0 allocations (counted on this thread, the log's buffer reserved before).
+#[test]
+fn the_instructions_run_without_allocating() {
+    use tandem_testkit::counting::{arm, disarm};
+    let cell = cell(&[]);
+    let mut r = Run::enabled(&cell);
+    r.log.reserve(1 << 16);
+    let (p, v) = leading(0);
+    r.ext(true, p, v, 400.0).unwrap();
+    r.step();
+    let mut accepted = true;
+    arm();
+    for k in 1..1000 {
+        let (p, v) = leading(k);
+        accepted &= r.ext(true, p, v, 400.0).is_ok();
+        r.step();
+    }
+    let (ext_allocs, _) = disarm();
+    assert!(accepted);
+    r.ext(false, 0.0, 0.0, 0.0).unwrap();
+    r.until(3000, "idle", |r| r.hyd().state == HydState::Idle);
+    r.direct(true, 0.1, 0.2).unwrap();
+    arm();
+    for _ in 0..300 {
+        r.step();
+    }
+    // Checked after the armed section.
+    let released = r.direct(false, 0.0, 0.2);
+    for _ in 0..300 {
+        r.step();
+    }
+    let (direct_allocs, _) = disarm();
+    assert!(released.is_ok() && r.job().is_none(), "{released:?}");
+    r.follow_up(true);
+    arm();
+    for _ in 0..300 {
+        r.step();
+    }
+    let (follow_allocs, _) = disarm();
+    assert_eq!((ext_allocs, direct_allocs, follow_allocs), (0, 0, 0));
 }
