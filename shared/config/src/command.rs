@@ -276,6 +276,36 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("calibration_cam", Some(Value::Bool(false))),
         ],
     },
+    // The Beckhoff hydraulic library's direct output and external set values: level inputs
+    // re-sent with their current values (`enable = false` ends them).
+    InstructionSpec {
+        name: "MC_AxRtSetDirectOutput_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("out_value", Some(Value::Num(0.0))),
+            ("ramp_time", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_AxRtSetExtGenValues_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("position", Some(Value::Num(0.0))),
+            ("velocity", Some(Value::Num(0.0))),
+            ("target_position", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_AxRtFollowUp_BkPlcMc",
+        params: &[("enable", Some(Value::Bool(true)))],
+    },
+    InstructionSpec {
+        name: "MC_AxUtiOffsetLatch_BkPlcMc",
+        params: &[
+            ("execute", Some(Value::Bool(true))),
+            ("offset_limit", Some(Value::Num(0.5))),
+        ],
+    },
     InstructionSpec {
         name: "MC_SetReferenceFlag_BkPlcMc",
         params: &[("reference_flag", Some(Value::Bool(true)))],
@@ -1085,6 +1115,24 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
             )?,
             calibration_cam: a.flag("calibration_cam")?,
         }),
+        "MC_AxRtSetDirectOutput_BkPlcMc" => Command::SetDirectOutput {
+            enable: a.flag("enable")?,
+            out_value: a.num("out_value")?,
+            ramp_time: a.num("ramp_time")?,
+        },
+        "MC_AxRtSetExtGenValues_BkPlcMc" => Command::SetExtGenValues {
+            enable: a.flag("enable")?,
+            position: a.num("position")?,
+            velocity: a.num("velocity")?,
+            target_position: a.num("target_position")?,
+        },
+        "MC_AxRtFollowUp_BkPlcMc" => Command::FollowUp {
+            enable: a.flag("enable")?,
+        },
+        "MC_AxUtiOffsetLatch_BkPlcMc" => Command::OffsetLatch {
+            execute: a.flag("execute")?,
+            offset_limit: a.num("offset_limit")?,
+        },
         "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
             reference_flag: a.flag("reference_flag")?,
         },
@@ -1284,6 +1332,82 @@ mod tests {
             c,
             Command::SetReferenceFlag {
                 reference_flag: true
+            }
+        );
+    }
+
+    #[test]
+    fn direct_output_and_external_set_values_take_the_library_inputs() {
+        let c = parse(
+            "MC_AxRtSetDirectOutput_BkPlcMc",
+            &[
+                p("out_value", Value::Num(-0.4)),
+                p("ramp_time", Value::Num(0.5)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::SetDirectOutput {
+                enable: true,
+                out_value: -0.4,
+                ramp_time: 0.5
+            }
+        );
+        let c = parse(
+            "MC_AxRtSetExtGenValues_BkPlcMc",
+            &[
+                p("position", Value::Num(12.5)),
+                p("velocity", Value::Num(30.0)),
+                p("target_position", Value::Num(200.0)),
+            ],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::SetExtGenValues {
+                enable: true,
+                position: 12.5,
+                velocity: 30.0,
+                target_position: 200.0
+            }
+        );
+        let c = parse(
+            "MC_AxRtSetExtGenValues_BkPlcMc",
+            &[p("enable", Value::Bool(false))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(
+            c,
+            Command::SetExtGenValues {
+                enable: false,
+                position: 0.0,
+                velocity: 0.0,
+                target_position: 0.0
+            }
+        );
+        assert!(parse(
+            "MC_AxRtSetDirectOutput_BkPlcMc",
+            &[p("enable", Value::Num(1.0))],
+            Refs::default()
+        )
+        .is_err());
+        let c = parse(
+            "MC_AxRtFollowUp_BkPlcMc",
+            &[p("enable", Value::Bool(false))],
+            Refs::default(),
+        )
+        .unwrap();
+        assert_eq!(c, Command::FollowUp { enable: false });
+        let c = parse("MC_AxUtiOffsetLatch_BkPlcMc", &[], Refs::default()).unwrap();
+        assert_eq!(
+            c,
+            Command::OffsetLatch {
+                execute: true,
+                offset_limit: 0.5
             }
         );
     }

@@ -192,6 +192,16 @@ impl AutoZero {
         Ok(())
     }
 
+    /// Writes `fZeroCompensation` (V) from outside, as `MC_AxUtiOffsetLatch_BkPlcMc` does: the
+    /// compensation goes on from it (`OldValue` too); a value that is not finite changes
+    /// nothing.
+    pub fn set_compensation(&mut self, compensation: f64) {
+        if compensation.is_finite() {
+            self.status.compensation = compensation;
+            self.old_value = compensation;
+        }
+    }
+
     /// The outputs of the last cycle.
     pub fn status(&self) -> AutoZeroStatus {
         self.status
@@ -277,6 +287,19 @@ mod tests {
             threshold: 0.05,
             filter: 2.0,
         }
+    }
+
+    /// A value written from outside (MC_AxUtiOffsetLatch_BkPlcMc) is where the compensation
+    /// goes on from; a value that is not finite changes nothing.
+    #[test]
+    fn a_written_compensation_is_kept_and_integrated_from() {
+        let mut a = AutoZero::new(params(), 0.1).unwrap();
+        a.set_compensation(-0.2);
+        a.set_compensation(f64::NAN);
+        assert_eq!(a.status().compensation, -0.2);
+        // Inside the window nothing moves.
+        let s = a.step(&standing(0.005));
+        assert_eq!(s.compensation, -0.2);
     }
 
     #[test]

@@ -93,6 +93,10 @@ pub struct HydControlInput {
     pub clamping_output: f64,
     /// `fZeroCompensation` (V) as `MC_AxCtrlAutoZero_BkPlcMc` has set it; `None`: unchanged.
     pub zero_compensation: Option<f64>,
+    /// The control value of `MC_AxRtSetDirectOutput_BkPlcMc` (normalised): with it, Finish
+    /// takes it as its commanded value (step 1) in place of the set velocity and the position
+    /// controller's output (0, the I part held); the clamping output is not added.
+    pub direct_output: Option<f64>,
     /// The cycle (s, > 0): the I part's time step.
     pub dt: f64,
 }
@@ -203,13 +207,13 @@ impl HydController {
         if let Some(z) = i.zero_compensation {
             self.finish.set_zero_compensation(z);
         }
-        let pi = if i.position_control {
+        let pi = if i.position_control && i.direct_output.is_none() {
             self.lag_ctrl_output(i.set_position - i.actual_position, i.dt)
         } else {
             0.0
         };
         let ex = match &mut self.ex {
-            Some(ex) => {
+            Some(ex) if i.direct_output.is_none() => {
                 let response = ex.step(&ExInput {
                     set_velocity: i.set_velocity,
                     actual_velocity: i.actual_velocity,
@@ -217,16 +221,25 @@ impl HydController {
                 });
                 response / self.params.finish.ref_velo
             }
-            None => 0.0,
+            _ => 0.0,
         };
         let lag = match self.params.lag_out_limit {
             l if l > 0.0 => (pi + ex).clamp(-l, l),
             _ => pi + ex,
         };
-        let input = FinishInput {
-            set_velocity: i.set_velocity,
-            lag_ctrl_output: lag,
-            clamping_output: i.clamping_output,
+        let input = match i.direct_output {
+            // Step 1 of Finish gives `fFeedForward · fSetVelo / fRefVelo + fLagCtrlOutput`;
+            // the direct control value stands for that sum.
+            Some(d) if d.is_finite() => FinishInput {
+                set_velocity: 0.0,
+                lag_ctrl_output: d,
+                clamping_output: 0.0,
+            },
+            _ => FinishInput {
+                set_velocity: i.set_velocity,
+                lag_ctrl_output: lag,
+                clamping_output: i.clamping_output,
+            },
         };
         let out = match &self.table {
             Some(t) => self.finish.linear(t, &input),
@@ -306,6 +319,36 @@ mod tests {
             ..at(10.5, 10.0)
         });
         assert_eq!((out.lag_ctrl_output, out.output), (0.0, 0.2));
+    }
+
+    /// MC_AxRtSetDirectOutput_BkPlcMc's control value stands for Finish's step 1: the set
+    /// velocity, the lag and the clamping output do not count; the offset does.
+    #[test]
+    fn a_direct_output_replaces_the_set_velocity_and_the_controller() {
+        let mut c = HydController::new(params(), None).unwrap();
+        let out = c.step(&HydControlInput {
+            set_velocity: 40.0,
+            clamping_output: 2.0,
+            direct_output: Some(-0.35),
+            ..at(10.5, 10.0)
+        });
+        assert_eq!((out.lag_ctrl_output, out.output), (0.0, -0.35));
+        let mut c = HydController::new(
+            HydControllerParams {
+                finish: FinishParams {
+                    zero_compensation: 0.5,
+                    ..params().finish
+                },
+                ..params()
+            },
+            None,
+        )
+        .unwrap();
+        let out = c.step(&HydControlInput {
+            direct_output: Some(0.25),
+            ..at(10.5, 10.0)
+        });
+        assert!((out.output - 0.3).abs() < 1e-15, "{out:?}");
     }
 
     #[test]

@@ -69,6 +69,15 @@ pub enum Instruction {
     MoveJoySticked,
     /// `MC_Home_BkPlcMc` (Beckhoff hydraulic library): homing in the library's modes.
     HydHome,
+    /// `MC_AxRtSetDirectOutput_BkPlcMc` (Beckhoff hydraulic library): open-loop control value.
+    SetDirectOutput,
+    /// `MC_AxRtSetExtGenValues_BkPlcMc` (Beckhoff hydraulic library): external set values.
+    SetExtGenValues,
+    /// `MC_AxRtFollowUp_BkPlcMc` (Beckhoff hydraulic library): set values follow the actual ones.
+    FollowUp,
+    /// `MC_AxUtiOffsetLatch_BkPlcMc` (Beckhoff hydraulic library): the controller's output
+    /// latched into the offset compensation.
+    OffsetLatch,
     /// `MC_GearIn`.
     GearIn,
     /// `MC_GearInPos`.
@@ -126,6 +135,10 @@ impl Instruction {
             Self::HydMoveJog => "MC_MoveJog_BkPlcMc",
             Self::MoveJoySticked => "MC_MoveJoySticked_BkPlcMc",
             Self::HydHome => "MC_Home_BkPlcMc",
+            Self::SetDirectOutput => "MC_AxRtSetDirectOutput_BkPlcMc",
+            Self::SetExtGenValues => "MC_AxRtSetExtGenValues_BkPlcMc",
+            Self::FollowUp => "MC_AxRtFollowUp_BkPlcMc",
+            Self::OffsetLatch => "MC_AxUtiOffsetLatch_BkPlcMc",
             Self::GearIn => "MC_GearIn",
             Self::GearInPos => "MC_GearInPos",
             Self::FlyingGear => "MC_FlyingGear_BkPlcMc",

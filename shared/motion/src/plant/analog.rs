@@ -831,6 +831,7 @@ impl AnalogConnection {
             position_control: out.position_controlled,
             clamping_output: out.hydraulic.clamping_output,
             zero_compensation: out.hydraulic.zero_compensation,
+            direct_output: out.hydraulic.direct_output,
             dt,
         });
         self.status.lag_ctrl_output = o.lag_ctrl_output;

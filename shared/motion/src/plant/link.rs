@@ -153,6 +153,11 @@ pub struct HydValveOutputs {
     /// (`bLocked_Estop` of `MC_EmergencyStop_BkPlcMc` / `MC_ImmediateStop_BkPlcMc`).
     #[doc(alias = "bLocked_Estop")]
     pub locked: bool,
+    /// The control value of `MC_AxRtSetDirectOutput_BkPlcMc` (normalised, ±1.0 = full scale):
+    /// Finish takes it in place of the set velocity and the position controller's output.
+    /// `None`: none runs.
+    #[doc(alias = "MC_AxRtSetDirectOutput_BkPlcMc")]
+    pub direct_output: Option<f64>,
 }
 
 /// Switch levels read from input signals of the node's process image, in place of the

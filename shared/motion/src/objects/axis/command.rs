@@ -566,6 +566,49 @@ pub enum Command {
     /// current inputs while it runs.
     #[doc(alias = "MC_Home_BkPlcMc")]
     HydHome(super::hyd_home::HydHomeInputs),
+    /// `MC_AxRtSetDirectOutput_BkPlcMc` (Beckhoff hydraulic library, 4.4.7.7): the control
+    /// value `out_value` output open loop, slewed with `ramp_time`; sent again with the current
+    /// inputs, `enable = false` ramps it to 0 and ends it.
+    #[doc(alias = "MC_AxRtSetDirectOutput_BkPlcMc")]
+    SetDirectOutput {
+        /// `Enable`.
+        enable: bool,
+        /// `OutValue` (normalised, ±1.0 = full scale).
+        out_value: f64,
+        /// `RampTime` (s for full scale; 0: at once).
+        ramp_time: f64,
+    },
+    /// `MC_AxRtSetExtGenValues_BkPlcMc` (Beckhoff hydraulic library, 4.4.7.8): set values from
+    /// outside the axis' generator, sent each cycle; `enable = false` ends it (a moving axis
+    /// stops with `fStopRamp`).
+    #[doc(alias = "MC_AxRtSetExtGenValues_BkPlcMc")]
+    SetExtGenValues {
+        /// `Enable`.
+        enable: bool,
+        /// `Position` (mm): the set position of this cycle.
+        position: f64,
+        /// `Velocity` (mm/s): the set velocity of this cycle.
+        velocity: f64,
+        /// `TargetPosition` (mm): the target of the current motion.
+        target_position: f64,
+    },
+    /// `MC_AxRtFollowUp_BkPlcMc` (Beckhoff hydraulic library, 4.4.9.3): while `enable`, the set
+    /// position follows the actual one with the position controller off; `enable = false`
+    /// closes the loop again at the actual position.
+    #[doc(alias = "MC_AxRtFollowUp_BkPlcMc")]
+    FollowUp {
+        /// `Enable`.
+        enable: bool,
+    },
+    /// `MC_AxUtiOffsetLatch_BkPlcMc` (Beckhoff hydraulic library, 4.4.9.5): with `execute`,
+    /// the position controller's output at standstill becomes part of `fZeroCompensation`.
+    #[doc(alias = "MC_AxUtiOffsetLatch_BkPlcMc")]
+    OffsetLatch {
+        /// `Execute` (each command with `true` is a rising edge).
+        execute: bool,
+        /// `OffsetLimit` (V, default 0.5): the largest controller output accepted.
+        offset_limit: f64,
+    },
     /// Writes `Override.Velocity` (0..200 %), effective at once with the jobs' dynamics.
     #[doc(alias = "MC_SetOverride")]
     SetOverride {

@@ -77,6 +77,8 @@ pub(super) struct HydCommands {
     pub(super) home: Option<super::hyd_home::HomeRun>,
     /// The reference cam's input signal (`[axes.<name>.inputs] reference_cam`).
     pub(super) cam_input: bool,
+    /// MC_AxRtSetDirectOutput_BkPlcMc and MC_AxRtSetExtGenValues_BkPlcMc.
+    pub(super) direct: super::hyd_direct::HydDirect,
 }
 
 impl HydCommands {
@@ -90,6 +92,7 @@ impl HydCommands {
             joystick: None,
             home: None,
             cam_input: false,
+            direct: super::hyd_direct::HydDirect::default(),
         }
     }
 

@@ -56,9 +56,9 @@ pub(super) struct HydAxis {
     /// The running MC_AxCtrlPressure_BkPlcMc job.
     pressure: Option<PressureJob>,
     /// The position controller's and Finish's parameters (AutoZero's basis).
-    controller: HydControllerParams,
+    pub(super) controller: HydControllerParams,
     /// MC_AxCtrlAutoZero_BkPlcMc, once it has been enabled; its `Enable`.
-    auto_zero: Option<(AutoZero, bool)>,
+    pub(super) auto_zero: Option<(AutoZero, bool)>,
     /// The library's stop and jog instructions' state (`super::hyd_commands`).
     pub(super) cmds: super::hyd_commands::HydCommands,
     /// MC_AxCtrlSlowDownOnPressureEx_BkPlcMc while enabled, with its last cycle
@@ -104,6 +104,10 @@ pub struct HydraulicStatus {
     /// MC_AxCtrlSlowDownOnPressureEx_BkPlcMc while enabled: `Busy`, `Active` and the
     /// permissible velocity of the last cycle.
     pub slow_down: Option<SlowDownStatus>,
+    /// `fZeroCompensation` in effect (V): the configured one, or as MC_AxCtrlAutoZero_BkPlcMc
+    /// or MC_AxUtiOffsetLatch_BkPlcMc set it.
+    #[doc(alias = "fZeroCompensation")]
+    pub zero_compensation: f64,
 }
 
 impl HydAxis {
@@ -255,6 +259,8 @@ impl Axis {
     pub(super) fn hyd_position_control(&self) -> bool {
         match self.hyd.as_deref() {
             Some(h) if h.pressure.is_some() => false,
+            // MC_AxRtSetDirectOutput_BkPlcMc: open loop; MC_AxRtFollowUp_BkPlcMc: none.
+            Some(_) if self.hyd_direct_output().is_some() || self.hyd_following_up() => false,
             // bTimeBased: "The position controller is always active" (at the target too,
             // except where target clamping replaces it).
             Some(h) if h.engaged && h.time_based => {
@@ -401,13 +407,14 @@ impl Axis {
             state: h.last.state,
             positive: h.last.positive,
             engaged: h.engaged,
-            target: h.gen.target(),
+            target: self.hyd_ext_gen_target().unwrap_or_else(|| h.gen.target()),
             in_target_range: h.window.in_target_range,
             in_target: h.window.in_target,
             actual: h.actual,
             pressure_control: h.pressure.map(|p| (p.set, p.last)),
             auto_zero: h.auto_zero.map(|(a, on)| (a.status(), on)),
             slow_down: h.slow_down.map(|(_, s)| s),
+            zero_compensation: self.hyd_zero_compensation(),
         })
     }
 
@@ -434,7 +441,15 @@ impl Axis {
                 Some((a, enable))
             }
             None => Some((
-                AutoZero::new(params, finish.zero_compensation).map_err(|_| refused)?,
+                AutoZero::new(
+                    params,
+                    // From the value MC_AxUtiOffsetLatch_BkPlcMc latched, if it did.
+                    h.cmds
+                        .direct
+                        .latched_zero()
+                        .unwrap_or(finish.zero_compensation),
+                )
+                .map_err(|_| refused)?,
                 enable,
             )),
         };
@@ -485,8 +500,12 @@ impl Axis {
                 } else {
                     0.0
                 },
-                zero_compensation: h.auto_zero.map(|(a, _)| a.status().compensation),
+                zero_compensation: h
+                    .auto_zero
+                    .map(|(a, _)| a.status().compensation)
+                    .or(h.cmds.direct.latched_zero()),
                 locked: h.cmds.outputs_locked(),
+                direct_output: self.hyd_direct_output(),
             },
             None => HydValveOutputs::default(),
         }

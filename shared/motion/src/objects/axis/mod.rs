@@ -11,6 +11,7 @@ mod buffer;
 mod command;
 mod config;
 mod hyd_commands;
+mod hyd_direct;
 mod hyd_home;
 mod hyd_joystick;
 mod hyd_slow_down;
@@ -943,7 +944,7 @@ impl Axis {
         if self.stopping_alarm_pending() {
             return Err(ErrorId::JobRejectedInErrorStop);
         }
-        if self.stop_lock || self.hyd_locked() {
+        if self.stop_lock || self.hyd_locked() || self.hyd_following_up() {
             return Err(ErrorId::AxisLocked);
         }
         Ok(())
@@ -1082,6 +1083,10 @@ impl Axis {
             | Command::HydMoveJog { .. }
             | Command::MoveJoySticked { .. }
             | Command::HydHome(_) => self.apply_hyd_command(cmd),
+            Command::SetDirectOutput { .. }
+            | Command::SetExtGenValues { .. }
+            | Command::FollowUp { .. }
+            | Command::OffsetLatch { .. } => self.apply_hyd_direct(cmd),
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }

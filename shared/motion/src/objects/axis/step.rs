@@ -43,6 +43,7 @@ impl Axis {
         self.check_sw_limits();
         self.update_jobs();
         self.hyd_commands_cycle();
+        self.hyd_direct_cycle();
         self.monitor(act.balanced + self.offset);
         self.hyd_auto_zero();
 
@@ -180,7 +181,7 @@ impl Axis {
 
     fn generate(&mut self) {
         let dt = self.cfg.cycle;
-        let by_generator = self.hyd_generate();
+        let by_generator = self.hyd_direct_generate() || self.hyd_generate();
         match self.goal {
             _ if by_generator => {}
             Goal::Direct {
@@ -885,6 +886,10 @@ impl Axis {
                 Some(Instruction::HydHome) => AxisState::Homing,
                 // The library's McState_Synchronizedmotion for MC_MoveJoySticked_BkPlcMc.
                 Some(Instruction::MoveJoySticked) => AxisState::SynchronizedMotion,
+                // MC_AxRtSetExtGenValues_BkPlcMc: McState_Synchronizedmotion; and
+                // MC_AxRtSetDirectOutput_BkPlcMc: McState_Continuousmotion.
+                Some(Instruction::SetExtGenValues) => AxisState::SynchronizedMotion,
+                Some(Instruction::SetDirectOutput) => AxisState::ContinuousMotion,
                 Some(
                     Instruction::MoveVelocity
                     | Instruction::MoveJog
