@@ -220,6 +220,10 @@ pub enum DcsField {
     FirstOnPosition,
     /// `LastOnPosition` of a switch.
     LastOnPosition,
+    /// `AxisDirection` of a switch (a code the library does not know).
+    AxisDirection,
+    /// `CamSwitchMode` of a switch (a code the library does not know).
+    CamSwitchMode,
     /// `Duration` of a switch.
     Duration,
     /// `OnCompensation` of a track.
@@ -252,6 +256,8 @@ impl core::fmt::Display for DcsError {
             DcsField::TrackNumber => "switch TrackNumber",
             DcsField::FirstOnPosition => "switch FirstOnPosition",
             DcsField::LastOnPosition => "switch LastOnPosition",
+            DcsField::AxisDirection => "switch AxisDirection",
+            DcsField::CamSwitchMode => "switch CamSwitchMode",
             DcsField::Duration => "switch Duration",
             DcsField::OnCompensation => "track OnCompensation",
             DcsField::OffCompensation => "track OffCompensation",
