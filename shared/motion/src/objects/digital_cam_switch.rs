@@ -47,11 +47,22 @@
 //!   after the uncompensated crossing; inferred), none when that is not positive.
 //! - **Hysteresis** (per track, position units): after a switching point (`FirstOnPosition` or
 //!   `LastOnPosition` of a switch) fired at actual position `p_f`, that point is not evaluated
-//!   again until `|p - p_f| >= Hysteresis`; the other point of the switch still is.
+//!   again until `|p - p_f| >= Hysteresis`; the other point of the switch still is. A point
+//!   fires when the (projected) position crosses it, whether or not the direction filter lets
+//!   the switch's output change (inferred).
 //! - **Enable** (level) controls everything: FALSE clears the outputs and every switch's state
 //!   (`InOperation`, `Busy` FALSE); TRUE evaluates (`InOperation`, `Busy` TRUE; inferred: Busy
 //!   as for PLCopen's Enable-type FBs). `EnableMask` masks the outputs only: the switches keep
 //!   being evaluated, so a mask bit set mid-cam shows the cam at once (inferred).
+//!
+//! # Decisions on the reference's inconsistencies
+//!
+//! - The library's Sample 8 calls the −1000…1000 switch "positive direction"; the FB's example
+//!   table gives it `AxisDirection` 0 (both). The table is followed (it is the definition the
+//!   signal diagram shows).
+//! - Sample 8 calls `OnCompensation = −0.125` a "switch-on delay of 0.125 s"; the track type
+//!   says a negative compensation gives the signal early. The type is followed.
+//! - The `TrackNumber` → bit mapping the reference leaves open: bit `TrackNumber − 1` (above).
 //!
 //! # Compared with the S7 output cam
 //!
@@ -549,14 +560,15 @@ impl DigitalCamSwitch {
     /// One cycle with the axis' actual position and velocity, `dt` (s) since the last cycle:
     /// returns `OutputBits` (see the module documentation).
     pub fn step(&mut self, actual_position: f64, actual_velocity: f64, dt: f64) -> u32 {
-        if !self.input.enable {
-            self.status.output_bits = 0;
-            return 0;
-        }
+        // The direction of the last motion is followed while disabled too.
         if actual_velocity > 0.0 {
             self.direction = 1;
         } else if actual_velocity < 0.0 {
             self.direction = -1;
+        }
+        if !self.input.enable {
+            self.status.output_bits = 0;
+            return 0;
         }
         let c = Cycle {
             p: actual_position,
