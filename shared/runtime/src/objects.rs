@@ -754,7 +754,8 @@ impl Objects {
         Ok(())
     }
 
-    /// Applies a script action addressed to an output cam, cam track or measuring input.
+    /// Applies a script action addressed to an output cam, cam track, measuring input or
+    /// digital cam switch.
     /// `Err` is an ErrorID to log as a rejection.
     pub(crate) fn apply(
         &mut self,

@@ -30,6 +30,11 @@
 //! held back to its predecessor's time by the object) switches at once at the next boundary,
 //! counted as late, never lost.
 //!
+//! A digital cam switch (the hydraulic library's MC_DigitalCamSwitch_BkPlcMc) drives one signal
+//! per track (`tracks[n - 1].output`) without look-ahead: the library evaluates its cams once
+//! per cycle, so a track bit computed in the step at `t` is an edge due at `t + T`, written at
+//! that boundary.
+//!
 //! # The order within one step at `t`, after the objects stepped
 //!
 //! 1. Every device whose node's cycle falls on `t` reaches the boundary `t`:
