@@ -428,6 +428,10 @@ pub(crate) fn owns(cell: &Cell, n: usize, target: &str, action: &Action) -> bool
             .or_else(|| {
                 cell.measuring_input(target)
                     .and_then(|i| axis_node(cell.measuring_inputs[i].axis))
+            })
+            .or_else(|| {
+                cell.digital_cam_switch(target)
+                    .and_then(|i| axis_node(cell.digital_cam_switches[i].axis))
             }),
     };
     node == Some(n)

@@ -650,6 +650,22 @@ pub struct CamTrackEntry {
     pub output: Option<SignalIndex>,
 }
 
+/// An MC_DigitalCamSwitch_BkPlcMc of the cell (`[[digital_cam_switches]]`): its switch and
+/// track sets, checked by the engine.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DigitalCamSwitchEntry {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose actual position and velocity switch it.
+    pub axis: AxisIndex,
+    /// `Switches`.
+    pub switches: Vec<tandem_motion::objects::digital_cam_switch::CamSwitch>,
+    /// `TrackOptions` (track `n` is element `n - 1`).
+    pub tracks: Vec<tandem_motion::objects::digital_cam_switch::TrackOptions>,
+    /// Per track: the digital output signal its bit drives, if any.
+    pub outputs: Vec<Option<SignalIndex>>,
+}
+
 /// A simulated mark sensor on a measuring input.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct SensorEntry {
@@ -756,6 +772,8 @@ pub struct Cell {
     pub cam_tracks: Vec<CamTrackEntry>,
     /// Measuring inputs, in file order.
     pub measuring_inputs: Vec<MeasuringInputEntry>,
+    /// MC_DigitalCamSwitch_BkPlcMc objects, in file order.
+    pub digital_cam_switches: Vec<DigitalCamSwitchEntry>,
     /// The devices of the nodes' process images, in name order.
     pub devices: Vec<DeviceEntry>,
     /// The named signals, in name order.
@@ -952,7 +970,15 @@ impl Cell {
         self.measuring_inputs.iter().position(|c| c.name == name)
     }
 
-    /// The axis of the output cam, cam track or measuring input named `name`.
+    /// The index of the digital cam switch named `name`.
+    pub fn digital_cam_switch(&self, name: &str) -> Option<usize> {
+        self.digital_cam_switches
+            .iter()
+            .position(|c| c.name == name)
+    }
+
+    /// The axis of the output cam, cam track, measuring input or digital cam switch named
+    /// `name`.
     pub fn object_axis(&self, name: &str) -> Option<AxisIndex> {
         self.output_cam(name)
             .map(|i| self.output_cams[i].axis)
@@ -960,6 +986,10 @@ impl Cell {
             .or_else(|| {
                 self.measuring_input(name)
                     .map(|i| self.measuring_inputs[i].axis)
+            })
+            .or_else(|| {
+                self.digital_cam_switch(name)
+                    .map(|i| self.digital_cam_switches[i].axis)
             })
     }
 }

@@ -196,6 +196,9 @@ pub enum Problem {
         /// The engine's reason.
         reason: tandem_motion::objects::measuring::MeasuringConfigError,
     },
+    /// A switch or track of a digital cam switch refused by the engine, with the hydraulic
+    /// library's error code (the key names the entry and its field).
+    CamSwitch(tandem_motion::objects::digital_cam_switch::DcsError),
     /// A script instruction or its parameters.
     Command(CommandError),
     /// A required key that is missing.
@@ -564,6 +567,31 @@ impl fmt::Display for Problem {
                 write!(f, "`{sensor_axis}` must be on the node of `{axis}`")
             }
             Problem::Rejected { object, reason } => write!(f, "rejected by the {object}: {reason}"),
+            Problem::CamSwitch(e) => {
+                use tandem_motion::objects::digital_cam_switch::{DcsField, COMPENSATION_MAX};
+                let rule = match e.field {
+                    DcsField::SwitchCount => "too many switches",
+                    DcsField::TrackCount => "too many tracks",
+                    DcsField::TrackNumber => "must be 1..=32 and name an entry of `tracks`",
+                    DcsField::FirstOnPosition => "must be finite, within ±1e12",
+                    DcsField::AxisDirection => "must be 0 (both), 1 (positive) or 2 (negative)",
+                    DcsField::CamSwitchMode => "must be 0 (position) or 1 (time)",
+                    DcsField::LastOnPosition => {
+                        "must be given for a position switch, finite, within ±1e12 and at least first_on_position"
+                    }
+                    DcsField::Duration => "must be given for a time switch, finite and >= 0 s",
+                    DcsField::OnCompensation | DcsField::OffCompensation => {
+                        return write!(
+                            f,
+                            "must be within ±{COMPENSATION_MAX} s ({} {})",
+                            e.code,
+                            e.code.meaning()
+                        )
+                    }
+                    DcsField::Hysteresis => "must be 0..1e12",
+                };
+                write!(f, "{rule} ({} {})", e.code, e.code.meaning())
+            }
             Problem::Command(c) => fmt::Display::fmt(c, f),
         }
     }

@@ -57,8 +57,8 @@ pub mod security;
 pub use cell::{
     AnalogChannelParams, AnalogDriveConnection, AxisEntry, AxisIndex, AxisInputs, CamEntry,
     CamTrackEntry, Cell, Cia402Connection, CounterParams, Coupling, DeviceEntry, DeviceIndex,
-    DeviceKind, DigitalInputParams, DigitalOutputParams, DriveConnection, EncoderEntry,
-    EncoderIndex, EncoderSource, EthercatDriveParams, EthercatIdentity, EthercatRole,
+    DeviceKind, DigitalCamSwitchEntry, DigitalInputParams, DigitalOutputParams, DriveConnection,
+    EncoderEntry, EncoderIndex, EncoderSource, EthercatDriveParams, EthercatIdentity, EthercatRole,
     EthercatSegment, EthercatSubDevice, InputBindings, Leader, LeadingValueConfig,
     MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration, SensorEntry,
     SignalDirection, SignalEntry, SignalIndex, SignalType, LEADING_BUFFER, MAX_CHANNELS,

@@ -34,6 +34,9 @@ pub struct CellFile {
     /// `[[measuring_inputs]]`.
     #[serde(default)]
     pub measuring_inputs: Vec<MeasuringInputSection>,
+    /// `[[digital_cam_switches]]`: MC_DigitalCamSwitch_BkPlcMc objects.
+    #[serde(default)]
+    pub digital_cam_switches: Vec<DigitalCamSwitchSection>,
     /// `[devices.<name>]`: the devices of the nodes' process images.
     #[serde(default)]
     pub devices: BTreeMap<String, DeviceSection>,
@@ -631,6 +634,60 @@ pub struct TrackCamSection {
     /// `OffPosition` (distance tracks).
     pub off: Option<f64>,
     /// `Duration` (s, time tracks).
+    pub duration: Option<f64>,
+}
+
+/// `[[digital_cam_switches]]`: the switches and tracks of an MC_DigitalCamSwitch_BkPlcMc of
+/// the Beckhoff hydraulic library, on the actual position of an axis.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DigitalCamSwitchSection {
+    /// Name (unique among all objects).
+    pub name: String,
+    /// The axis whose actual position and velocity switch it.
+    pub axis: String,
+    /// `TrackOptions`: track `n` is entry `n - 1` (up to 32), driving bit `n - 1`.
+    #[serde(default)]
+    pub tracks: Vec<DcsTrackSection>,
+    /// `Switches`.
+    #[serde(default)]
+    pub switches: Vec<DcsSwitchSection>,
+}
+
+/// One track of a digital cam switch (`MC_TRACK_REFTYPE_BkPlcMc`) and the signal it drives.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DcsTrackSection {
+    /// `OnCompensation` (s): positive delays, negative gives early.
+    #[serde(default)]
+    pub on_compensation: f64,
+    /// `OffCompensation` (s).
+    #[serde(default)]
+    pub off_compensation: f64,
+    /// `Hysteresis` (position units).
+    #[serde(default)]
+    pub hysteresis: f64,
+    /// The digital output signal the track's bit drives (`[signals.<name>]`), if any.
+    pub output: Option<String>,
+}
+
+/// One switch of a digital cam switch (`MC_CAMSWITCH_REFTYPE_BkPlcMc`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DcsSwitchSection {
+    /// `TrackNumber` (1-based).
+    pub track_number: i64,
+    /// `FirstOnPosition`.
+    pub first_on_position: f64,
+    /// `LastOnPosition` (position switches).
+    pub last_on_position: Option<f64>,
+    /// `AxisDirection`: 0 both (default), 1 positive, 2 negative.
+    #[serde(default)]
+    pub axis_direction: i64,
+    /// `CamSwitchMode`: 0 position (default), 1 time.
+    #[serde(default)]
+    pub cam_switch_mode: i64,
+    /// `Duration` (s, time switches).
     pub duration: Option<f64>,
 }
 

@@ -19,6 +19,8 @@
 //! `MC_CamTrack` (`enable`, `mode`, `invert_output`), `MC_MeasuringInput` and
 //! `MC_MeasuringInputCyclic` (`mode`, `measuring_range`, `start_position`, `end_position`),
 //! `MC_AbortMeasuringInput`, and `InputEdge` (`rising`): an input edge at the entry's `t`.
+//! A digital cam switch (`[[digital_cam_switches]]`) takes `MC_DigitalCamSwitch_BkPlcMc`
+//! (`enable`, default `true`; `enable_mask`, default `0xFFFFFFFF`: bit `n - 1` is track `n`).
 //! A simulated drive (`[devices.<name>]`) takes `DriveFault` (`code`): a fault with that CiA 402
 //! error code (0x603F, e.g. `code = 0x2310`) from the entry's `t`, or with `code = 0` its cause
 //! removed (a fault reset then succeeds).
@@ -44,6 +46,8 @@ pub struct ObjectNames<'a> {
     pub cam_tracks: Vec<&'a str>,
     /// `[[measuring_inputs]]`.
     pub measuring_inputs: Vec<&'a str>,
+    /// `[[digital_cam_switches]]`.
+    pub digital_cam_switches: Vec<&'a str>,
     /// `[devices.<name>]`.
     pub devices: Vec<&'a str>,
     /// The input signals (`[signals.<name>]` on a `sim_digital_input`, `sim_analog_input` or
@@ -118,6 +122,11 @@ pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, C
             .iter()
             .map(|c| c.name.as_str())
             .collect(),
+        digital_cam_switches: cell
+            .digital_cam_switches
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect(),
         devices: cell.devices.iter().map(|d| d.name.as_str()).collect(),
         input_signals: cell
             .signals
@@ -141,7 +150,7 @@ pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, C
 
 /// The instructions of output cams, cam tracks, measuring inputs and simulated devices: name,
 /// the kind of object it addresses (0 output cam, 1 cam track, 2 measuring input, 3 device,
-/// 4 input signal) and parameters with defaults.
+/// 4 input signal, 5 digital cam switch) and parameters with defaults.
 type ObjectInstruction = (&'static str, u8, &'static [(&'static str, Value)]);
 
 const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
@@ -193,6 +202,15 @@ const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
         "SetInput",
         4,
         &[("value", Value::Bool(true)), ("pulse", Value::Num(0.0))],
+    ),
+    (
+        "MC_DigitalCamSwitch_BkPlcMc",
+        5,
+        &[
+            ("enable", Value::Bool(true)),
+            // Inferred: every track by default (the PLC's DWORD input starts at 0).
+            ("enable_mask", Value::Num(4_294_967_295.0)),
+        ],
     ),
 ];
 
@@ -268,6 +286,13 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
                 .filter(|p| (0.0..=3600.0).contains(p))
                 .and_then(seconds_to_ns)
                 .ok_or(wrong("pulse", Expected::Number))?,
+        },
+        "MC_DigitalCamSwitch_BkPlcMc" => Action::DigitalCamSwitch {
+            enable: b(0),
+            enable_mask: Some(x(1))
+                .filter(|m| m.fract() == 0.0 && (0.0..=4_294_967_295.0).contains(m))
+                .map(|m| m as u32)
+                .ok_or(wrong("enable_mask", Expected::Integer))?,
         },
         _ => Action::InputEdge { rising: b(0) },
     })
@@ -401,6 +426,7 @@ fn object_instruction<'t>(
         1 => (&objects.cam_tracks, "cam track"),
         2 => (&objects.measuring_inputs, "measuring input"),
         3 => (&objects.devices, "device"),
+        5 => (&objects.digital_cam_switches, "digital cam switch"),
         _ => (&objects.input_signals, "input signal"),
     };
     if !list.contains(&target) {

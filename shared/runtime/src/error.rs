@@ -32,6 +32,13 @@ pub enum ExecError {
         /// The engine's reason.
         reason: tandem_motion::objects::measuring::MeasuringConfigError,
     },
+    /// A digital cam switch whose switch or track set the engine refuses.
+    CamSwitch {
+        /// Its name.
+        name: String,
+        /// The engine's reason.
+        reason: tandem_motion::objects::digital_cam_switch::DcsError,
+    },
     /// A simulated device whose parameters the model refuses.
     Device {
         /// Its name.
@@ -56,6 +63,9 @@ impl fmt::Display for ExecError {
             ExecError::Axis { name, reason } => write!(f, "axis {name}: {reason}"),
             ExecError::Encoder { name, reason } => write!(f, "encoder {name}: {reason}"),
             ExecError::Object { kind, name, reason } => write!(f, "{kind} {name}: {reason}"),
+            ExecError::CamSwitch { name, reason } => {
+                write!(f, "digital cam switch {name}: {reason}")
+            }
             ExecError::Device { name, reason } => write!(f, "device {name}: {reason}"),
             ExecError::EnableTimeout(e) => write!(f, "{e}"),
             ExecError::AnalogDrive { name, reason } => write!(f, "device {name}: {reason}"),

@@ -355,7 +355,8 @@ fn axes_with_objects(cell: &Cell, owned: &Owned) -> (Vec<bool>, Vec<bool>) {
             owned.axis(i)
                 && (cell.output_cams.iter().any(|c| c.axis == i)
                     || cell.cam_tracks.iter().any(|c| c.axis == i)
-                    || cell.measuring_inputs.iter().any(|c| c.axis == i))
+                    || cell.measuring_inputs.iter().any(|c| c.axis == i)
+                    || cell.digital_cam_switches.iter().any(|c| c.axis == i))
         })
         .collect();
     let needs_motion: Vec<bool> = cell
@@ -815,7 +816,8 @@ impl<'c> Executive<'c> {
             | Action::MeasuringInput { .. }
             | Action::AbortMeasuringInput
             | Action::ResetObject { .. }
-            | Action::InputEdge { .. } => {
+            | Action::InputEdge { .. }
+            | Action::DigitalCamSwitch { .. } => {
                 if !cell.object_axis(target).is_some_and(|a| self.owned.axis(a)) {
                     return Err(ErrorId::IllegalObject);
                 }

@@ -1,11 +1,13 @@
-//! Output cams, cam tracks and measuring inputs of an executive: stepped after their axis with
-//! the motion of its last cycle.
+//! Output cams, cam tracks, measuring inputs and digital cam switches of an executive: stepped
+//! after their axis with the motion of its last cycle.
 
 use crate::error::ExecError;
 use crate::notes::{keep, seconds, Describe, IoNote, Secs, NOTES};
 use crate::outputs::ObjectEdge;
 use std::io::{self, Write};
-use tandem_config::{AxisIndex, CamTrackEntry, Cell, MeasuringInputEntry, OutputCamEntry};
+use tandem_config::{
+    AxisIndex, CamTrackEntry, Cell, DigitalCamSwitchEntry, MeasuringInputEntry, OutputCamEntry,
+};
 use tandem_motion::catalog::alarm::AlarmInstance;
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::kinematics::cycle_motion::AxisMotion;
@@ -13,6 +15,7 @@ use tandem_motion::kinematics::profile::State;
 use tandem_motion::objects::action::Action;
 use tandem_motion::objects::axis::AxisStatus;
 use tandem_motion::objects::cam_track::{CamTrack, CamTrackMode, McCamTrack};
+use tandem_motion::objects::digital_cam_switch::{DigitalCamSwitch, McDigitalCamSwitch};
 use tandem_motion::objects::job::{JobEventKind, JobId};
 use tandem_motion::objects::measuring::{
     MeasuringInput, MeasuringJobKind, MeasuringState, MeasuringWindow,
@@ -42,6 +45,10 @@ pub const MEASURING_INPUT_COLUMNS: &[&str] = &[
     "counter2",
     "lost_edge_counter1",
 ];
+
+/// The per-digital-cam-switch columns of the trace, in order (prefixed with `<name>.`):
+/// `OutputBits` (bit `n - 1` is track `n`) and `InOperation`.
+pub const DIGITAL_CAM_SWITCH_COLUMNS: &[&str] = &["outputs", "in_operation"];
 
 /// The FB instance the script's calls come from.
 const INSTANCE: u32 = 1;
@@ -151,6 +158,13 @@ pub(crate) struct SimTrack {
     ahead: Option<SwitchingAhead>,
 }
 
+/// An MC_DigitalCamSwitch_BkPlcMc of the executive and its output bits of the last cycle.
+#[derive(Debug)]
+pub(crate) struct SimSwitch {
+    dcs: DigitalCamSwitch,
+    bits: u32,
+}
+
 /// The motion an object on `position_type` steps with: the cycle's, or, for an object that
 /// drives an output, the motion predicted over its look-ahead (its edges are then the times
 /// the output switches; see [`crate::outputs`]).
@@ -192,12 +206,13 @@ pub(crate) struct StepOutput {
     alarms: Vec<Option<AlarmInstance>>,
 }
 
-/// The output cams, cam tracks and measuring inputs of an executive.
+/// The output cams, cam tracks, measuring inputs and digital cam switches of an executive.
 #[derive(Debug)]
 pub(crate) struct Objects {
     cams: Vec<SimCam>,
     tracks: Vec<SimTrack>,
     inputs: Vec<SimInput>,
+    switches: Vec<SimSwitch>,
     /// Per axis: an MC_Home job was started and has not ended.
     pub(crate) homing: Vec<bool>,
     row: String,
@@ -500,6 +515,65 @@ impl CycleObject for SimInput {
     }
 }
 
+impl CycleObject for SimSwitch {
+    type Entry = DigitalCamSwitchEntry;
+    fn axis(e: &DigitalCamSwitchEntry) -> AxisIndex {
+        e.axis
+    }
+    fn name(e: &DigitalCamSwitchEntry) -> &str {
+        &e.name
+    }
+    /// One evaluation on the actual position and velocity at the end of the cycle. A changed
+    /// bit is an edge of its track (`Edge::cam` = track - 1) at the next boundary, `t + T`:
+    /// the library's outputs are written by the process image after the cycle that computed
+    /// them (no look-ahead, no exact crossing time: its resolution is the cycle).
+    fn step(
+        &mut self,
+        _: &DigitalCamSwitchEntry,
+        motion: &CycleMotion,
+        _: &[Option<CycleMotion>],
+        edges: &mut CamEdges,
+    ) -> i64 {
+        edges.clear();
+        let m = &motion.actual;
+        let dt_ns = m.t1_ns - m.t0_ns;
+        let bits = self.dcs.step(m.end.p, m.end.v, dt_ns as f64 * 1e-9);
+        let changed = bits ^ self.bits;
+        self.bits = bits;
+        for track in 0..32u8 {
+            if changed & (1 << track) != 0 {
+                edges.push(tandem_motion::objects::output_cam::Edge {
+                    time_ns: m.t1_ns.saturating_add(dt_ns),
+                    on: bits & (1 << track) != 0,
+                    cam: track,
+                });
+            }
+        }
+        m.t1_ns
+    }
+    fn alarm(&self) -> Option<AlarmInstance> {
+        None
+    }
+    fn report(
+        &mut self,
+        e: &DigitalCamSwitchEntry,
+        r: &mut Report<'_>,
+        log: &mut impl Write,
+    ) -> io::Result<()> {
+        for edge in r.edges.as_slice() {
+            writeln!(
+                log,
+                "t={} {} track {} {}",
+                Secs(edge.time_ns),
+                e.name,
+                edge.cam + 1,
+                on_off(edge.on)
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// The step of the objects of one axis: the cell, the axis and every axis' motion of its
 /// last cycle.
 struct AxisCycle<'a> {
@@ -609,17 +683,29 @@ impl Objects {
                 logged: (0, 0, 0, 0, false),
             });
         }
+        let mut switches = Vec::new();
+        for c in &cell.digital_cam_switches {
+            let dcs = DigitalCamSwitch::new(&c.switches, &c.tracks).map_err(|reason| {
+                ExecError::CamSwitch {
+                    name: c.name.clone(),
+                    reason,
+                }
+            })?;
+            switches.push(SimSwitch { dcs, bits: 0 });
+        }
         Ok(Self {
             cams,
             tracks,
             inputs,
+            switches,
             homing: vec![false; cell.axes.len()],
             row: String::new(),
             out: StepOutput {
                 edges: CamEdges::default(),
                 output_edges: Vec::with_capacity(
                     (cell.output_cams.len() + cell.cam_tracks.len())
-                        * tandem_motion::objects::output_cam::EDGE_CAPACITY,
+                        * tandem_motion::objects::output_cam::EDGE_CAPACITY
+                        + cell.digital_cam_switches.len() * 32,
                 ),
                 corrections: Vec::with_capacity(cell.measuring_inputs.len()),
                 notes: Vec::with_capacity(NOTES),
@@ -660,10 +746,16 @@ impl Objects {
                 write!(out, ",{}.{col}", c.name)?;
             }
         }
+        for c in &cell.digital_cam_switches {
+            for col in DIGITAL_CAM_SWITCH_COLUMNS {
+                write!(out, ",{}.{col}", c.name)?;
+            }
+        }
         Ok(())
     }
 
-    /// Applies a script action addressed to an output cam, cam track or measuring input.
+    /// Applies a script action addressed to an output cam, cam track, measuring input or
+    /// digital cam switch.
     /// `Err` is an ErrorID to log as a rejection.
     pub(crate) fn apply(
         &mut self,
@@ -721,6 +813,21 @@ impl Objects {
                 mode,
                 window,
             } => self.measuring_input(cell, target, cyclic, mode, window),
+            Action::DigitalCamSwitch {
+                enable,
+                enable_mask,
+            } => {
+                let i = cell
+                    .digital_cam_switch(target)
+                    .ok_or(ErrorId::IllegalObject)?;
+                let s = self.switches.get_mut(i).ok_or(ErrorId::IllegalObject)?;
+                s.dcs.call(McDigitalCamSwitch {
+                    enable,
+                    enable_mask,
+                });
+                // Enable FALSE clears the outputs at once: their edges go with the next step.
+                Ok(())
+            }
             Action::AbortMeasuringInput => {
                 let i = cell.measuring_input(target).ok_or(ErrorId::IllegalObject)?;
                 self.inputs[i].input.abort_measuring_input()?;
@@ -818,6 +925,15 @@ impl Objects {
             first,
             out,
             log,
+        )?;
+        let first_switch = first + cell.measuring_inputs.len();
+        step_kind(
+            &c,
+            &mut self.switches,
+            &cell.digital_cam_switches,
+            first_switch,
+            out,
+            log,
         )
     }
 
@@ -867,6 +983,11 @@ impl Objects {
                 s.counter2,
                 s.lost_edge_counter1
             );
+        }
+        for c in &self.switches {
+            let s = c.dcs.status();
+            // Writing into a String cannot fail.
+            let _ = write!(r, ",{},{}", s.output_bits, u8::from(s.in_operation));
         }
         &self.row
     }

@@ -30,6 +30,11 @@
 //! held back to its predecessor's time by the object) switches at once at the next boundary,
 //! counted as late, never lost.
 //!
+//! A digital cam switch (the hydraulic library's MC_DigitalCamSwitch_BkPlcMc) drives one signal
+//! per track (`tracks[n - 1].output`) without look-ahead: the library evaluates its cams once
+//! per cycle, so a track bit computed in the step at `t` is an edge due at `t + T`, written at
+//! that boundary.
+//!
 //! # The order within one step at `t`, after the objects stepped
 //!
 //! 1. Every device whose node's cycle falls on `t` reaches the boundary `t`:
@@ -263,6 +268,10 @@ pub(crate) struct Outputs {
     of_device: Vec<Option<usize>>,
     /// Per object (output cams, then cam tracks): its terminal and channel.
     bindings: Vec<Option<(usize, u8)>>,
+    /// The object number of the first digital cam switch (after the measuring inputs).
+    first_switch: usize,
+    /// Per digital cam switch, per track: its terminal and channel.
+    switch_bindings: Vec<[Option<(usize, u8)>; 32]>,
     /// The switches since the last drain.
     switches: Vec<OutputSwitch>,
 }
@@ -278,7 +287,8 @@ const ETHERCAT_DIO_OUTPUTS: tandem_config::DigitalOutputParams =
 /// An output edge of an output cam or cam track, for the output stage.
 #[derive(Copy, Clone, Debug)]
 pub(crate) struct ObjectEdge {
-    /// The object, numbered as [`crate::notes::IoNote::object`] (output cams, then cam tracks).
+    /// The object, numbered as [`crate::notes::IoNote::object`] (output cams, then cam tracks,
+    /// measuring inputs, digital cam switches; a digital cam switch's track is `edge.cam + 1`).
     pub(crate) object: usize,
     /// The edge, with its exact time.
     pub(crate) edge: tandem_motion::objects::output_cam::Edge,
@@ -373,6 +383,11 @@ impl Outputs {
                 .iter()
                 .map(|c| c.output)
                 .chain(cell.cam_tracks.iter().map(|c| c.output))
+                .chain(
+                    cell.digital_cam_switches
+                        .iter()
+                        .flat_map(|c| c.outputs.iter().copied()),
+                )
                 .flatten()
                 .filter(|s| cell.signals.get(s.0).is_some_and(|s| s.device.0 == i))
                 .count();
@@ -405,10 +420,25 @@ impl Outputs {
             .map(|c| bind(c.output))
             .chain(cell.cam_tracks.iter().map(|c| bind(c.output)))
             .collect();
+        let switch_bindings = cell
+            .digital_cam_switches
+            .iter()
+            .map(|c| {
+                let mut b = [None; 32];
+                for (slot, s) in b.iter_mut().zip(&c.outputs) {
+                    *slot = bind(*s);
+                }
+                b
+            })
+            .collect();
         Self {
             terminals,
             of_device,
             bindings,
+            first_switch: cell.output_cams.len()
+                + cell.cam_tracks.len()
+                + cell.measuring_inputs.len(),
+            switch_bindings,
             switches: Vec::with_capacity(SWITCHES),
         }
     }
@@ -423,7 +453,17 @@ impl Outputs {
             }
         }
         for e in edges.iter() {
-            let Some(Some((k, channel))) = self.bindings.get(e.object).copied() else {
+            let bound = match e.object.checked_sub(self.first_switch) {
+                // A digital cam switch: the edge's `cam` is its track - 1.
+                Some(s) => self
+                    .switch_bindings
+                    .get(s)
+                    .and_then(|b| b.get(usize::from(e.edge.cam)))
+                    .copied()
+                    .flatten(),
+                None => self.bindings.get(e.object).copied().flatten(),
+            };
+            let Some((k, channel)) = bound else {
                 continue;
             };
             if let Some(term) = self.terminals.get_mut(k) {

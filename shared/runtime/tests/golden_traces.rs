@@ -32,6 +32,7 @@ const EXAMPLES: &[&str] = &[
     "hydraulic-press",
     "hydraulic-flying-gear",
     "hydraulic-gantry",
+    "hydraulic-cam-switch",
 ];
 
 fn root() -> PathBuf {

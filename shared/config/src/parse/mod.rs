@@ -184,6 +184,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         &mut objects.output_cams,
         &mut objects.cam_tracks,
     )?;
+    signal::switch_outputs(cx, &raw, &bindings, &mut objects.digital_cam_switches)?;
     let inputs = signal::inputs(cx, &raw, &bindings, &objects.measuring_inputs)?;
     signal::activate_limits(&raw, &inputs, &mut axes);
     let security = security::security(cx, &raw, dir)?;
@@ -222,6 +223,7 @@ fn parse_in(file: &str, src: &str, dir: Option<&Path>) -> Result<Cell, ConfigErr
         output_cams: objects.output_cams,
         cam_tracks: objects.cam_tracks,
         measuring_inputs: objects.measuring_inputs,
+        digital_cam_switches: objects.digital_cam_switches,
         devices,
         signals,
         inputs,

@@ -47,6 +47,11 @@ pub(super) fn check(cx: Ctx<'_>, raw: &CellFile) -> Result<(), ConfigError> {
             "measuring input",
             raw.measuring_inputs.iter().map(|o| &o.name).collect(),
         ),
+        (
+            "digital_cam_switches",
+            "digital cam switch",
+            raw.digital_cam_switches.iter().map(|o| &o.name).collect(),
+        ),
     ];
     for (array, what, names) in arrays {
         if let Some((i, n)) = names.into_iter().enumerate().find(|(_, n)| !plain_name(n)) {

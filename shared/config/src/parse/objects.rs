@@ -3,16 +3,20 @@
 
 use super::{pick, Ctx, FieldError};
 use crate::cell::{
-    AxisEntry, AxisIndex, CamTrackEntry, MeasuringInputEntry, Node, OutputCamEntry, Registration,
-    SensorEntry,
+    AxisEntry, AxisIndex, CamTrackEntry, DigitalCamSwitchEntry, MeasuringInputEntry, Node,
+    OutputCamEntry, Registration, SensorEntry,
 };
 use crate::error::{ConfigError, Problem};
 use crate::schema::{
-    CamTrackSection, CellFile, MeasuringInputSection, OutputCamSection, RegistrationSection,
-    SensorSection, TrackCamSection,
+    CamTrackSection, CellFile, DcsSwitchSection, DigitalCamSwitchSection, MeasuringInputSection,
+    OutputCamSection, RegistrationSection, SensorSection, TrackCamSection,
 };
+use tandem_motion::catalog::hyd_error::HydErrorCode;
 use tandem_motion::objects::cam_track::{
     CamTrack, CamTrackConfig, CamTrackData, CamTrackType, TrackCam, TrackOutputInterface, MAX_CAMS,
+};
+use tandem_motion::objects::digital_cam_switch::{
+    CamSwitch, CamSwitchMode, DcsError, DcsField, DigitalCamSwitch, SwitchDirection, TrackOptions,
 };
 use tandem_motion::objects::measuring::{MeasuringInput, MeasuringInputConfig, MeasuringRoute};
 use tandem_motion::objects::output_cam::{
@@ -28,6 +32,8 @@ pub(super) struct Objects {
     pub(super) cam_tracks: Vec<CamTrackEntry>,
     /// `[[measuring_inputs]]`.
     pub(super) measuring_inputs: Vec<MeasuringInputEntry>,
+    /// `[[digital_cam_switches]]`.
+    pub(super) digital_cam_switches: Vec<DigitalCamSwitchEntry>,
 }
 
 /// What the object sections are checked against: the axes and the names already used.
@@ -103,6 +109,7 @@ pub(super) fn objects(
         output_cams: Vec::new(),
         cam_tracks: Vec::new(),
         measuring_inputs: Vec::new(),
+        digital_cam_switches: Vec::new(),
     };
     for (i, c) in raw.output_cams.iter().enumerate() {
         out.output_cams.push(output_cam(&mut scope, i, c)?);
@@ -113,6 +120,10 @@ pub(super) fn objects(
     for (i, m) in raw.measuring_inputs.iter().enumerate() {
         out.measuring_inputs
             .push(measuring_input(&mut scope, nodes, i, m)?);
+    }
+    for (i, c) in raw.digital_cam_switches.iter().enumerate() {
+        out.digital_cam_switches
+            .push(digital_cam_switch(&mut scope, i, c)?);
     }
     Ok(out)
 }
@@ -464,5 +475,98 @@ fn registration(
         axis,
         target: r.target,
         gain: r.gain,
+    })
+}
+
+/// Switch `s` of a digital cam switch as the engine takes it; a code the engine does not know
+/// or a missing key is refused as the field it belongs to.
+fn cam_switch(j: usize, s: &DcsSwitchSection) -> Result<CamSwitch, DcsError> {
+    let refuse = |field, code| DcsError {
+        index: j,
+        field,
+        code,
+    };
+    let code = |x: i64| i32::try_from(x).unwrap_or(i32::MAX);
+    let axis_direction = SwitchDirection::from_code(code(s.axis_direction))
+        .map_err(|c| refuse(DcsField::AxisDirection, c))?;
+    let cam_switch_mode = CamSwitchMode::from_code(code(s.cam_switch_mode))
+        .map_err(|c| refuse(DcsField::CamSwitchMode, c))?;
+    let (last_on_position, duration) = match cam_switch_mode {
+        CamSwitchMode::Position => (
+            s.last_on_position.ok_or(refuse(
+                DcsField::LastOnPosition,
+                HydErrorCode::ILLEGAL_VALUE,
+            ))?,
+            s.duration.unwrap_or(0.0),
+        ),
+        CamSwitchMode::Time => (
+            s.last_on_position.unwrap_or(s.first_on_position),
+            s.duration
+                .ok_or(refuse(DcsField::Duration, HydErrorCode::ILLEGAL_VALUE))?,
+        ),
+    };
+    Ok(CamSwitch {
+        track_number: code(s.track_number),
+        first_on_position: s.first_on_position,
+        last_on_position,
+        axis_direction,
+        cam_switch_mode,
+        duration,
+    })
+}
+
+/// Entry `i` of `[[digital_cam_switches]]`, its switches and tracks checked by the engine; a
+/// refusal names `tracks[j].<key>` or `switches[j].<key>`.
+fn digital_cam_switch(
+    s: &mut Scope<'_>,
+    i: usize,
+    c: &DigitalCamSwitchSection,
+) -> Result<DigitalCamSwitchEntry, ConfigError> {
+    let a = "digital_cam_switches";
+    s.unique(a, i, &c.name)?;
+    let axis = s.axis_of(a, i, "axis", &c.axis)?;
+    let tracks: Vec<TrackOptions> = c
+        .tracks
+        .iter()
+        .map(|t| TrackOptions {
+            on_compensation: t.on_compensation,
+            off_compensation: t.off_compensation,
+            hysteresis: t.hysteresis,
+        })
+        .collect();
+    let refused = |e: DcsError| {
+        let (list, key) = match e.field {
+            DcsField::SwitchCount => ("switches", None),
+            DcsField::TrackCount => ("tracks", None),
+            DcsField::TrackNumber => ("switches", Some("track_number")),
+            DcsField::FirstOnPosition => ("switches", Some("first_on_position")),
+            DcsField::LastOnPosition => ("switches", Some("last_on_position")),
+            DcsField::AxisDirection => ("switches", Some("axis_direction")),
+            DcsField::CamSwitchMode => ("switches", Some("cam_switch_mode")),
+            DcsField::Duration => ("switches", Some("duration")),
+            DcsField::OnCompensation => ("tracks", Some("on_compensation")),
+            DcsField::OffCompensation => ("tracks", Some("off_compensation")),
+            DcsField::Hysteresis => ("tracks", Some("hysteresis")),
+        };
+        let mut err = s.cx.in_array(a, i, list, Problem::CamSwitch(e));
+        if let Some(key) = key {
+            err.key = format!("{a}[{i}].{list}[{}].{key}", e.index);
+        }
+        err
+    };
+    let switches = c
+        .switches
+        .iter()
+        .enumerate()
+        .map(|(j, x)| cam_switch(j, x))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(refused)?;
+    DigitalCamSwitch::new(&switches, &tracks).map_err(refused)?;
+    Ok(DigitalCamSwitchEntry {
+        name: c.name.clone(),
+        axis,
+        switches,
+        outputs: vec![None; tracks.len()],
+        tracks,
     })
 }

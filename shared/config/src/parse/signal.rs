@@ -319,6 +319,57 @@ pub(super) fn outputs(
     Ok(())
 }
 
+/// The `output` of every track of every digital cam switch (`tracks[j].output`): a signal of
+/// the object's node that no other object drives (named `<object>.track<n>` as its driver).
+pub(super) fn switch_outputs(
+    cx: Ctx<'_>,
+    raw: &CellFile,
+    b: &Bindings<'_>,
+    switches: &mut [crate::cell::DigitalCamSwitchEntry],
+) -> Result<(), ConfigError> {
+    let mut by: Vec<Option<String>> = vec![None; b.signals.len()];
+    // The signals output cams and cam tracks drive (checked before): not a second time.
+    let driven = raw
+        .output_cams
+        .iter()
+        .filter_map(|c| c.output.as_ref().map(|o| (o, &c.name)))
+        .chain(
+            raw.cam_tracks
+                .iter()
+                .filter_map(|c| c.output.as_ref().map(|o| (o, &c.name))),
+        );
+    for (o, name) in driven {
+        if let Some(slot) = b
+            .signals
+            .iter()
+            .position(|s| &s.name == o)
+            .and_then(|k| by.get_mut(k))
+        {
+            *slot = Some(name.clone());
+        }
+    }
+    let a = "digital_cam_switches";
+    for (i, (entry, s)) in switches
+        .iter_mut()
+        .zip(&raw.digital_cam_switches)
+        .enumerate()
+    {
+        let node = b.node_of(entry.axis);
+        for (j, (slot, t)) in entry.outputs.iter_mut().zip(&s.tracks).enumerate() {
+            let Some(name) = &t.output else {
+                continue;
+            };
+            let object = format!("{}.track{}", entry.name, j + 1);
+            let bound = b.bind(cx, (a, i), (&object, node), name, &mut by);
+            *slot = Some(bound.map_err(|mut e| {
+                e.key = format!("{a}[{i}].tracks[{j}].output");
+                e
+            })?);
+        }
+    }
+    Ok(())
+}
+
 /// Where an input signal is bound, for [`Bindings::input`].
 struct InputUse<'k> {
     /// The node the consumer runs on.

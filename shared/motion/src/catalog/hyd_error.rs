@@ -297,6 +297,12 @@ pub const CODES: &[(u32, &str, &str)] = &[
 impl HydErrorCode {
     /// `dwTcHydAdsErrIllegalValue`.
     pub const ILLEGAL_VALUE: Self = Self(0x0706);
+    /// `dwTcHydAdsErrInvalidIdxOffset`: an index out of bounds.
+    pub const INVALID_IDX_OFFSET: Self = Self(0x0703);
+    /// `dwTcHydErrCdIllegalOutputNumber`.
+    pub const ILLEGAL_OUTPUT_NUMBER: Self = Self(0x4104);
+    /// `dwTcHydErrCdNotSupport`.
+    pub const NOT_SUPPORT: Self = Self(0x4107);
     /// `dwTcHydAdsErrSyntax`.
     pub const SYNTAX: Self = Self(0x070D);
     /// `dwTcHydErrCdAcc`.

@@ -48,6 +48,14 @@ pub enum Action {
         /// `InvertOutput`.
         invert_output: bool,
     },
+    /// `MC_DigitalCamSwitch_BkPlcMc` on the digital cam switch named by the entry
+    /// (level-type: the inputs hold until a later entry changes them).
+    DigitalCamSwitch {
+        /// `Enable`.
+        enable: bool,
+        /// `EnableMask`: bit `n - 1` lets track `n` through.
+        enable_mask: u32,
+    },
     /// `MC_MeasuringInput` (one-time) or `MC_MeasuringInputCyclic` on the measuring input
     /// named by the entry.
     MeasuringInput {

@@ -1,12 +1,14 @@
 //! The technology objects, each stepped once per cycle: the axis with its jobs and synchronous
 //! operation ([`axis`]), the external encoder ([`encoder`]), leading values for followers
-//! ([`leading`]), output cams ([`output_cam`]), cam tracks ([`cam_track`]) and measuring inputs
+//! ([`leading`]), output cams ([`output_cam`]), cam tracks ([`cam_track`]), the hydraulic library's
+//! digital cam switch ([`digital_cam_switch`]) and measuring inputs
 //! ([`measuring`]); the job bookkeeping they share ([`job`]) and the command type the runtime
 //! applies to them ([`action`]).
 
 pub mod action;
 pub mod axis;
 pub mod cam_track;
+pub mod digital_cam_switch;
 pub mod encoder;
 pub mod job;
 pub mod leading;
