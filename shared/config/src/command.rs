@@ -1021,46 +1021,15 @@ fn buffered_move(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
     }))
 }
 
-/// The Beckhoff hydraulic library's single-axis instructions (`*_BkPlcMc`); `None` for another.
+/// The Beckhoff hydraulic library's single-axis instructions (`*_BkPlcMc`: power, stops, jog,
+/// homing, positions; the controllers through [`hydraulic_control_command`]); `None` for
+/// another.
 fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
     Ok(Some(match a.spec.name {
         "MC_Power_BkPlcMc" => Command::HydPower {
             enable: a.flag("enable")?,
             enable_positive: a.flag("enable_positive")?,
             enable_negative: a.flag("enable_negative")?,
-        },
-        "MC_AxCtrlPressure_BkPlcMc" => Command::PressureControl {
-            enable: a.flag("enable")?,
-            set_value: a.num("set_value")?,
-            kp: a.num("kp")?,
-            tn: a.num("tn")?,
-            preset: a.num("preset")?,
-            windup_limit: a.num("windup_limit")?,
-            force: a.flag("force")?,
-        },
-        "MC_AxCtrlAutoZero_BkPlcMc" => Command::AutoZero {
-            enable: a.flag("enable")?,
-            params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {
-                enable_on_moving: a.flag("enable_on_moving")?,
-                offset_limit: a.num("offset_limit")?,
-                tn: a.num("tn")?,
-                threshold: a.num("threshold")?,
-                filter: a.num("filter")?,
-            },
-        },
-        "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc" => Command::SlowDownOnPressure {
-            enable: a.flag("enable")?,
-            params: tandem_motion::hydraulic::slow_down::SlowDownParams {
-                enable_relief: a.flag("enable_relief")?,
-                set_point: a.num("set_point")?,
-                kp: a.num("kp")?,
-                feed_velocity: a.num("feed_velocity")?,
-                reading: if a.flag("force")? {
-                    tandem_motion::hydraulic::pressure::PressureReading::Force
-                } else {
-                    tandem_motion::hydraulic::pressure::PressureReading::Pressure
-                },
-            },
         },
         "MC_EmergencyStop_BkPlcMc" => Command::EmergencyStop {
             execute: a.flag("execute")?,
@@ -1115,6 +1084,50 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
             )?,
             calibration_cam: a.flag("calibration_cam")?,
         }),
+        "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
+            reference_flag: a.flag("reference_flag")?,
+        },
+        _ => return hydraulic_control_command(a),
+    }))
+}
+
+/// The Beckhoff hydraulic library's controllers and set-value hooks (pressure, AutoZero,
+/// slow-down, direct output, external set values, follow-up, offset latch); `None` for another.
+fn hydraulic_control_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
+    Ok(Some(match a.spec.name {
+        "MC_AxCtrlPressure_BkPlcMc" => Command::PressureControl {
+            enable: a.flag("enable")?,
+            set_value: a.num("set_value")?,
+            kp: a.num("kp")?,
+            tn: a.num("tn")?,
+            preset: a.num("preset")?,
+            windup_limit: a.num("windup_limit")?,
+            force: a.flag("force")?,
+        },
+        "MC_AxCtrlAutoZero_BkPlcMc" => Command::AutoZero {
+            enable: a.flag("enable")?,
+            params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {
+                enable_on_moving: a.flag("enable_on_moving")?,
+                offset_limit: a.num("offset_limit")?,
+                tn: a.num("tn")?,
+                threshold: a.num("threshold")?,
+                filter: a.num("filter")?,
+            },
+        },
+        "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc" => Command::SlowDownOnPressure {
+            enable: a.flag("enable")?,
+            params: tandem_motion::hydraulic::slow_down::SlowDownParams {
+                enable_relief: a.flag("enable_relief")?,
+                set_point: a.num("set_point")?,
+                kp: a.num("kp")?,
+                feed_velocity: a.num("feed_velocity")?,
+                reading: if a.flag("force")? {
+                    tandem_motion::hydraulic::pressure::PressureReading::Force
+                } else {
+                    tandem_motion::hydraulic::pressure::PressureReading::Pressure
+                },
+            },
+        },
         "MC_AxRtSetDirectOutput_BkPlcMc" => Command::SetDirectOutput {
             enable: a.flag("enable")?,
             out_value: a.num("out_value")?,
@@ -1132,9 +1145,6 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
         "MC_AxUtiOffsetLatch_BkPlcMc" => Command::OffsetLatch {
             execute: a.flag("execute")?,
             offset_limit: a.num("offset_limit")?,
-        },
-        "MC_SetReferenceFlag_BkPlcMc" => Command::SetReferenceFlag {
-            reference_flag: a.flag("reference_flag")?,
         },
         _ => return Ok(None),
     }))
