@@ -187,9 +187,18 @@ fn the_output_stage_steps_without_allocating() {
 /// Runs bundled example `name` (`config/<name>.toml` with its script) through the executive,
 /// counting the allocations of every step and drain: the executive after the run and the count.
 fn run_counting<'c>(cell: &'c tandem_config::Cell, name: &str) -> (Executive<'c>, u64) {
+    run_counting_with(cell, name, "")
+}
+
+/// [`run_counting`] with `extra` appended to the bundled script (more `[[at]]` entries).
+fn run_counting_with<'c>(
+    cell: &'c tandem_config::Cell,
+    name: &str,
+    extra: &str,
+) -> (Executive<'c>, u64) {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let file = format!("{name}-script.toml");
-    let src = std::fs::read_to_string(root.join("config").join(&file)).unwrap();
+    let src = std::fs::read_to_string(root.join("config").join(&file)).unwrap() + extra;
     let script = tandem_config::script::parse_cell(&file, &src, cell).unwrap();
     let mut exec = Executive::new(cell, None).unwrap();
     let mut log = std::io::sink();
@@ -259,6 +268,61 @@ fn the_force_control_stages_step_without_allocating() {
     let st = exec.status()[0];
     assert_eq!((st.state.name(), st.position), ("Standstill", 300.0));
     assert!(exec.commands == 7 && exec.rejected == 0);
+}
+
+/// MC_DigitalCamSwitch_BkPlcMc (`config/hydraulic-cam-switch.toml`): the library's worked
+/// example on the ram, its two tracks on digital outputs through both moves and the mask
+/// change, with 0 allocations.
+#[test]
+fn the_digital_cam_switch_steps_without_allocating() {
+    let cell = example_cell("hydraulic-cam-switch");
+    let (mut exec, allocations) = run_counting(&cell, "hydraulic-cam-switch");
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    assert_eq!(exec.status()[0].state.name(), "Standstill");
+    assert!(exec.commands == 7 && exec.rejected == 0);
+}
+
+/// The bundled hydraulic axis on the jerk-based generator with the extended position
+/// controller (its D part and condition feedback, nalgebra's fixed-size matrices), through the
+/// two positionings, with 0 allocations.
+#[test]
+fn the_jerk_generator_and_the_extended_controller_step_without_allocating() {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let src = std::fs::read_to_string(root.join("config/hydraulic.toml")).unwrap();
+    let src = src.replacen(
+        "fLagAmp = 50.0",
+        "fLagAmp = 50.0\nposition_controller = \"extended\"\nfLagAmpTd = 0.5\n\
+         fLagAmpTdd = 0.005\nfLagAmpCfb_kV = 0.3\nfLagAmpCfb_tV = 0.005\n\
+         fLagAmpCfb_kA = 0.001\nfLagAmpCfb_tA = 0.005\nnProfileType = \"iTcMc_ProfileJerkBased\"",
+        1,
+    );
+    let cell = tandem_config::parse("hydraulic.toml", &src).unwrap();
+    let (mut exec, allocations) = run_counting(&cell, "hydraulic");
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    let st = exec.status()[0];
+    assert_eq!((st.state.name(), st.position), ("Standstill", 120.0));
+    assert!(exec.commands == 4 && exec.rejected == 0);
+}
+
+/// MC_AxCtrlSlowDownOnPressureEx_BkPlcMc on the press (`config/hydraulic-press.toml`, the
+/// limiter enabled before the approach), through contact, pressing and return, with 0
+/// allocations.
+#[test]
+fn the_slow_down_on_pressure_steps_without_allocating() {
+    let cell = example_cell("hydraulic-press");
+    let extra = "\n[[at]]\nt = 0.05\naxis = \"ram\"\n\
+                 instruction = \"MC_AxCtrlSlowDownOnPressureEx_BkPlcMc\"\n\
+                 set_point = 30000.0\nkp = 0.01\n";
+    let (exec, allocations) = run_counting_with(&cell, "hydraulic-press", extra);
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    assert!(exec
+        .axis(tandem_config::AxisIndex(0))
+        .unwrap()
+        .hydraulic_status()
+        .unwrap()
+        .slow_down
+        .is_some());
+    assert!(exec.commands == 8 && exec.rejected == 0);
 }
 
 /// MC_FlyingGear_BkPlcMc (`config/hydraulic-flying-gear.toml`): the cushion's flying gear on
