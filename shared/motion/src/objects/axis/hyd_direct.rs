@@ -349,12 +349,16 @@ impl Axis {
     /// velocity `value · fRefVelo`, the set position at the actual one. Returns whether either
     /// ran.
     pub(super) fn hyd_direct_generate(&mut self) -> bool {
-        let state = *self.direct_state();
-        if state.follow_up {
+        // Looked at by reference: most cycles of most axes run neither (no copy of the state).
+        let (follow_up, direct) = {
+            let d = self.direct_state();
+            (d.follow_up, d.direct)
+        };
+        if follow_up {
             self.follow_actual();
             return true;
         }
-        let Some(mut run) = state.direct else {
+        let Some(mut run) = direct else {
             return false;
         };
         if !self.still_main(run.job) {
@@ -383,10 +387,11 @@ impl Axis {
     /// actual position in position control); runs whose job is no longer the axis' (aborted)
     /// end.
     pub(super) fn hyd_direct_cycle(&mut self) {
-        let state = *self.direct_state();
-        if state.direct.is_none() && state.ext_gen.is_none() {
+        let d = self.direct_state();
+        if d.direct.is_none() && d.ext_gen.is_none() {
             return;
         }
+        let state = *d;
         if let Some(run) = state.direct {
             if !self.still_main(run.job) {
                 self.set_direct_state(|d| d.direct = None);
