@@ -145,6 +145,22 @@ fn bad_inputs_are_refused_and_change_nothing() {
     };
     assert_eq!(r.try_cmd(bad_kp), Err(ErrorId::IllegalControllerParameter));
     assert_eq!(r.hyd().slow_down, None);
+    // The limit is built for the displacement-based generator: the jerk-based one and the
+    // time-based mode are refused (the library: "the axis must be distance-controlled").
+    let src = std::fs::read_to_string(root().join("config/hydraulic-press.toml")).unwrap();
+    for key in [
+        "nProfileType = \"iTcMc_ProfileJerkBased\"",
+        "bTimeBased = true",
+    ] {
+        let s = src.replacen("fLagAmp = 50.0", &format!("fLagAmp = 50.0\n{key}"), 1);
+        let other = tandem_config::parse("hydraulic-press.toml", &s).unwrap();
+        let mut o = powered(&other);
+        assert_eq!(
+            o.try_cmd(slow_down(10_000.0, false)),
+            Err(ErrorId::IllegalControllerParameter),
+            "{key}"
+        );
+    }
     // config/hydraulic.toml has no pressure inputs.
     let plain = tandem_config::load(&root().join("config/hydraulic.toml")).unwrap();
     let mut p = Run::enabled(&plain);
