@@ -16,6 +16,7 @@ use tandem_motion::hydraulic::generator::{
     Approach, CtrlBasedGenerator, GeneratorParams, HydState,
 };
 use tandem_motion::hydraulic::monitor::{MonitorParams, TargetMonitor};
+use tandem_motion::hydraulic::profile_core::ProfileGenerator;
 use tandem_motion::plant::hydraulic::{CylinderParams, SimCylinder};
 
 const DT: f64 = 1e-3;

@@ -12,6 +12,7 @@ use tandem_motion::hydraulic::generator::{Approach, CtrlBasedGenerator, Generato
 use tandem_motion::hydraulic::pressure::{
     ForceScaling, PressureController, PressureParams, PressureReading,
 };
+use tandem_motion::hydraulic::profile_core::ProfileGenerator;
 use tandem_motion::plant::hydraulic::{CylinderParams, SimCylinder};
 
 const DT: f64 = 1e-3;

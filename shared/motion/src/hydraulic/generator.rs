@@ -40,6 +40,7 @@
 //!
 //! Pure: no IO, no clock (the cycle time is an input), no allocation.
 
+use super::profile_core::{check_move, GeneratorCore, ProfileGenerator};
 use crate::catalog::hyd_error::HydErrorCode;
 /// The generator's state, as the library names it (`E_TcHydAxState`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -238,7 +239,6 @@ pub struct Setpoint {
 /// A move the generator runs (the command's values, already limited by the parameters).
 #[derive(Copy, Clone, Debug, PartialEq)]
 struct Move {
-    target: f64,
     velocity: f64,
     acc: f64,
     dec: f64,
@@ -250,21 +250,8 @@ struct Move {
 #[doc(alias = "iTcMc_ProfileCtrlBased")]
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct CtrlBasedGenerator {
-    p: GeneratorParams,
-    state: HydState,
-    positive: bool,
-    velocity: f64,
-    position: f64,
+    c: GeneratorCore,
     mv: Move,
-    /// A move in the other direction waits for the stop ramp.
-    reverse_pending: bool,
-    /// The deceleration of the running stop (`TcDec`, mm/s²): `fRefVelo / fStopRamp`, or the
-    /// stop command's.
-    stop_dec: f64,
-    /// The feed enables of the positive and the negative direction.
-    feed: [bool; 2],
-    /// Automatic starts by `fReposDistance`.
-    repositioned: u64,
     /// The limit of the set velocity's magnitude during a move (mm/s; +∞: none; negative:
     /// backing off), MC_AxCtrlSlowDownOnPressureEx_BkPlcMc's permissible velocity.
     velocity_limit: f64,
@@ -319,58 +306,24 @@ impl CtrlBasedGenerator {
             });
         }
         Ok(Self {
-            p,
-            state: HydState::Idle,
-            positive: true,
-            velocity: 0.0,
-            position: x,
+            c: GeneratorCore::idle_at(p, x),
             mv: Move {
-                target: x,
                 velocity: 0.0,
                 acc: p.acc.min(p.max_acc),
                 dec: p.dec.min(p.max_dec),
                 brake_point: 0.0,
             },
-            reverse_pending: false,
             velocity_limit: f64::INFINITY,
             limited: false,
-            stop_dec: p.ref_velo / p.stop_ramp,
-            feed: [true; 2],
-            repositioned: 0,
         })
-    }
-
-    /// The parameters.
-    pub fn params(&self) -> &GeneratorParams {
-        &self.p
-    }
-
-    /// The state.
-    pub fn state(&self) -> HydState {
-        self.state
-    }
-
-    /// The target of the running or last move (`fTargetPos`).
-    pub fn target(&self) -> f64 {
-        self.mv.target
-    }
-
-    /// Automatic starts by `fReposDistance` since creation.
-    pub fn repositioned(&self) -> u64 {
-        self.repositioned
-    }
-
-    /// The remaining distance at which the braking ramp of the running move begins.
-    pub fn brake_point(&self) -> f64 {
-        self.mv.brake_point
     }
 
     /// The approach of direction `positive`.
     fn approach(&self, positive: bool) -> &Approach {
-        if positive || !self.p.asymmetrical {
-            &self.p.approach_p
+        if positive || !self.c.p.asymmetrical {
+            &self.c.p.approach_p
         } else {
-            &self.p.approach_m
+            &self.c.p.approach_m
         }
     }
 
@@ -387,20 +340,15 @@ impl CtrlBasedGenerator {
         deceleration: f64,
         actual: f64,
     ) -> Result<(), GeneratorError> {
-        for (name, value) in [("Position", target), ("Velocity", velocity)] {
-            if !value.is_finite() || (name == "Velocity" && value <= 0.0) {
-                return Err(GeneratorError::Invalid { name, value });
-            }
-        }
-        for (name, value) in [
-            ("Acceleration", acceleration),
-            ("Deceleration", deceleration),
-        ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(GeneratorError::Invalid { name, value });
-            }
-        }
-        let p = &self.p;
+        check_move(
+            target,
+            velocity,
+            &[
+                ("Acceleration", acceleration),
+                ("Deceleration", deceleration),
+            ],
+        )?;
+        let p = &self.c.p;
         let limit = |param: f64, max: f64, cmd: f64| {
             let l = param.min(max);
             if cmd > 0.0 {
@@ -421,161 +369,72 @@ impl CtrlBasedGenerator {
         let acc = limit(p.acc, p.max_acc, acceleration);
         let dec = limit(p.dec, p.max_dec, deceleration);
         let vc = approach.creep_speed;
+        self.c.target = target;
         self.mv = Move {
-            target,
             velocity: v,
             acc,
             dec,
             brake_point: approach.creep_distance + (v * v - vc * vc).max(0.0) / (2.0 * dec),
         };
-        let moving_other_way = self.velocity != 0.0 && (self.velocity > 0.0) != positive;
-        self.reverse_pending = moving_other_way;
+        let moving_other_way = self.c.velocity != 0.0 && (self.c.velocity > 0.0) != positive;
+        self.c.reverse_pending = moving_other_way;
         if moving_other_way {
-            self.stop_dec = self.p.ref_velo / self.p.stop_ramp;
-            self.state = HydState::TcDec;
+            self.begin_stop(HydState::TcDec, self.c.stop_ramp_dec());
         } else {
-            self.positive = positive;
-            self.state = HydState::TcAcc;
+            self.c.positive = positive;
+            self.c.state = HydState::TcAcc;
         }
-        if self.velocity == 0.0 {
-            self.position = actual;
+        if self.c.velocity == 0.0 {
+            self.c.position = actual;
         }
         Ok(())
     }
 
-    /// The feed enables of the two directions (`Enable_Positive`, `Enable_Negative` of
-    /// MC_Power_BkPlcMc, the `dwTcHydDcDwFdPosEna` / `FdNegEna` bits). A move whose direction
-    /// loses its enable makes an intermediate stop with `fStopRamp` and waits
-    /// ([`HydState::FeedStop`]); it goes on, from the start ramp, when the enable returns. A
-    /// move started in a direction without enable is refused (`dwTcHydErrCdPosFdEna` /
-    /// `NegFdEna`; inferred: the library checks it at the start).
-    pub fn set_feed_enables(&mut self, positive: bool, negative: bool) {
-        self.feed = [positive, negative];
-    }
-
-    /// Whether direction `positive` has its feed enable.
-    pub fn feed_enabled(&self, positive: bool) -> bool {
-        self.feed[usize::from(!positive)]
-    }
-
-    /// A regular stop (`MC_Stop_BkPlcMc`): the set velocity ramps to 0 with `fStopRamp`.
-    pub fn stop(&mut self) {
-        self.stop_with(self.p.ref_velo / self.p.stop_ramp);
-    }
-
-    /// A stop with the command's `Deceleration` (mm/s², `MC_Stop_BkPlcMc` from V3.0.5; a
-    /// value that is not finite and above 0 takes `fStopRamp`'s): the set velocity ramps to 0
-    /// with it (`iTcHydStateTcDecP/M`).
-    pub fn stop_with(&mut self, deceleration: f64) {
-        if self.state != HydState::Idle && self.state != HydState::EmergencyBreak {
-            self.stop_dec = if deceleration.is_finite() && deceleration > 0.0 {
-                deceleration
-            } else {
-                self.p.ref_velo / self.p.stop_ramp
-            };
-            self.state = HydState::TcDec;
-            self.reverse_pending = false;
-        }
-    }
-
-    /// Takes over a setpoint another generator produced (set position and set velocity,
-    /// mm and mm/s), as the axis does when a positioning follows a motion the generator did
-    /// not run: the next move starts from it without a step. An idle generator with a velocity
-    /// other than 0 ramps it down with the stop ramp until a move is given. Values that are not
-    /// finite change nothing.
-    pub fn take_over(&mut self, position: f64, velocity: f64) {
-        if !(position.is_finite() && velocity.is_finite()) {
-            return;
-        }
-        self.position = position;
-        self.velocity = velocity;
-        self.reverse_pending = false;
-        if velocity == 0.0 {
-            self.state = HydState::Idle;
-            self.mv.target = position;
-        } else {
-            self.positive = velocity > 0.0;
-            self.stop_dec = self.p.ref_velo / self.p.stop_ramp;
-            self.state = HydState::TcDec;
-        }
-    }
-
-    /// An emergency stop: the set velocity ramps to 0 with `fEmergencyRamp`.
-    pub fn emergency_stop(&mut self) {
-        if self.state != HydState::Idle {
-            self.state = HydState::EmergencyBreak;
-            self.reverse_pending = false;
-        }
-    }
-
-    /// One cycle of `dt` seconds with the actual position `actual` and actual velocity
-    /// `actual_velocity` (for the dead-time term of the braking distance).
-    pub fn step(&mut self, dt: f64, actual: f64, actual_velocity: f64) -> Setpoint {
-        if dt.is_finite() && dt > 0.0 && actual.is_finite() && actual_velocity.is_finite() {
-            self.advance(dt, actual, actual_velocity);
-        }
-        let idle = self.state == HydState::Idle;
-        Setpoint {
-            velocity: self.velocity,
-            position: self.position,
-            state: self.state,
-            positive: self.positive,
-            clamping_output: if idle && self.p.target_clamping > 0.0 {
-                self.p
-                    .target_clamping
-                    .copysign(if self.positive { 1.0 } else { -1.0 })
-            } else {
-                0.0
-            },
-            position_control: idle && self.p.target_clamping == 0.0,
-        }
-    }
-
     /// The state machine of one cycle.
-    fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
+    fn cycle(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
         self.limited = false;
-        let sign = if self.positive { 1.0 } else { -1.0 };
-        let approach = *self.approach(self.positive);
-        let speed = self.velocity.abs();
+        let sign = self.c.sign();
+        let approach = *self.approach(self.c.positive);
+        let speed = self.c.velocity.abs();
         let m = self.mv;
         let moving = matches!(
-            self.state,
+            self.c.state,
             HydState::TcAcc | HydState::ConstVelo | HydState::PcDec | HydState::CreepVelo
         );
-        if moving && !self.feed_enabled(self.positive) {
-            self.state = HydState::FeedStop;
+        if moving && !self.feed_enabled(self.c.positive) {
+            self.c.state = HydState::FeedStop;
         }
-        if self.state == HydState::FeedStop {
-            if self.feed_enabled(self.positive) {
+        if self.c.state == HydState::FeedStop {
+            if self.feed_enabled(self.c.positive) {
                 // The enable is back: the move goes on from the start ramp (from the velocity
                 // the intermediate stop had come down to; inferred).
-                self.state = HydState::TcAcc;
+                self.c.state = HydState::TcAcc;
             } else {
-                let s = (speed - self.p.ref_velo / self.p.stop_ramp * dt).max(0.0);
+                let s = (speed - self.c.stop_ramp_dec() * dt).max(0.0);
                 self.set(s * sign, dt);
                 return;
             }
         }
-        match self.state {
+        match self.c.state {
             HydState::Idle => {
-                self.velocity = 0.0;
-                self.position = m.target;
-                let off = (actual - m.target).abs();
-                if self.p.repos_distance > 0.0 && off > self.p.repos_distance {
+                self.c.velocity = 0.0;
+                self.c.position = self.c.target;
+                let off = (actual - self.c.target).abs();
+                if self.c.p.repos_distance > 0.0 && off > self.c.p.repos_distance {
                     // The automatic start: a positioning to the same target with the last
                     // move's dynamics, from the actual position.
-                    self.positive = m.target >= actual;
-                    self.position = actual;
-                    self.state = HydState::TcAcc;
-                    self.repositioned += 1;
+                    self.c.positive = self.c.target >= actual;
+                    self.c.position = actual;
+                    self.c.state = HydState::TcAcc;
+                    self.c.repositioned += 1;
                 }
                 return;
             }
             HydState::TcDec | HydState::EmergencyBreak => {
-                let dec = if self.state == HydState::TcDec {
-                    self.stop_dec
+                let dec = if self.c.state == HydState::TcDec {
+                    self.c.stop_dec
                 } else {
-                    self.p.ref_velo / self.p.emergency_ramp
+                    self.c.emergency_dec()
                 };
                 let s = (speed - dec * dt).max(0.0);
                 self.set(s * sign, dt);
@@ -586,29 +445,29 @@ impl CtrlBasedGenerator {
             }
             _ => {}
         }
-        let remaining = (m.target - actual) * sign;
+        let remaining = (self.c.target - actual) * sign;
         if remaining <= approach.brake_distance + approach.brake_dead_time * actual_velocity.abs() {
-            self.state = HydState::Idle;
-            self.velocity = 0.0;
-            self.position = m.target;
+            self.c.state = HydState::Idle;
+            self.c.velocity = 0.0;
+            self.c.position = self.c.target;
             return;
         }
         let vc = approach.creep_speed;
         let up = speed + m.acc * dt;
-        let s = if self.state == HydState::CreepVelo || remaining <= approach.creep_distance {
-            self.state = HydState::CreepVelo;
+        let s = if self.c.state == HydState::CreepVelo || remaining <= approach.creep_distance {
+            self.c.state = HydState::CreepVelo;
             up.min(vc)
-        } else if self.state == HydState::PcDec || remaining <= m.brake_point {
-            self.state = HydState::PcDec;
+        } else if self.c.state == HydState::PcDec || remaining <= m.brake_point {
+            self.c.state = HydState::PcDec;
             let root = (vc * vc + 2.0 * m.dec * (remaining - approach.creep_distance)).sqrt();
             root.min(up)
         } else if speed > m.velocity {
             // A restart with a lower velocity: down to it with the deceleration.
-            self.state = HydState::TcAcc;
+            self.c.state = HydState::TcAcc;
             (speed - m.dec * dt).max(m.velocity)
         } else {
             let s = up.min(m.velocity);
-            self.state = if s >= m.velocity {
+            self.c.state = if s >= m.velocity {
                 HydState::ConstVelo
             } else {
                 HydState::TcAcc
@@ -636,22 +495,49 @@ impl CtrlBasedGenerator {
 
     /// Sets the set velocity and integrates the set position.
     fn set(&mut self, v: f64, dt: f64) {
-        self.position += 0.5 * (self.velocity + v) * dt;
-        self.velocity = v;
+        self.c.position += 0.5 * (self.c.velocity + v) * dt;
+        self.c.velocity = v;
     }
 
     /// A stop ramp has reached 0: the move in the other direction that waited for it starts,
     /// or the axis is idle at its set position.
     fn finish_stop(&mut self) {
-        if self.reverse_pending && self.state == HydState::TcDec {
-            self.reverse_pending = false;
-            self.positive = !self.positive;
-            self.state = HydState::TcAcc;
+        if self.c.reverse_pending && self.c.state == HydState::TcDec {
+            self.c.reverse_pending = false;
+            self.c.positive = !self.c.positive;
+            self.c.state = HydState::TcAcc;
         } else {
-            self.reverse_pending = false;
-            self.state = HydState::Idle;
-            self.mv.target = self.position;
+            self.c.reverse_pending = false;
+            self.c.state = HydState::Idle;
+            self.c.target = self.c.position;
         }
+    }
+}
+
+impl ProfileGenerator for CtrlBasedGenerator {
+    fn core(&self) -> &GeneratorCore {
+        &self.c
+    }
+
+    fn core_mut(&mut self) -> &mut GeneratorCore {
+        &mut self.c
+    }
+
+    fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
+        self.cycle(dt, actual, actual_velocity);
+    }
+
+    /// The stop ramps of this generator are linear in time; an emergency stop ramps with
+    /// `fEmergencyRamp` whatever `dec` says, and keeps the regular stop's deceleration.
+    fn begin_stop(&mut self, state: HydState, dec: f64) {
+        if state == HydState::TcDec {
+            self.c.stop_dec = dec;
+        }
+        self.c.state = state;
+    }
+
+    fn brake_point(&self) -> f64 {
+        self.mv.brake_point
     }
 }
 
@@ -685,7 +571,7 @@ mod tests {
     /// before) until idle or `cycles`; returns the setpoints.
     fn run(g: &mut CtrlBasedGenerator, cycles: usize) -> Vec<Setpoint> {
         let mut out = Vec::new();
-        let (mut x, mut v) = (g.position, g.velocity);
+        let (mut x, mut v) = (g.c.position, g.c.velocity);
         for _ in 0..cycles {
             let s = g.step(DT, x, v);
             out.push(s);
@@ -811,7 +697,7 @@ mod tests {
         let out = run(&mut g, 1000);
         let ramp = out.iter().filter(|s| s.state == HydState::TcDec).count();
         assert_eq!(ramp + 1, 100);
-        g.move_absolute(2000.0, 100.0, 0.0, 0.0, g.position)
+        g.move_absolute(2000.0, 100.0, 0.0, 0.0, g.c.position)
             .unwrap();
         run(&mut g, 300);
         g.stop_with(0.0);

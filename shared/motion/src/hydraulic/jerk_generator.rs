@@ -73,7 +73,8 @@
 //!
 //! Pure: no IO, no clock (the cycle time is an input), no allocation.
 
-use super::generator::{CtrlBasedGenerator, GeneratorError, GeneratorParams, HydState, Setpoint};
+use super::generator::{CtrlBasedGenerator, GeneratorError, GeneratorParams, HydState};
+use super::profile_core::{check_move, GeneratorCore, ProfileGenerator};
 use crate::catalog::hyd_error::HydErrorCode;
 
 /// `nJerkEnabled` bit `16#0001`: the acceleration of a time-controlled ramp is built up with
@@ -355,7 +356,6 @@ impl Curve {
 /// A move the generator runs (the command's values, limited by the parameters).
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
 struct JerkMove {
-    target: f64,
     /// The travel velocity the command asked for (limited).
     velocity: f64,
     /// The peak velocity of the start ramp (the travel velocity, or less for a short move).
@@ -382,20 +382,10 @@ enum Phase {
 #[doc(alias = "iTcMc_ProfileJerkBased")]
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct JerkBasedGenerator {
-    p: GeneratorParams,
+    c: GeneratorCore,
     j: JerkParams,
-    state: HydState,
     phase: Phase,
-    positive: bool,
-    velocity: f64,
-    /// The set acceleration along the motion (mm/s²).
-    acceleration: f64,
-    position: f64,
     mv: JerkMove,
-    reverse_pending: bool,
-    stop_dec: f64,
-    feed: [bool; 2],
-    repositioned: u64,
 }
 
 impl JerkBasedGenerator {
@@ -406,16 +396,10 @@ impl JerkBasedGenerator {
         j.check()?;
         let dec = p.dec.min(p.max_dec);
         Ok(Self {
-            p,
+            c: GeneratorCore::idle_at(p, x),
             j,
-            state: HydState::Idle,
             phase: Phase::Curve,
-            positive: true,
-            velocity: 0.0,
-            acceleration: 0.0,
-            position: x,
             mv: JerkMove {
-                target: x,
                 acc: p.acc.min(p.max_acc),
                 jerk: j.max_jerk,
                 curve: Curve {
@@ -425,41 +409,12 @@ impl JerkBasedGenerator {
                 },
                 ..JerkMove::default()
             },
-            reverse_pending: false,
-            stop_dec: p.ref_velo / p.stop_ramp,
-            feed: [true; 2],
-            repositioned: 0,
         })
-    }
-
-    /// The parameters shared with the displacement-based generator.
-    pub fn params(&self) -> &GeneratorParams {
-        &self.p
     }
 
     /// `fMaxJerk` and `nJerkEnabled`.
     pub fn jerk_params(&self) -> &JerkParams {
         &self.j
-    }
-
-    /// The state (`E_TcMcCurrentStep`: the braking and its jerk-limited end are `PcDec`).
-    pub fn state(&self) -> HydState {
-        self.state
-    }
-
-    /// The target of the running or last move (`fTargetPos`).
-    pub fn target(&self) -> f64 {
-        self.mv.target
-    }
-
-    /// Automatic starts by `fReposDistance` since creation.
-    pub fn repositioned(&self) -> u64 {
-        self.repositioned
-    }
-
-    /// The remaining distance at which the braking ramp of the running move begins.
-    pub fn brake_point(&self) -> f64 {
-        self.mv.brake_point
     }
 
     /// The residual distance of the running move: where the jerk-limited end begins.
@@ -475,12 +430,12 @@ impl JerkBasedGenerator {
 
     /// The set acceleration of the last cycle (mm/s², signed).
     pub fn acceleration(&self) -> f64 {
-        self.acceleration
+        self.c.acceleration
     }
 
     /// Whether the running move is in its jerk-limited end into the target.
     pub fn in_final_approach(&self) -> bool {
-        matches!(self.phase, Phase::Final { .. }) && self.state == HydState::PcDec
+        matches!(self.phase, Phase::Final { .. }) && self.c.state == HydState::PcDec
     }
 
     /// Starts a move to `target` (`MC_MoveAbsolute_BkPlcMc`) from the actual position
@@ -493,29 +448,24 @@ impl JerkBasedGenerator {
         (acceleration, deceleration, jerk): (f64, f64, f64),
         actual: f64,
     ) -> Result<(), GeneratorError> {
-        for (name, value) in [("Position", target), ("Velocity", velocity)] {
-            if !value.is_finite() || (name == "Velocity" && value <= 0.0) {
-                return Err(GeneratorError::Invalid { name, value });
-            }
-        }
-        for (name, value) in [
-            ("Acceleration", acceleration),
-            ("Deceleration", deceleration),
-            ("Jerk", jerk),
-        ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(GeneratorError::Invalid { name, value });
-            }
-        }
+        check_move(
+            target,
+            velocity,
+            &[
+                ("Acceleration", acceleration),
+                ("Deceleration", deceleration),
+                ("Jerk", jerk),
+            ],
+        )?;
         let limit = |param: f64, cmd: f64| if cmd > 0.0 { param.min(cmd) } else { param };
         let positive = target >= actual;
         if !self.feed_enabled(positive) && target != actual {
             return Err(GeneratorError::FeedEnable { positive });
         }
-        let p = &self.p;
+        let p = &self.c.p;
         let jerk = limit(self.j.max_jerk, jerk);
+        self.c.target = target;
         self.mv = JerkMove {
-            target,
             velocity: velocity.min(p.ref_velo).min(p.max_velo),
             acc: limit(p.acc.min(p.max_acc), acceleration),
             jerk,
@@ -526,16 +476,16 @@ impl JerkBasedGenerator {
             },
             ..self.mv
         };
-        if self.velocity == 0.0 {
-            self.position = actual;
-            self.acceleration = 0.0;
+        if self.c.velocity == 0.0 {
+            self.c.position = actual;
+            self.c.acceleration = 0.0;
         }
-        let moving_other_way = self.velocity != 0.0 && (self.velocity > 0.0) != positive;
-        self.reverse_pending = moving_other_way;
+        let moving_other_way = self.c.velocity != 0.0 && (self.c.velocity > 0.0) != positive;
+        self.c.reverse_pending = moving_other_way;
         if moving_other_way {
-            self.begin_stop(HydState::TcDec, self.p.ref_velo / self.p.stop_ramp);
+            self.begin_stop(HydState::TcDec, self.c.stop_ramp_dec());
         } else {
-            self.positive = positive;
+            self.c.positive = positive;
             self.begin_move();
         }
         Ok(())
@@ -543,8 +493,8 @@ impl JerkBasedGenerator {
 
     /// The speed and the acceleration along the motion.
     fn along(&self) -> (f64, f64) {
-        let sign = if self.positive { 1.0 } else { -1.0 };
-        (self.velocity * sign, self.acceleration * sign)
+        let sign = self.c.sign();
+        (self.c.velocity * sign, self.c.acceleration * sign)
     }
 
     /// The jerks of a time-controlled ramp's build-up and reduction with jerk `j`.
@@ -559,8 +509,8 @@ impl JerkBasedGenerator {
     fn begin_move(&mut self) {
         let (v, a) = self.along();
         let m = self.mv;
-        let sign = if self.positive { 1.0 } else { -1.0 };
-        let d = (m.target - self.position) * sign;
+        let sign = self.c.sign();
+        let d = (self.c.target - self.c.position) * sign;
         let (ju, jd) = self.ramp_jerks(m.jerk);
         let ramp_to = |peak: f64| {
             let bound = if peak >= v { m.acc } else { m.curve.dec };
@@ -593,123 +543,39 @@ impl JerkBasedGenerator {
             ramp: ramp_to(peak),
             t: 0.0,
         };
-        self.state = HydState::TcAcc;
+        self.c.state = HydState::TcAcc;
     }
 
-    /// A time-controlled ramp to standstill with deceleration `dec` in state `state`.
-    fn begin_stop(&mut self, state: HydState, dec: f64) {
+    /// A time-controlled ramp to standstill with deceleration `dec` in state `state` (an
+    /// emergency stop without jerk limitation).
+    fn ramp_down(&mut self, state: HydState, dec: f64) {
         let (v, a) = self.along();
         let (ju, jd) = if state == HydState::EmergencyBreak {
             (f64::INFINITY, f64::INFINITY)
         } else {
             self.ramp_jerks(self.mv.jerk)
         };
-        self.stop_dec = dec;
+        self.c.stop_dec = dec;
         self.phase = Phase::Ramp {
             ramp: Ramp::new(v, a, 0.0, dec, ju, jd),
             t: 0.0,
         };
-        self.state = state;
-    }
-
-    /// The feed enables of the two directions, as [`CtrlBasedGenerator::set_feed_enables`].
-    pub fn set_feed_enables(&mut self, positive: bool, negative: bool) {
-        self.feed = [positive, negative];
-    }
-
-    /// Whether direction `positive` has its feed enable.
-    pub fn feed_enabled(&self, positive: bool) -> bool {
-        self.feed[usize::from(!positive)]
-    }
-
-    /// A regular stop (`MC_Stop_BkPlcMc`): the set velocity ramps to 0 with `fStopRamp` and
-    /// the move's jerk.
-    pub fn stop(&mut self) {
-        self.stop_with(self.p.ref_velo / self.p.stop_ramp);
-    }
-
-    /// A stop with the command's `Deceleration` (a value that is not finite and above 0 takes
-    /// `fStopRamp`'s), as [`CtrlBasedGenerator::stop_with`], with the move's jerk.
-    pub fn stop_with(&mut self, deceleration: f64) {
-        if self.state != HydState::Idle && self.state != HydState::EmergencyBreak {
-            let dec = if deceleration.is_finite() && deceleration > 0.0 {
-                deceleration
-            } else {
-                self.p.ref_velo / self.p.stop_ramp
-            };
-            self.reverse_pending = false;
-            self.begin_stop(HydState::TcDec, dec);
-        }
-    }
-
-    /// Takes over a setpoint another generator produced, as
-    /// [`CtrlBasedGenerator::take_over`] (the acceleration taken as 0).
-    pub fn take_over(&mut self, position: f64, velocity: f64) {
-        if !(position.is_finite() && velocity.is_finite()) {
-            return;
-        }
-        self.position = position;
-        self.velocity = velocity;
-        self.acceleration = 0.0;
-        self.reverse_pending = false;
-        if velocity == 0.0 {
-            self.state = HydState::Idle;
-            self.mv.target = position;
-        } else {
-            self.positive = velocity > 0.0;
-            self.begin_stop(HydState::TcDec, self.p.ref_velo / self.p.stop_ramp);
-        }
-    }
-
-    /// An emergency stop: the set velocity ramps to 0 with `fEmergencyRamp`, without jerk
-    /// limitation.
-    pub fn emergency_stop(&mut self) {
-        if self.state != HydState::Idle {
-            self.reverse_pending = false;
-            self.begin_stop(
-                HydState::EmergencyBreak,
-                self.p.ref_velo / self.p.emergency_ramp,
-            );
-        }
-    }
-
-    /// One cycle of `dt` seconds with the actual position `actual` and actual velocity
-    /// `actual_velocity` (for the dead-time term of the braking distance); the time-based
-    /// mode gives the set position and velocity of the last cycle.
-    pub fn step(&mut self, dt: f64, actual: f64, actual_velocity: f64) -> Setpoint {
-        if dt.is_finite() && dt > 0.0 && actual.is_finite() && actual_velocity.is_finite() {
-            self.advance(dt, actual, actual_velocity);
-        }
-        let idle = self.state == HydState::Idle;
-        Setpoint {
-            velocity: self.velocity,
-            position: self.position,
-            state: self.state,
-            positive: self.positive,
-            clamping_output: if idle && self.p.target_clamping > 0.0 {
-                self.p
-                    .target_clamping
-                    .copysign(if self.positive { 1.0 } else { -1.0 })
-            } else {
-                0.0
-            },
-            position_control: idle && self.p.target_clamping == 0.0,
-        }
+        self.c.state = state;
     }
 
     /// The state machine of one cycle.
-    fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
+    fn cycle(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
         let moving = matches!(
-            self.state,
+            self.c.state,
             HydState::TcAcc | HydState::ConstVelo | HydState::PcDec
         );
-        if moving && !self.feed_enabled(self.positive) {
-            self.reverse_pending = false;
-            self.begin_stop(HydState::FeedStop, self.p.ref_velo / self.p.stop_ramp);
+        if moving && !self.feed_enabled(self.c.positive) {
+            self.c.reverse_pending = false;
+            self.begin_stop(HydState::FeedStop, self.c.stop_ramp_dec());
         }
-        match self.state {
+        match self.c.state {
             HydState::Idle => self.idle(actual),
-            HydState::FeedStop if self.feed_enabled(self.positive) => {
+            HydState::FeedStop if self.feed_enabled(self.c.positive) => {
                 // The enable is back: the move goes on from the speed the stop came down to.
                 self.begin_move();
                 self.travel(dt, actual, actual_velocity);
@@ -721,14 +587,14 @@ impl JerkBasedGenerator {
 
     /// Idle: the set position is the target; the automatic start by `fReposDistance`.
     fn idle(&mut self, actual: f64) {
-        self.velocity = 0.0;
-        self.acceleration = 0.0;
-        self.position = self.mv.target;
-        let off = (actual - self.mv.target).abs();
-        if self.p.repos_distance > 0.0 && off > self.p.repos_distance {
-            self.positive = self.mv.target >= actual;
-            self.position = actual;
-            self.repositioned += 1;
+        self.c.velocity = 0.0;
+        self.c.acceleration = 0.0;
+        self.c.position = self.c.target;
+        let off = (actual - self.c.target).abs();
+        if self.c.p.repos_distance > 0.0 && off > self.c.p.repos_distance {
+            self.c.positive = self.c.target >= actual;
+            self.c.position = actual;
+            self.c.repositioned += 1;
             self.begin_move();
         }
     }
@@ -737,7 +603,7 @@ impl JerkBasedGenerator {
     /// axis is idle (a feed stop waits).
     fn stopping(&mut self, dt: f64) {
         let Phase::Ramp { ramp, t } = self.phase else {
-            self.begin_stop(self.state, self.stop_dec);
+            self.begin_stop(self.c.state, self.c.stop_dec);
             return;
         };
         let t = t + dt;
@@ -746,17 +612,17 @@ impl JerkBasedGenerator {
         self.set(v.max(0.0), a, dt);
         if t >= ramp.duration() || v <= 0.0 {
             self.set(0.0, 0.0, 0.0);
-            if self.state == HydState::FeedStop {
+            if self.c.state == HydState::FeedStop {
                 return;
             }
-            if self.reverse_pending && self.state == HydState::TcDec {
-                self.reverse_pending = false;
-                self.positive = !self.positive;
+            if self.c.reverse_pending && self.c.state == HydState::TcDec {
+                self.c.reverse_pending = false;
+                self.c.positive = !self.c.positive;
                 self.begin_move();
             } else {
-                self.reverse_pending = false;
-                self.state = HydState::Idle;
-                self.mv.target = self.position;
+                self.c.reverse_pending = false;
+                self.c.state = HydState::Idle;
+                self.c.target = self.c.position;
             }
         }
     }
@@ -764,14 +630,14 @@ impl JerkBasedGenerator {
     /// A cycle of the move: the start ramp or travel until the braking curve, the curve down
     /// to the residual distance, the jerk-limited end; idle within the braking distance.
     fn travel(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
-        let sign = if self.positive { 1.0 } else { -1.0 };
+        let sign = self.c.sign();
         let m = self.mv;
-        let approach = if self.positive || !self.p.asymmetrical {
-            self.p.approach_p
+        let approach = if self.c.positive || !self.c.p.asymmetrical {
+            self.c.p.approach_p
         } else {
-            self.p.approach_m
+            self.c.p.approach_m
         };
-        let remaining = (m.target - actual) * sign;
+        let remaining = (self.c.target - actual) * sign;
         let braking = approach.brake_distance + approach.brake_dead_time * actual_velocity.abs();
         if remaining <= braking {
             return self.arrive();
@@ -785,22 +651,22 @@ impl JerkBasedGenerator {
         let ahead = remaining - now * dt;
         let curve = m.curve.speed(ahead);
         let (speed, acc) = match self.phase {
-            Phase::Ramp { ramp, t } if self.state == HydState::TcAcc => {
+            Phase::Ramp { ramp, t } if self.c.state == HydState::TcAcc => {
                 let t = t + dt;
                 self.phase = Phase::Ramp { ramp, t };
                 let (v, a, _) = ramp.at(t);
                 if t >= ramp.duration() {
-                    self.state = HydState::ConstVelo;
+                    self.c.state = HydState::ConstVelo;
                 }
                 (v, a)
             }
-            _ if self.state == HydState::PcDec => (now, 0.0),
+            _ if self.c.state == HydState::PcDec => (now, 0.0),
             _ => (m.peak, 0.0),
         };
-        if speed < curve && self.state != HydState::PcDec {
+        if speed < curve && self.c.state != HydState::PcDec {
             return self.set(speed, acc, dt);
         }
-        self.state = HydState::PcDec;
+        self.c.state = HydState::PcDec;
         self.phase = Phase::Curve;
         if remaining < m.curve.residual() {
             // The jerk-limited end from the cubic branch at this distance, `rest` seconds
@@ -827,30 +693,53 @@ impl JerkBasedGenerator {
         }
         let before = rest + dt;
         let ds = j * (before.powi(3) - rest.powi(3)) / 6.0;
-        let sign = if self.positive { 1.0 } else { -1.0 };
+        let sign = self.c.sign();
         self.phase = Phase::Final { rest };
-        self.velocity = sign * 0.5 * j * rest * rest;
-        self.acceleration = -sign * j * rest;
-        self.position += sign * ds;
+        self.c.velocity = sign * 0.5 * j * rest * rest;
+        self.c.acceleration = -sign * j * rest;
+        self.c.position += sign * ds;
     }
 
     /// The move ends: idle, the set position the target.
     fn arrive(&mut self) {
-        self.state = HydState::Idle;
+        self.c.state = HydState::Idle;
         self.phase = Phase::Curve;
-        self.velocity = 0.0;
-        self.acceleration = 0.0;
-        self.position = self.mv.target;
+        self.c.velocity = 0.0;
+        self.c.acceleration = 0.0;
+        self.c.position = self.c.target;
     }
 
     /// Sets the speed `s` and acceleration `a` along the motion and integrates the set
     /// position over `dt`.
     fn set(&mut self, s: f64, a: f64, dt: f64) {
-        let sign = if self.positive { 1.0 } else { -1.0 };
+        let sign = self.c.sign();
         let v = s * sign;
-        self.position += 0.5 * (self.velocity + v) * dt;
-        self.velocity = v;
-        self.acceleration = a * sign;
+        self.c.position += 0.5 * (self.c.velocity + v) * dt;
+        self.c.velocity = v;
+        self.c.acceleration = a * sign;
+    }
+}
+
+impl ProfileGenerator for JerkBasedGenerator {
+    fn core(&self) -> &GeneratorCore {
+        &self.c
+    }
+
+    fn core_mut(&mut self) -> &mut GeneratorCore {
+        &mut self.c
+    }
+
+    /// The time-based mode gives the set position and velocity of the last cycle as `actual`.
+    fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
+        self.cycle(dt, actual, actual_velocity);
+    }
+
+    fn begin_stop(&mut self, state: HydState, dec: f64) {
+        self.ramp_down(state, dec);
+    }
+
+    fn brake_point(&self) -> f64 {
+        self.mv.brake_point
     }
 }
 
@@ -881,14 +770,6 @@ impl Generator {
         }
     }
 
-    /// The parameters.
-    pub fn params(&self) -> &GeneratorParams {
-        match self {
-            Self::CtrlBased(g) => g.params(),
-            Self::JerkBased(g) => g.params(),
-        }
-    }
-
     /// [`CtrlBasedGenerator::limit_velocity`] (MC_AxCtrlSlowDownOnPressureEx_BkPlcMc); the
     /// jerk-based generator takes no limit (the instruction refuses it).
     pub fn limit_velocity(&mut self, limit: f64) {
@@ -902,38 +783,6 @@ impl Generator {
         match self {
             Self::CtrlBased(g) => g.limited(),
             Self::JerkBased(_) => false,
-        }
-    }
-
-    /// The state.
-    pub fn state(&self) -> HydState {
-        match self {
-            Self::CtrlBased(g) => g.state(),
-            Self::JerkBased(g) => g.state(),
-        }
-    }
-
-    /// `fTargetPos`.
-    pub fn target(&self) -> f64 {
-        match self {
-            Self::CtrlBased(g) => g.target(),
-            Self::JerkBased(g) => g.target(),
-        }
-    }
-
-    /// Automatic starts by `fReposDistance`.
-    pub fn repositioned(&self) -> u64 {
-        match self {
-            Self::CtrlBased(g) => g.repositioned(),
-            Self::JerkBased(g) => g.repositioned(),
-        }
-    }
-
-    /// The remaining distance at which the braking ramp of the running move begins.
-    pub fn brake_point(&self) -> f64 {
-        match self {
-            Self::CtrlBased(g) => g.brake_point(),
-            Self::JerkBased(g) => g.brake_point(),
         }
     }
 
@@ -967,60 +816,41 @@ impl Generator {
             }
         }
     }
+}
 
-    /// The feed enables of the two directions.
-    pub fn set_feed_enables(&mut self, positive: bool, negative: bool) {
+impl ProfileGenerator for Generator {
+    fn core(&self) -> &GeneratorCore {
         match self {
-            Self::CtrlBased(g) => g.set_feed_enables(positive, negative),
-            Self::JerkBased(g) => g.set_feed_enables(positive, negative),
+            Self::CtrlBased(g) => g.core(),
+            Self::JerkBased(g) => g.core(),
         }
     }
 
-    /// Whether direction `positive` has its feed enable.
-    pub fn feed_enabled(&self, positive: bool) -> bool {
+    fn core_mut(&mut self) -> &mut GeneratorCore {
         match self {
-            Self::CtrlBased(g) => g.feed_enabled(positive),
-            Self::JerkBased(g) => g.feed_enabled(positive),
+            Self::CtrlBased(g) => g.core_mut(),
+            Self::JerkBased(g) => g.core_mut(),
         }
     }
 
-    /// A regular stop with `fStopRamp`.
-    pub fn stop(&mut self) {
+    fn advance(&mut self, dt: f64, actual: f64, actual_velocity: f64) {
         match self {
-            Self::CtrlBased(g) => g.stop(),
-            Self::JerkBased(g) => g.stop(),
+            Self::CtrlBased(g) => g.advance(dt, actual, actual_velocity),
+            Self::JerkBased(g) => g.advance(dt, actual, actual_velocity),
         }
     }
 
-    /// A stop with the command's deceleration.
-    pub fn stop_with(&mut self, deceleration: f64) {
+    fn begin_stop(&mut self, state: HydState, dec: f64) {
         match self {
-            Self::CtrlBased(g) => g.stop_with(deceleration),
-            Self::JerkBased(g) => g.stop_with(deceleration),
+            Self::CtrlBased(g) => g.begin_stop(state, dec),
+            Self::JerkBased(g) => g.begin_stop(state, dec),
         }
     }
 
-    /// Takes over another generator's setpoint.
-    pub fn take_over(&mut self, position: f64, velocity: f64) {
+    fn brake_point(&self) -> f64 {
         match self {
-            Self::CtrlBased(g) => g.take_over(position, velocity),
-            Self::JerkBased(g) => g.take_over(position, velocity),
-        }
-    }
-
-    /// An emergency stop with `fEmergencyRamp`.
-    pub fn emergency_stop(&mut self) {
-        match self {
-            Self::CtrlBased(g) => g.emergency_stop(),
-            Self::JerkBased(g) => g.emergency_stop(),
-        }
-    }
-
-    /// One cycle.
-    pub fn step(&mut self, dt: f64, actual: f64, actual_velocity: f64) -> Setpoint {
-        match self {
-            Self::CtrlBased(g) => g.step(dt, actual, actual_velocity),
-            Self::JerkBased(g) => g.step(dt, actual, actual_velocity),
+            Self::CtrlBased(g) => g.brake_point(),
+            Self::JerkBased(g) => g.brake_point(),
         }
     }
 }
@@ -1031,6 +861,7 @@ mod tests {
 
     use super::*;
     use crate::hydraulic::generator::Approach;
+    use crate::hydraulic::generator::Setpoint;
     use crate::kinematics::profile::{plan_velocity, Limits, State};
     use proptest::prelude::*;
 
@@ -1075,7 +906,7 @@ mod tests {
     /// before, as the time-based mode gives it) until idle or `cycles`.
     fn run(g: &mut JerkBasedGenerator, cycles: usize) -> Vec<Sample> {
         let mut out = Vec::new();
-        let (mut x, mut v) = (g.position, g.velocity);
+        let (mut x, mut v) = (g.c.position, g.c.velocity);
         for _ in 0..cycles {
             let s = g.step(DT, x, v);
             out.push(Sample {
@@ -1277,7 +1108,7 @@ mod tests {
         assert_eq!((last.state, last.velocity), (HydState::Idle, 0.0));
         assert_eq!(g.target(), last.position);
         // An emergency stop has no jerk: fEmergencyRamp 0.1 s from 500 mm/s, 5000 mm/s².
-        g.move_absolute(2000.0, 100.0, (0.0, 0.0, 0.0), g.position)
+        g.move_absolute(2000.0, 100.0, (0.0, 0.0, 0.0), g.c.position)
             .unwrap();
         run(&mut g, 400);
         g.emergency_stop();
@@ -1293,7 +1124,7 @@ mod tests {
         let out = run(&mut g, 300);
         assert_eq!(out.last().unwrap().s.state, HydState::TcAcc);
         // Mid-ramp: a new target and a lower velocity.
-        g.move_absolute(300.0, 80.0, (0.0, 0.0, 0.0), g.position)
+        g.move_absolute(300.0, 80.0, (0.0, 0.0, 0.0), g.c.position)
             .unwrap();
         let mut all = out;
         all.extend(run(&mut g, 20_000));
@@ -1305,10 +1136,10 @@ mod tests {
         }
         assert_eq!(all.last().unwrap().s.position, 300.0);
         // The other way: the stop ramp first, then the move.
-        g.move_absolute(600.0, 100.0, (0.0, 0.0, 0.0), g.position)
+        g.move_absolute(600.0, 100.0, (0.0, 0.0, 0.0), g.c.position)
             .unwrap();
         run(&mut g, 1000);
-        g.move_absolute(0.0, 50.0, (0.0, 0.0, 0.0), g.position)
+        g.move_absolute(0.0, 50.0, (0.0, 0.0, 0.0), g.c.position)
             .unwrap();
         let out = run(&mut g, 50_000);
         let mut states: Vec<(HydState, bool)> =

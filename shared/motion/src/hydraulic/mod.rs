@@ -6,6 +6,8 @@
 //! `objects::axis` and the analog connection, docs/hydraulics.md):
 //! - [`generator`]: the displacement-based set value generator `iTcMc_ProfileCtrlBased` (start
 //!   ramp, travel, square-root braking ramp to creep speed, creep, idle; stops);
+//! - [`profile_core`]: what both generators share (the set values, the feed enables, the
+//!   stops) and [`profile_core::ProfileGenerator`], the interface the axis runs either through;
 //! - [`time_ramp`]: the time-ramp generator `iTcMc_ProfileTimeRamp` for an axis without an
 //!   encoder, on four digital position cams;
 //! - [`monitor`]: the target window monitoring (InTargRng, InTarget with its filter time, Done);
@@ -37,6 +39,7 @@ pub mod generator;
 pub mod jerk_generator;
 pub mod monitor;
 pub mod pressure;
+pub mod profile_core;
 pub mod slow_down;
 pub mod time_ramp;
 pub mod valve_table;

@@ -38,6 +38,7 @@
 use super::{reduce, Axis, Command, Goal, HydJogMode};
 use crate::catalog::error_id::ErrorId;
 use crate::catalog::override_table::NewJob;
+use crate::hydraulic::profile_core::ProfileGenerator;
 use crate::kinematics::dynamics::Dynamics;
 use crate::kinematics::profile::{Limits, State};
 use crate::objects::job::{Instruction, JobEventKind, JobId};

@@ -128,6 +128,7 @@ use crate::catalog::error_id::ErrorId;
 use crate::catalog::override_table::NewJob;
 use crate::hydraulic::finish::FULL_SCALE_V;
 use crate::hydraulic::generator::HydState;
+use crate::hydraulic::profile_core::ProfileGenerator;
 use crate::kinematics::profile::State;
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 

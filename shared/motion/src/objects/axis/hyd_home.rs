@@ -47,6 +47,7 @@ use super::{reduce, Axis, Goal};
 use crate::catalog::error_id::ErrorId;
 use crate::catalog::hyd_error::HydErrorCode;
 use crate::catalog::override_table::NewJob;
+use crate::hydraulic::profile_core::ProfileGenerator;
 use crate::kinematics::profile::Limits;
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 

@@ -10,6 +10,7 @@ use super::hydraulic::HydAxis;
 use super::Axis;
 use crate::catalog::error_id::ErrorId;
 use crate::hydraulic::jerk_generator::ProfileType;
+use crate::hydraulic::profile_core::ProfileGenerator;
 use crate::hydraulic::slow_down::{SlowDownParams, SlowDownStatus};
 use crate::objects::job::{Instruction, JobEventKind, JobId};
 

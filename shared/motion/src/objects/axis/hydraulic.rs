@@ -30,6 +30,7 @@ use crate::hydraulic::generator::{HydState, Setpoint};
 use crate::hydraulic::jerk_generator::Generator;
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
 use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
+use crate::hydraulic::profile_core::ProfileGenerator;
 use crate::hydraulic::slow_down::{SlowDownParams, SlowDownStatus};
 use crate::kinematics::profile::{Profile, State};
 use crate::objects::job::{Instruction, JobEventKind, JobId};
