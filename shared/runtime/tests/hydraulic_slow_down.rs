@@ -16,8 +16,7 @@ use tandem_config::Cell;
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::hydraulic::pressure::PressureReading;
 use tandem_motion::hydraulic::slow_down::SlowDownParams;
-use tandem_motion::objects::axis::{AxisState, Command, StartMode, StopMode};
-use tandem_runtime::exec::Executive;
+use tandem_motion::objects::axis::{AxisState, Command};
 use tandem_testkit::workspace::root;
 
 fn press() -> Cell {
@@ -26,23 +25,7 @@ fn press() -> Cell {
 
 /// The press powered at 300 mm, standing.
 fn powered(cell: &Cell) -> Run<'_> {
-    let mut r = Run {
-        exec: Executive::new(cell, None).unwrap(),
-        k: 0,
-        log: Vec::new(),
-    };
-    r.step();
-    r.cmd(Command::Power {
-        enable: true,
-        start_mode: StartMode::PositionControlled,
-        stop_mode: StopMode::Emergency,
-    });
-    r.cmd(Command::Home {
-        mode: 0,
-        position: 300.0,
-    });
-    r.until(100, "enabled", |r| r.state() == AxisState::Standstill);
-    r
+    Run::enabled_at(cell, 300.0)
 }
 
 fn slow_down(set_point: f64, enable_relief: bool) -> Command {

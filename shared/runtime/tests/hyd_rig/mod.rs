@@ -28,6 +28,11 @@ pub struct Run<'c> {
 impl<'c> Run<'c> {
     /// The axis powered and homed at 100 mm, standing.
     pub fn enabled(cell: &'c Cell) -> Self {
+        Self::enabled_at(cell, 100.0)
+    }
+
+    /// The axis powered and homed at `position` (mm), standing.
+    pub fn enabled_at(cell: &'c Cell, position: f64) -> Self {
         let mut r = Self {
             exec: Executive::new(cell, None).unwrap(),
             k: 0,
@@ -39,10 +44,7 @@ impl<'c> Run<'c> {
             start_mode: StartMode::PositionControlled,
             stop_mode: StopMode::Emergency,
         });
-        r.cmd(Command::Home {
-            mode: 0,
-            position: 100.0,
-        });
+        r.cmd(Command::Home { mode: 0, position });
         r.until(100, "enabled", |r| r.state() == AxisState::Standstill);
         r
     }
