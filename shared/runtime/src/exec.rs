@@ -673,7 +673,7 @@ impl<'c> Executive<'c> {
             &self.drives.analog,
             &mut self.trace_row,
         );
-        self.trace_row.push_str(self.objects.row());
+        self.objects.row(&mut self.trace_row);
         &self.trace_row
     }
 

@@ -215,7 +215,6 @@ pub(crate) struct Objects {
     switches: Vec<SimSwitch>,
     /// Per axis: an MC_Home job was started and has not ended.
     pub(crate) homing: Vec<bool>,
-    row: String,
     /// Notes, corrections and alarms of the current step.
     pub(crate) out: StepOutput,
 }
@@ -699,7 +698,6 @@ impl Objects {
             inputs,
             switches,
             homing: vec![false; cell.axes.len()],
-            row: String::new(),
             out: StepOutput {
                 edges: CamEdges::default(),
                 output_edges: Vec::with_capacity(
@@ -937,11 +935,9 @@ impl Objects {
         )
     }
 
-    /// The objects' part of a trace row.
-    pub(crate) fn row(&mut self) -> &str {
+    /// Appends the objects' part of a trace row to `r`.
+    pub(crate) fn row(&self, r: &mut String) {
         use std::fmt::Write as _;
-        let r = &mut self.row;
-        r.clear();
         let last = |x: Option<i64>| x.map(seconds).unwrap_or_default();
         for c in &self.cams {
             // Writing into a String cannot fail.
@@ -989,6 +985,5 @@ impl Objects {
             // Writing into a String cannot fail.
             let _ = write!(r, ",{},{}", s.output_bits, u8::from(s.in_operation));
         }
-        &self.row
     }
 }
