@@ -258,10 +258,16 @@ impl Axis {
     /// Whether the position controller acts: not while the engaged generator runs a move, nor
     /// while the pressure controller gives the control value (it cancels `fLagCtrlOutput`).
     pub(super) fn hyd_position_control(&self) -> bool {
+        self.hyd_position_control_with(self.hyd_direct_output())
+    }
+
+    /// [`Self::hyd_position_control`] with the direct output of this cycle, `direct`
+    /// ([`Self::hyd_direct_output`], looked up once by the caller).
+    pub(super) fn hyd_position_control_with(&self, direct: Option<f64>) -> bool {
         match self.hyd.as_deref() {
             Some(h) if h.pressure.is_some() => false,
             // MC_AxRtSetDirectOutput_BkPlcMc: open loop; MC_AxRtFollowUp_BkPlcMc: none.
-            Some(_) if self.hyd_direct_output().is_some() || self.hyd_following_up() => false,
+            Some(_) if direct.is_some() || self.hyd_following_up() => false,
             // bTimeBased: "The position controller is always active" (at the target too,
             // except where target clamping replaces it).
             Some(h) if h.engaged && h.time_based => {
@@ -492,8 +498,9 @@ impl Axis {
     }
 
     /// What the valve's Finish stage takes from the axis this cycle: the generator's pressing
-    /// output at the target (while it computes the setpoint) and AutoZero's compensation.
-    pub(super) fn hyd_valve_outputs(&self) -> HydValveOutputs {
+    /// output at the target (while it computes the setpoint), AutoZero's compensation and the
+    /// direct output `direct` ([`Self::hyd_direct_output`], looked up once by the caller).
+    pub(super) fn hyd_valve_outputs(&self, direct: Option<f64>) -> HydValveOutputs {
         match self.hyd.as_deref() {
             Some(h) => HydValveOutputs {
                 clamping_output: if h.engaged && h.pressure.is_none() {
@@ -506,7 +513,7 @@ impl Axis {
                     .map(|(a, _)| a.status().compensation)
                     .or(h.cmds.direct.latched_zero()),
                 locked: h.cmds.outputs_locked(),
-                direct_output: self.hyd_direct_output(),
+                direct_output: direct,
             },
             None => HydValveOutputs::default(),
         }

@@ -61,16 +61,17 @@ impl Axis {
     #[inline]
     pub(super) fn outputs(&self) -> DriveOutputs {
         let tot = self.total();
+        let direct = self.hyd_direct_output();
         DriveOutputs {
             position: tot.p - self.offset,
             velocity: tot.v,
             enable: self.enabled || self.power.awaiting_drive,
-            position_controlled: self.pos_ctrl && self.hyd_position_control(),
+            position_controlled: self.pos_ctrl && self.hyd_position_control_with(direct),
             fault_reset: self.power.fault_reset,
             acceleration: tot.a,
             quick_stop: self.power.quick_stop && !self.enabled && !self.power.awaiting_drive,
             homing_latch: self.homing_latch(),
-            hydraulic: self.hyd_valve_outputs(),
+            hydraulic: self.hyd_valve_outputs(direct),
         }
     }
 
