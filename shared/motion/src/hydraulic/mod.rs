@@ -24,6 +24,8 @@
 //!   absolute output with direction bits, reversal);
 //! - [`pressure`]: the pressures and force from two inputs (`MC_AxRtReadForceDiff_BkPlcMc`) and
 //!   the pressure or force controller (`MC_AxCtrlPressure_BkPlcMc`);
+//! - [`pressure_ff`]: the PID pressure or force controller with feed-forward
+//!   (`MC_AxCtrlPressureFF_BkPlcMc`, `ST_TcPctrlParam`);
 //! - [`slow_down`]: slowing down on pressure, `MC_AxCtrlSlowDownOnPressureEx_BkPlcMc` (a
 //!   permissible velocity from the margin to a set pressure or force);
 //! - [`autoident`]: the automatic identification `MC_AxUtiAutoIdent_BkPlcMc` (end of travel,
@@ -39,6 +41,7 @@ pub mod generator;
 pub mod jerk_generator;
 pub mod monitor;
 pub mod pressure;
+pub mod pressure_ff;
 pub mod profile_core;
 pub mod slow_down;
 pub mod time_ramp;
