@@ -180,6 +180,30 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
             ("force", Some(Value::Bool(true))),
         ],
     },
+    // The Beckhoff hydraulic library's PID pressure or force controller with feed-forward
+    // (`ST_TcPctrlParam` in the same entry; `reset` is TRUE by default as in the library: a
+    // script sets it false to run the controller).
+    InstructionSpec {
+        name: "MC_AxCtrlPressureFF_BkPlcMc",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("reset", Some(Value::Bool(true))),
+            ("enable_p", Some(Value::Bool(true))),
+            ("enable_i", Some(Value::Bool(true))),
+            ("enable_d", Some(Value::Bool(true))),
+            ("setpoint", Some(Value::Num(0.0))),
+            ("feed_velocity", Some(Value::Num(0.0))),
+            ("feed_charge", Some(Value::Num(0.0))),
+            ("kp", Some(Value::Num(0.0))),
+            ("tn", Some(Value::Num(0.0))),
+            ("tv", Some(Value::Num(0.0))),
+            ("preset", Some(Value::Num(0.0))),
+            ("windup_limit", Some(Value::Num(1.0))),
+            ("nf", Some(Value::Num(0.0))),
+            ("align_areas", Some(Value::Bool(false))),
+            ("force", Some(Value::Bool(true))),
+        ],
+    },
     // The Beckhoff hydraulic library's automatic zero compensation (defaults:
     // `AutoZeroParams::DEFAULT`).
     InstructionSpec {
@@ -1091,6 +1115,39 @@ fn hydraulic_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
     }))
 }
 
+/// MC_AxCtrlPressureFF_BkPlcMc with its `ST_TcPctrlParam` (an `nf` outside 0..65535 stands
+/// as 65535, which the axis refuses with the other values out of range).
+fn pressure_ff_command(a: &Args<'_>) -> Result<Command, CommandError> {
+    use tandem_motion::hydraulic::pressure::PressureReading;
+    use tandem_motion::hydraulic::pressure_ff::{PctrlParams, PidInputs};
+    Ok(Command::PressureControlFf {
+        enable: a.flag("enable")?,
+        reset: a.flag("reset")?,
+        inputs: PidInputs {
+            enable_p: a.flag("enable_p")?,
+            enable_i: a.flag("enable_i")?,
+            enable_d: a.flag("enable_d")?,
+            setpoint: a.num("setpoint")?,
+            feed_velocity: a.num("feed_velocity")?,
+            feed_charge: a.num("feed_charge")?,
+        },
+        params: PctrlParams {
+            kp: a.num("kp")?,
+            tn: a.num("tn")?,
+            tv: a.num("tv")?,
+            preset: a.num("preset")?,
+            windup_limit: a.num("windup_limit")?,
+            nf: u16::try_from(a.code("nf")?).unwrap_or(u16::MAX),
+            align_areas: a.flag("align_areas")?,
+            reading: if a.flag("force")? {
+                PressureReading::Force
+            } else {
+                PressureReading::Pressure
+            },
+        },
+    })
+}
+
 /// The Beckhoff hydraulic library's controllers and set-value hooks (pressure, AutoZero,
 /// slow-down, direct output, external set values, follow-up, offset latch); `None` for another.
 fn hydraulic_control_command(a: &Args<'_>) -> Result<Option<Command>, CommandError> {
@@ -1104,6 +1161,7 @@ fn hydraulic_control_command(a: &Args<'_>) -> Result<Option<Command>, CommandErr
             windup_limit: a.num("windup_limit")?,
             force: a.flag("force")?,
         },
+        "MC_AxCtrlPressureFF_BkPlcMc" => pressure_ff_command(a)?,
         "MC_AxCtrlAutoZero_BkPlcMc" => Command::AutoZero {
             enable: a.flag("enable")?,
             params: tandem_motion::hydraulic::auto_zero::AutoZeroParams {

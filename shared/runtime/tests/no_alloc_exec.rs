@@ -325,6 +325,25 @@ fn the_slow_down_on_pressure_steps_without_allocating() {
     assert!(exec.commands == 8 && exec.rejected == 0);
 }
 
+/// MC_AxCtrlPressureFF_BkPlcMc on the press (`config/hydraulic-press.toml`): after the script's
+/// release of MC_AxCtrlPressure_BkPlcMc, the PID controller with its D filter presses for 30 ms,
+/// is reset, and the ram returns, with 0 allocations.
+#[test]
+fn the_pressure_ff_controller_steps_without_allocating() {
+    let cell = example_cell("hydraulic-press");
+    let extra = "\n[[at]]\nt = 4.55\naxis = \"ram\"\n\
+                 instruction = \"MC_AxCtrlPressureFF_BkPlcMc\"\nreset = false\n\
+                 setpoint = 2000.0\nkp = 0.00002\ntn = 0.05\ntv = 0.002\nnf = 5\n\
+                 windup_limit = 0.2\n\
+                 \n[[at]]\nt = 4.58\naxis = \"ram\"\n\
+                 instruction = \"MC_AxCtrlPressureFF_BkPlcMc\"\n";
+    let (mut exec, allocations) = run_counting_with(&cell, "hydraulic-press", extra);
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    let st = exec.status()[0];
+    assert_eq!((st.state.name(), st.position), ("Standstill", 300.0));
+    assert!(exec.commands == 9 && exec.rejected == 0);
+}
+
 /// MC_FlyingGear_BkPlcMc (`config/hydraulic-flying-gear.toml`): the cushion's flying gear on
 /// the slide through waiting, engaging, in sync, releasing and stopped, with 0 allocations.
 #[test]

@@ -44,6 +44,9 @@ pub enum Instruction {
     MotionInVelocity,
     /// `MC_AxCtrlPressure_BkPlcMc` (Beckhoff hydraulic library): pressure or force control.
     PressureControl,
+    /// `MC_AxCtrlPressureFF_BkPlcMc` (Beckhoff hydraulic library): PID pressure or force
+    /// control with feed-forward.
+    PressureControlFf,
     /// `MC_AxCtrlAutoZero_BkPlcMc` (Beckhoff hydraulic library): automatic zero compensation.
     AutoZero,
     /// `MC_AxCtrlSlowDownOnPressureEx_BkPlcMc` (Beckhoff hydraulic library): slowing down on
@@ -124,6 +127,7 @@ impl Instruction {
             Self::MotionInPosition => "MC_MotionInPosition",
             Self::MotionInVelocity => "MC_MotionInVelocity",
             Self::PressureControl => "MC_AxCtrlPressure_BkPlcMc",
+            Self::PressureControlFf => "MC_AxCtrlPressureFF_BkPlcMc",
             Self::AutoZero => "MC_AxCtrlAutoZero_BkPlcMc",
             Self::SlowDownOnPressure => "MC_AxCtrlSlowDownOnPressureEx_BkPlcMc",
             Self::EmergencyStop => "MC_EmergencyStop_BkPlcMc",

@@ -458,6 +458,23 @@ pub enum Command {
         /// `ReadingMode`: the force (`iTcHydPressureReadingActForce`), else the pressure.
         force: bool,
     },
+    /// The PID pressure or force controller with feed-forward of a hydraulic axis (Beckhoff
+    /// TwinCAT PLC Hydraulic Positioning library, `MC_AxCtrlPressureFF_BkPlcMc` with
+    /// `ST_TcPctrlParam`): enabled and not reset it takes the control value from the generator
+    /// and controls the actual pressure or force to `inputs.setpoint`; a running one takes the
+    /// new inputs and parameters each time it is given; disabled or reset, the axis stands in
+    /// position control where it is.
+    #[doc(alias = "MC_AxCtrlPressureFF_BkPlcMc")]
+    PressureControlFf {
+        /// `Enable`.
+        enable: bool,
+        /// `Reset`: the I part cleared, the controller inactive.
+        reset: bool,
+        /// `Enable_P`, `Enable_I`, `Enable_D`, `Setpoint`, `FeedVelocity`, `FeedCharge`.
+        inputs: crate::hydraulic::pressure_ff::PidInputs,
+        /// `ST_TcPctrlParam` (`pParam`) and the reading mode.
+        params: crate::hydraulic::pressure_ff::PctrlParams,
+    },
     /// The automatic zero compensation of a hydraulic axis with a zero-overlap valve (Beckhoff
     /// TwinCAT PLC Hydraulic Positioning library, `MC_AxCtrlAutoZero_BkPlcMc`): with `enable` it
     /// adjusts `fZeroCompensation` at standstill until the lag is gone; without, the value

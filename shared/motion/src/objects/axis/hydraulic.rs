@@ -30,6 +30,7 @@ use crate::hydraulic::generator::{HydState, Setpoint};
 use crate::hydraulic::jerk_generator::Generator;
 use crate::hydraulic::monitor::{TargetMonitor, TargetStatus};
 use crate::hydraulic::pressure::{ActualForce, PressureController, PressureOutput, PressureParams};
+use crate::hydraulic::pressure_ff::{PctrlParams, PidInputs, PidOutput, PressureFfController};
 use crate::hydraulic::profile_core::ProfileGenerator;
 use crate::hydraulic::slow_down::{SlowDownParams, SlowDownStatus};
 use crate::kinematics::profile::{Profile, State};
@@ -67,14 +68,52 @@ pub(super) struct HydAxis {
     pub(super) slow_down: Option<(SlowDownParams, SlowDownStatus)>,
 }
 
+/// The controller of a running pressure or force control.
+// The PID variant carries its D filter (100 values) inline: the job lives in the axis' boxed
+// hydraulic part, and boxing the variant would allocate when the instruction is given.
+#[allow(clippy::large_enum_variant)]
+#[derive(Copy, Clone, Debug, PartialEq)]
+enum PressureLaw {
+    /// MC_AxCtrlPressure_BkPlcMc.
+    Pi(PressureController),
+    /// MC_AxCtrlPressureFF_BkPlcMc with its inputs of the last command, and its last outputs.
+    Pid(PressureFfController, PidInputs, PidOutput),
+}
+
 /// A running pressure or force control.
 #[derive(Copy, Clone, Debug, PartialEq)]
 struct PressureJob {
-    ctrl: PressureController,
-    /// `fSetPressure`.
+    law: PressureLaw,
+    /// `fSetPressure` (`Setpoint`).
     set: f64,
     job: JobId,
     last: PressureOutput,
+}
+
+impl PressureJob {
+    /// The instruction that runs it.
+    fn instruction(&self) -> Instruction {
+        Self::instruction_of(&self.law)
+    }
+
+    /// The instruction that runs `law`.
+    fn instruction_of(law: &PressureLaw) -> Instruction {
+        match law {
+            PressureLaw::Pi(_) => Instruction::PressureControl,
+            PressureLaw::Pid(..) => Instruction::PressureControlFf,
+        }
+    }
+
+    /// One cycle of `dt` seconds with the actual values.
+    fn step(&mut self, actual: &ActualForce, dt: f64) {
+        self.last = match &mut self.law {
+            PressureLaw::Pi(c) => c.step(true, false, self.set, actual, dt),
+            PressureLaw::Pid(c, u, out) => {
+                *out = c.step(true, false, u, actual, dt);
+                out.control()
+            }
+        };
+    }
 }
 
 /// What a hydraulic axis shows besides the axis' status.
@@ -96,9 +135,12 @@ pub struct HydraulicStatus {
     /// The pressures and the force of the last sample (`fActPressureA`, `fActPressureB`,
     /// `fActPressure`, `fActForce`); `None` without pressure inputs.
     pub actual: Option<ActualForce>,
-    /// The pressure or force controller runs (MC_AxCtrlPressure_BkPlcMc), with its set value
-    /// and its output of the last cycle.
+    /// The pressure or force controller runs (MC_AxCtrlPressure_BkPlcMc or
+    /// MC_AxCtrlPressureFF_BkPlcMc), with its set value and its output of the last cycle.
     pub pressure_control: Option<(f64, PressureOutput)>,
+    /// MC_AxCtrlPressureFF_BkPlcMc runs: its outputs of the last cycle (`Deviation`,
+    /// `Proportional`, `Integrator`, `Differential`, `Response`, `InWindup`).
+    pub pressure_ff: Option<PidOutput>,
     /// MC_AxCtrlAutoZero_BkPlcMc's outputs and `fZeroCompensation`, once it has been enabled,
     /// with its `Enable`.
     pub auto_zero: Option<(AutoZeroStatus, bool)>,
@@ -325,38 +367,118 @@ impl Axis {
         params: PressureParams,
     ) -> Result<JobId, ErrorId> {
         let refused = ErrorId::IllegalControllerParameter;
-        let running = self.hyd.as_deref().ok_or(refused)?.pressure;
-        if self.hyd.as_deref().is_some_and(|h| h.actual.is_none()) {
-            return Err(refused);
-        }
+        let running = self.hyd_pressure_running(Instruction::PressureControl, enable)?;
         if !enable {
-            let Some(pj) = running else {
-                let id = self.new_id();
-                self.emit(id, Instruction::PressureControl, JobEventKind::Done);
-                return Ok(id);
-            };
-            self.hyd_pressure_end();
-            self.basic = State::rest(self.actual_p);
-            self.finish_main(pj.job, Instruction::PressureControl);
-            return Ok(pj.job);
+            return Ok(self.hyd_pressure_off(running, Instruction::PressureControl));
         }
         self.check_motion_allowed()?;
         if !set.is_finite() {
             return Err(refused);
         }
-        let mut ctrl = PressureController::new(params).map_err(|_| refused)?;
-        if let Some(pj) = running {
-            ctrl = pj.ctrl.retuned(params);
-            if let Some(p) = self.hyd.as_deref_mut().and_then(|h| h.pressure.as_mut()) {
-                *p = PressureJob { ctrl, set, ..*p };
-            }
-            return Ok(pj.job);
+        let ctrl = PressureController::new(params).map_err(|_| refused)?;
+        let law = match running.map(|pj| pj.law) {
+            Some(PressureLaw::Pi(c)) => PressureLaw::Pi(c.retuned(params)),
+            _ => PressureLaw::Pi(ctrl),
+        };
+        Ok(self.hyd_pressure_on(running, law, set))
+    }
+
+    /// `MC_AxCtrlPressureFF_BkPlcMc`: enabled and not reset, the PID controller takes the
+    /// control value (a running one takes the new inputs and parameters, its I part kept);
+    /// disabled or reset, a running one ends (Done) and the axis stands in position control at
+    /// its actual position. Refused as [`Self::cmd_pressure_control`] (16#80F5), and while the
+    /// other pressure instruction runs.
+    pub(super) fn cmd_pressure_control_ff(
+        &mut self,
+        enable: bool,
+        reset: bool,
+        inputs: PidInputs,
+        params: PctrlParams,
+    ) -> Result<JobId, ErrorId> {
+        let refused = ErrorId::IllegalControllerParameter;
+        let running =
+            self.hyd_pressure_running(Instruction::PressureControlFf, enable && !reset)?;
+        if !enable || reset {
+            return Ok(self.hyd_pressure_off(running, Instruction::PressureControlFf));
         }
+        self.check_motion_allowed()?;
+        let finite = [inputs.setpoint, inputs.feed_velocity, inputs.feed_charge];
+        if !finite.iter().all(|x| x.is_finite()) {
+            return Err(refused);
+        }
+        let ctrl = match running.map(|pj| pj.law) {
+            Some(PressureLaw::Pid(c, ..)) => c.retuned(params),
+            _ => PressureFfController::new(params),
+        }
+        .map_err(|_| refused)?;
+        let last = match running.map(|pj| pj.law) {
+            Some(PressureLaw::Pid(_, _, out)) => out,
+            _ => PidOutput::default(),
+        };
+        let law = PressureLaw::Pid(ctrl, inputs, last);
+        Ok(self.hyd_pressure_on(running, law, inputs.setpoint))
+    }
+
+    /// The pressure job of `instruction` that runs now, if any; refused (16#80F5) on an axis
+    /// that is not hydraulic or has no pressure inputs, and, to `enable` it, while the other
+    /// pressure instruction runs (inferred: each of the library's two controllers owns the
+    /// control value while it runs; one must be disabled before the other takes it). Disabling
+    /// an instruction that does not run changes nothing.
+    fn hyd_pressure_running(
+        &self,
+        instruction: Instruction,
+        enable: bool,
+    ) -> Result<Option<PressureJob>, ErrorId> {
+        let refused = ErrorId::IllegalControllerParameter;
+        let h = self.hyd.as_deref().ok_or(refused)?;
+        if h.actual.is_none() {
+            return Err(refused);
+        }
+        match h.pressure {
+            Some(pj) if pj.instruction() != instruction && enable => Err(refused),
+            Some(pj) if pj.instruction() != instruction => Ok(None),
+            running => Ok(running),
+        }
+    }
+
+    /// Ends the running pressure job (Done), the axis standing in position control at its
+    /// actual position; with none running, a new job that is Done at once.
+    fn hyd_pressure_off(
+        &mut self,
+        running: Option<PressureJob>,
+        instruction: Instruction,
+    ) -> JobId {
+        let Some(pj) = running else {
+            let id = self.new_id();
+            self.emit(id, instruction, JobEventKind::Done);
+            return id;
+        };
+        self.hyd_pressure_end();
+        self.basic = State::rest(self.actual_p);
+        self.finish_main(pj.job, instruction);
+        pj.job
+    }
+
+    /// Starts a pressure job with `law` and set value `set`, or gives a running one (the same
+    /// job) its new law and set value.
+    fn hyd_pressure_on(
+        &mut self,
+        running: Option<PressureJob>,
+        law: PressureLaw,
+        set: f64,
+    ) -> JobId {
+        if let Some(pj) = running {
+            if let Some(p) = self.hyd.as_deref_mut().and_then(|h| h.pressure.as_mut()) {
+                *p = PressureJob { law, set, ..*p };
+            }
+            return pj.job;
+        }
+        let instruction = PressureJob::instruction_of(&law);
         self.fold_superimposed();
         let v = self.basic.v;
         let lim = self.default_limits();
         let job = self.start_main(
-            Instruction::PressureControl,
+            instruction,
             lim,
             Goal::Direct {
                 position: None,
@@ -366,13 +488,13 @@ impl Axis {
         );
         if let Some(h) = self.hyd.as_deref_mut() {
             h.pressure = Some(PressureJob {
-                ctrl,
+                law,
                 set,
                 job,
                 last: PressureOutput::default(),
             });
         }
-        Ok(job)
+        job
     }
 
     /// The pressure controller no longer runs.
@@ -399,7 +521,7 @@ impl Axis {
             return false;
         }
         let actual = h.actual.unwrap_or_default();
-        pj.last = pj.ctrl.step(true, false, pj.set, &actual, dt);
+        pj.step(&actual, dt);
         self.basic = State {
             p: actual_p,
             v: pj.last.set_speed * h.ref_velo,
@@ -419,6 +541,10 @@ impl Axis {
             in_target: h.window.in_target,
             actual: h.actual,
             pressure_control: h.pressure.map(|p| (p.set, p.last)),
+            pressure_ff: h.pressure.and_then(|p| match p.law {
+                PressureLaw::Pid(_, _, out) => Some(out),
+                PressureLaw::Pi(_) => None,
+            }),
             auto_zero: h.auto_zero.map(|(a, on)| (a.status(), on)),
             slow_down: h.slow_down.map(|(_, s)| s),
             zero_compensation: self.hyd_zero_compensation(),
@@ -554,6 +680,12 @@ impl Axis {
                     },
                 },
             ),
+            Command::PressureControlFf {
+                enable,
+                reset,
+                inputs,
+                params,
+            } => self.cmd_pressure_control_ff(enable, reset, inputs, params),
             Command::AutoZero { enable, params } => self.cmd_auto_zero(enable, params),
             Command::SlowDownOnPressure { enable, params } => self.cmd_slow_down(enable, params),
             _ => Err(ErrorId::IllegalObject),

@@ -1072,6 +1072,7 @@ impl Axis {
             Command::SetOverride { velocity } => self.cmd_set_override(velocity),
             Command::HydPower { .. }
             | Command::PressureControl { .. }
+            | Command::PressureControlFf { .. }
             | Command::AutoZero { .. }
             | Command::SlowDownOnPressure { .. } => self.apply_hyd_control(cmd),
             Command::EmergencyStop { .. }

@@ -896,7 +896,8 @@ impl Axis {
                     | Instruction::MoveJog
                     | Instruction::MotionInPosition
                     | Instruction::MotionInVelocity
-                    | Instruction::PressureControl,
+                    | Instruction::PressureControl
+                    | Instruction::PressureControlFf,
                 ) => AxisState::ContinuousMotion,
                 Some(_) => AxisState::DiscreteMotion,
                 None if self.sync.is_some() => AxisState::SynchronizedMotion,
