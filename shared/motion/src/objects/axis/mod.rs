@@ -335,6 +335,8 @@ pub struct Axis {
     enabled: bool,
     /// The connected drive works at its own limit (StatusWord X27 "InLimitation").
     in_limitation: bool,
+    /// A torque job is active (`torque` has one): the cycle looks at `torque` only then.
+    torque_active: bool,
     pos_ctrl: bool,
     homed: bool,
     stop_lock: bool,
@@ -388,7 +390,8 @@ pub struct Axis {
     absolute: AbsoluteOffset,
     /// Jobs queued behind `main` (PLCopen BufferMode); read only when a job ends.
     queue: buffer::JobQueue,
-    /// MC_TorqueLimiting, MC_TorqueAdditive, MC_TorqueRange and the drive's actual torque.
+    /// MC_TorqueLimiting, MC_TorqueAdditive and MC_TorqueRange (read by the cycle only while
+    /// `torque_active`).
     torque: torque::TorqueJobs,
 }
 
@@ -431,6 +434,7 @@ impl Axis {
             },
             enabled: false,
             in_limitation: false,
+            torque_active: false,
             pos_ctrl: false,
             offset: 0.0,
             absolute,

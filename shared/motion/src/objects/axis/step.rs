@@ -45,7 +45,9 @@ impl Axis {
         self.hyd_commands_cycle();
         self.hyd_direct_cycle();
         self.monitor(act.balanced + self.offset);
-        self.torque_cycle(inputs.torque_actual);
+        if self.torque_active {
+            self.torque_cycle();
+        }
         self.hyd_auto_zero();
 
         let out = self.outputs();
@@ -72,7 +74,11 @@ impl Axis {
             quick_stop: self.power.quick_stop && !self.enabled && !self.power.awaiting_drive,
             homing_latch: self.homing_latch(),
             hydraulic: self.hyd_valve_outputs(),
-            torque: self.torque.outputs(),
+            torque: if self.torque_active {
+                self.torque.outputs()
+            } else {
+                crate::plant::link::TorqueOutputs::default()
+            },
         }
     }
 
@@ -871,9 +877,12 @@ impl Axis {
             | bit(status_bit::IN_LIMITATION, self.in_limitation)
             | bit(
                 status_bit::TORQUE_LIMITING_COMMAND,
-                self.torque.limiting_active(),
+                self.torque_active && self.torque.limiting_active(),
             )
-            | bit(status_bit::IN_CLAMPING, self.torque.in_clamping())
+            | bit(
+                status_bit::IN_CLAMPING,
+                self.torque_active && self.torque.in_clamping(),
+            )
     }
 
     /// The PLCopen state from the alarm reaction, the enable and the running jobs.

@@ -47,8 +47,6 @@ pub(super) struct TorqueJobs {
     additive: Option<(JobId, f64)>,
     /// MC_TorqueRange: its job, upper and lower limit.
     range: Option<(JobId, f64, f64)>,
-    /// The drive's actual torque at the load (`StatusTorqueData.ActualTorque`).
-    actual: f64,
 }
 
 /// `StatusTorqueData` and the outputs of the torque instructions.
@@ -90,12 +88,17 @@ impl TorqueJobs {
         self.limiting.is_some()
     }
 
-    /// The status.
-    pub(super) fn status(&self) -> TorqueStatus {
+    /// Any job active.
+    fn any(&self) -> bool {
+        self.limiting.is_some() || self.additive.is_some() || self.range.is_some()
+    }
+
+    /// The status, with the drive's actual torque `actual`.
+    fn status(&self, actual: f64) -> TorqueStatus {
         TorqueStatus {
             additive_active: self.additive.is_some(),
             range_active: self.range.is_some(),
-            actual_torque: self.actual,
+            actual_torque: actual,
             limiting_active: self.limiting.is_some(),
             in_clamping: self.in_clamping(),
             limit: self.limiting.map_or(0.0, |l| l.limit),
@@ -110,14 +113,25 @@ impl Axis {
         self.torque.capable = on;
     }
 
-    /// `StatusTorqueData` and the state of MC_TorqueLimiting.
+    /// `StatusTorqueData` and the state of MC_TorqueLimiting (`ActualTorque` as the connected
+    /// drive last reported it; 0 in simulation).
     pub fn torque_status(&self) -> TorqueStatus {
-        self.torque.status()
+        let actual = match &self.link {
+            super::DriveLink::Connected { inputs, .. } => inputs.torque_actual,
+            super::DriveLink::Simulation(_) => 0.0,
+        };
+        self.torque.status(actual)
     }
 
     /// MC_TorqueLimiting, MC_TorqueAdditive and MC_TorqueRange; any other command is refused
     /// (16#8002).
     pub(super) fn apply_torque(&mut self, cmd: &super::Command) -> Result<JobId, ErrorId> {
+        let r = self.torque_command(cmd);
+        self.torque_active = self.torque.any();
+        r
+    }
+
+    fn torque_command(&mut self, cmd: &super::Command) -> Result<JobId, ErrorId> {
         use super::Command as C;
         match *cmd {
             C::TorqueLimiting {
@@ -270,7 +284,8 @@ impl Axis {
     /// and standstill) are off now: under MC_TorqueLimiting or MC_TorqueRange unless
     /// `TorqueLimiting.PositionBasedMonitorings` keeps them.
     pub(super) fn position_monitorings_off(&self) -> bool {
-        (self.torque.limiting.is_some() || self.torque.range.is_some())
+        self.torque_active
+            && (self.torque.limiting.is_some() || self.torque.range.is_some())
             && !self.cfg.torque.keep_position_monitorings
     }
 
@@ -293,10 +308,9 @@ impl Axis {
         Ok(())
     }
 
-    /// The cycle's part, after the following error is formed: the actual torque, fixed stop
-    /// detection and the clamping monitoring.
-    pub(super) fn torque_cycle(&mut self, actual_torque: f64) {
-        self.torque.actual = actual_torque;
+    /// The cycle's part while a torque job is active, after the following error is formed:
+    /// fixed stop detection and the clamping monitoring.
+    pub(super) fn torque_cycle(&mut self) {
         let Some(mut l) = self.torque.limiting else {
             return;
         };
