@@ -233,6 +233,8 @@ fn encode(map: &DriveMap, c: &DriveCommand, out: &mut [u8]) {
             0x60B1 => i64::from(c.velocity_offset),
             0x60B2 => i64::from(c.torque_offset),
             0x6072 => i64::from(c.max_torque),
+            0x60E0 => i64::from(c.positive_torque_limit),
+            0x60E1 => i64::from(c.negative_torque_limit),
             0x60B8 => i64::from(c.touch_probe_function),
             _ => 0,
         };

@@ -353,6 +353,29 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
         ],
     },
     InstructionSpec {
+        name: "MC_TorqueLimiting",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("limit", Some(Value::Num(-1.0))),
+            ("mode", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_TorqueAdditive",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("value", Some(Value::Num(0.0))),
+        ],
+    },
+    InstructionSpec {
+        name: "MC_TorqueRange",
+        params: &[
+            ("enable", Some(Value::Bool(true))),
+            ("upper_limit", Some(Value::Num(1e12))),
+            ("lower_limit", Some(Value::Num(-1e12))),
+        ],
+    },
+    InstructionSpec {
         name: "MC_GearIn",
         params: &[
             ("ratio_numerator", Some(Value::Num(1.0))),
@@ -1287,6 +1310,20 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
             velocity: a.num("velocity")?,
             acceleration: a.num("acceleration")?,
             position_controlled: a.flag("position_controlled")?,
+        },
+        "MC_TorqueLimiting" => Command::TorqueLimiting {
+            enable: a.flag("enable")?,
+            limit: a.num("limit")?,
+            mode: a.code("mode")?,
+        },
+        "MC_TorqueAdditive" => Command::TorqueAdditive {
+            enable: a.flag("enable")?,
+            value: a.num("value")?,
+        },
+        "MC_TorqueRange" => Command::TorqueRange {
+            enable: a.flag("enable")?,
+            upper_limit: a.num("upper_limit")?,
+            lower_limit: a.num("lower_limit")?,
         },
         other => return Err(CommandError::NoParser(other)),
     })

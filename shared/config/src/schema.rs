@@ -1070,6 +1070,12 @@ pub struct AxisSection {
     pub leader_missing_reaction: Option<String>,
     /// `[axes.<name>.hydraulic]`: the parameters of a `kind = "hydraulic"` axis.
     pub hydraulic: Option<HydraulicSection>,
+    /// `[axes.<name>.torque_limiting]`.
+    #[serde(default)]
+    pub torque_limiting: TorqueLimitingSection,
+    /// `[axes.<name>.clamping]`.
+    #[serde(default)]
+    pub clamping: ClampingSection,
 }
 
 /// `[axes.<name>.extrapolation]`.
@@ -1471,6 +1477,69 @@ pub struct PlantSection {
     /// Position of one zero mark.
     #[serde(default)]
     pub zero_mark_offset: f64,
+    /// A mechanical stop the load cannot pass below (simulated CiA 402 servo only).
+    pub fixed_stop_min: Option<f64>,
+    /// A mechanical stop the load cannot pass above (simulated CiA 402 servo only).
+    pub fixed_stop_max: Option<f64>,
+}
+
+/// `[axes.<name>.torque_limiting]`: S7's `TorqueLimiting.*`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TorqueLimitingSection {
+    /// `LimitDefaults.Torque` / `.Force` (N·m, or N on a linear axis): MC_TorqueLimiting's
+    /// limit for `Limit` < 0; none: such a job is refused.
+    pub limit_default: Option<f64>,
+    /// `PositionBasedMonitorings` = 1: following error and positioning monitoring stay on
+    /// under torque limits.
+    #[serde(default)]
+    pub keep_position_monitorings: bool,
+    /// Metres per position unit of a linear axis, for forces in N (default 0.001: mm).
+    #[serde(default = "d_position_unit_m")]
+    pub position_unit_m: f64,
+}
+
+impl Default for TorqueLimitingSection {
+    fn default() -> Self {
+        Self {
+            limit_default: None,
+            keep_position_monitorings: false,
+            position_unit_m: d_position_unit_m(),
+        }
+    }
+}
+
+fn d_position_unit_m() -> f64 {
+    0.001
+}
+
+/// `[axes.<name>.clamping]`: S7's `Clamping.*` (fixed stop detection).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClampingSection {
+    /// `FollowingErrorDeviation` (position units): the following error that detects the stop.
+    #[serde(default = "d_clamping_deviation")]
+    pub following_error_deviation: f64,
+    /// `PositionTolerance` (position units): the clamping window.
+    #[serde(default = "d_clamping_tolerance")]
+    pub position_tolerance: f64,
+}
+
+impl Default for ClampingSection {
+    fn default() -> Self {
+        Self {
+            following_error_deviation: d_clamping_deviation(),
+            position_tolerance: d_clamping_tolerance(),
+        }
+    }
+}
+
+fn d_clamping_deviation() -> f64 {
+    1.0
+}
+
+fn d_clamping_tolerance() -> f64 {
+    0.1
 }
 
 /// `[[ethercat]]`: the EtherCAT segment one node drives as its MainDevice.

@@ -23,7 +23,9 @@
 //! (`enable`, default `true`; `enable_mask`, default `0xFFFFFFFF`: bit `n - 1` is track `n`).
 //! A simulated drive (`[devices.<name>]`) takes `DriveFault` (`code`): a fault with that CiA 402
 //! error code (0x603F, e.g. `code = 0x2310`) from the entry's `t`, or with `code = 0` its cause
-//! removed (a fault reset then succeeds).
+//! removed (a fault reset then succeeds); a simulated servo also takes `FixedStop` (`min`,
+//! `max`, positions of its axis's load; one left out: no stop on that side): its mechanical
+//! stops from the entry's `t` (`FixedStop` alone: the stop gives way).
 //! A simulated input signal (`[signals.<name>]` on a `sim_digital_input`) takes `SetInput`
 //! (`value`, default `true`; `pulse`, s, default 0): the input's level from the entry's `t`
 //! exactly, and with `pulse > 0` back to `!value` that long after (a timestamped input reports
@@ -199,6 +201,11 @@ const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
     ("InputEdge", 2, &[("rising", Value::Bool(true))]),
     ("DriveFault", 3, &[("code", Value::Num(0.0))]),
     (
+        "FixedStop",
+        3,
+        &[("min", Value::Num(f64::NAN)), ("max", Value::Num(f64::NAN))],
+    ),
+    (
         "SetInput",
         4,
         &[("value", Value::Bool(true)), ("pulse", Value::Num(0.0))],
@@ -280,6 +287,10 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
                 code: u16::try_from(c).map_err(|_| wrong("code", Expected::Integer))?,
             }
         }
+        "FixedStop" => Action::FixedStop {
+            min: Some(x(0)).filter(|x| x.is_finite()),
+            max: Some(x(1)).filter(|x| x.is_finite()),
+        },
         "SetInput" => Action::SetInput {
             value: b(0),
             pulse_ns: Some(x(1))

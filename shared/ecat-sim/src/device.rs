@@ -321,6 +321,8 @@ impl Cia402Drive {
             velocity_offset: od.value(0x60B1, 0) as i32,
             torque_offset: od.value(0x60B2, 0) as i16,
             max_torque: od.value(0x6072, 0) as u16,
+            positive_torque_limit: od.value(0x60E0, 0) as u16,
+            negative_torque_limit: od.value(0x60E1, 0) as u16,
             touch_probe_function: od.value(0x60B8, 0) as u16,
         };
         self.servo.exchange(&command);
@@ -412,6 +414,8 @@ fn dictionary(id: Identity) -> Vec<Entry> {
         tx(0x60BB, 4),
         tx(0x60BC, 4),
         tx(0x60BD, 4),
+        rx(0x60E0, 2),
+        rx(0x60E1, 2),
         tx(0x60F4, 4),
         tx(0x60FD, 4),
         rx(0x60FF, 4),

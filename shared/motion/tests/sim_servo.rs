@@ -925,3 +925,50 @@ fn the_cyclic_path_does_not_allocate() {
     assert!(latches > 1_000, "{latches}");
     assert_eq!(fb.digital_inputs, 7);
 }
+
+/// A mechanical stop: CSV at 2^20 increments/s into a stop 100,000 increments ahead, the motor
+/// stops dead on it and pushes with the 0x6072 limit (500 ‰); removed, it moves on.
+#[test]
+fn a_fixed_stop_holds_the_motor_at_the_limit_until_it_gives_way() {
+    let mut servo = SimServo::new(frictionless()).unwrap();
+    let stop = servo.position() + 100_000.0;
+    servo.set_fixed_stops(None, Some(stop));
+    enable(&mut servo, CSV);
+    let cmd = DriveCommand {
+        max_torque: 500,
+        ..csv(1 << 20)
+    };
+    let mut fb = cycle(&mut servo, &cmd);
+    for _ in 0..500 {
+        fb = cycle(&mut servo, &cmd);
+    }
+    assert_eq!(servo.position(), stop);
+    assert_eq!(servo.velocity(), 0.0);
+    assert_eq!(fb.torque_actual, 500, "{fb:?}");
+    assert_ne!(fb.statusword & statusword::INTERNAL_LIMIT_ACTIVE, 0);
+    servo.set_fixed_stops(None, None);
+    cycle(&mut servo, &cmd);
+    assert!(servo.position() > stop);
+}
+
+/// The one-sided limits 0x60E0 / 0x60E1 narrow the loop's torque in their direction only:
+/// against a stop above, 300 ‰ up; against a stop below, 200 ‰ down.
+#[test]
+fn the_positive_and_negative_torque_limits_apply_one_side_each() {
+    for (velocity, expected) in [(1 << 20, 300), (-(1 << 20), -200)] {
+        let mut servo = SimServo::new(frictionless()).unwrap();
+        let p = servo.position();
+        servo.set_fixed_stops(Some(p - 1000.0), Some(p + 1000.0));
+        enable(&mut servo, CSV);
+        let cmd = DriveCommand {
+            positive_torque_limit: 300,
+            negative_torque_limit: 200,
+            ..csv(velocity)
+        };
+        let mut fb = cycle(&mut servo, &cmd);
+        for _ in 0..200 {
+            fb = cycle(&mut servo, &cmd);
+        }
+        assert_eq!(fb.torque_actual, expected, "{fb:?}");
+    }
+}

@@ -107,10 +107,29 @@ pub struct Cia402Link {
     /// Torque feedforward 0x60B2 in per mille of the rated torque 0x6076 per drive
     /// increment/s² of the setpoint acceleration; `None`: off.
     torque_per_acceleration: Option<f64>,
+    /// The torque interface (MC_TorqueLimiting, MC_TorqueAdditive, MC_TorqueRange,
+    /// `ActualTorque`): per mille of the rated torque 0x6076 per unit of the axis's torque or
+    /// force at the load (through the gear, leadscrew, efficiency and the drive's inversion;
+    /// a linear axis's N through `position_unit_m`); `None`: the drive's rated torque is not
+    /// known, the axis has no torque interface.
+    pub(crate) per_mille_per_load: Option<f64>,
     /// The touch probe homing latches with: 2 when probe 1 serves a measuring input, else 1.
     homing_probe: u8,
     /// The homing mark the homing probe is armed for (as last commanded).
     homing_armed: Option<HomingLatch>,
+}
+
+/// The torque objects of one command (per mille of the rated torque; 0: not limited).
+#[derive(Copy, Clone, Debug, Default)]
+struct TorqueObjects {
+    /// Max torque 0x6072.
+    max_torque: u16,
+    /// Positive torque limit value 0x60E0.
+    positive: u16,
+    /// Negative torque limit value 0x60E1.
+    negative: u16,
+    /// Added to the torque offset 0x60B2.
+    additive: f64,
 }
 
 /// Whether measuring input `m` measures through its axis's drive's touch probe: route
@@ -274,6 +293,32 @@ impl Drives {
                         / params.rated_torque
                         * 1e3
                 });
+            link.per_mille_per_load = params.map(|params| {
+                let unit = if c.scaling.mechanics().leadscrew_pitch.is_some() {
+                    a.config.torque.position_unit_m
+                } else {
+                    1.0
+                };
+                unit / c.scaling.torque_factor() / params.rated_torque * 1e3
+            });
+            if let Some(Some(Slot {
+                device: Device::SimServo(servo),
+                ..
+            })) = slots.get_mut(c.device.0)
+            {
+                let at = |x: Option<f64>| x.map(|x| f64::from(c.scaling.drive_increments(x)));
+                let (lo, hi) = (
+                    at(a.config.plant.fixed_stop_min),
+                    at(a.config.plant.fixed_stop_max),
+                );
+                // The drive's increments run the other way with an inverted drive.
+                let (lo, hi) = if c.scaling.mechanics().inverse_drive {
+                    (hi, lo)
+                } else {
+                    (lo, hi)
+                };
+                servo.set_fixed_stops(lo, hi);
+            }
             if let (Some((lo, hi)), Some(Some(slot))) =
                 (a.config.plant.reference_cam, slots.get_mut(c.device.0))
             {
@@ -432,6 +477,41 @@ impl Drives {
     pub(crate) fn feedback(&self, device: usize) -> Option<&DriveFeedback> {
         self.slots.get(device)?.as_ref().map(|s| &s.feedback)
     }
+
+    /// The last command to device `device`, simulated or external (for traces and tests).
+    pub(crate) fn command_of(&self, device: usize) -> Option<&DriveCommand> {
+        self.slots.get(device)?.as_ref().map(|s| &s.command)
+    }
+
+    /// Moves the mechanical stops of simulated servo `device` to `min` and `max`, positions of
+    /// its axis's load (`None`: no stop there, e.g. the stop gave way); `false` when this
+    /// executive runs no such servo.
+    pub(crate) fn set_fixed_stops(
+        &mut self,
+        device: usize,
+        min: Option<f64>,
+        max: Option<f64>,
+    ) -> bool {
+        let Some(link) = self.links.iter().find(|l| l.device == device) else {
+            return false;
+        };
+        let at = |x: Option<f64>| x.map(|x| f64::from(link.scaling.drive_increments(x)));
+        let (lo, hi) = if link.scaling.mechanics().inverse_drive {
+            (at(max), at(min))
+        } else {
+            (at(min), at(max))
+        };
+        match self.slots.get_mut(device) {
+            Some(Some(Slot {
+                device: Device::SimServo(servo),
+                ..
+            })) => {
+                servo.set_fixed_stops(lo, hi);
+                true
+            }
+            _ => false,
+        }
+    }
 }
 
 impl Cia402Link {
@@ -464,6 +544,7 @@ impl Cia402Link {
             operational: false,
             statusword: 0,
             torque_per_acceleration: None,
+            per_mille_per_load: None,
             homing_probe: 1,
             homing_armed: None,
         })
@@ -588,6 +669,9 @@ impl Cia402Link {
             state,
             in_limitation: self.operational
                 && fb.statusword & statusword::INTERNAL_LIMIT_ACTIVE != 0,
+            torque_actual: self
+                .per_mille_per_load
+                .map_or(0.0, |k| f64::from(fb.torque_actual) / k),
         }
     }
 
@@ -770,7 +854,8 @@ impl Cia402Link {
         let torque = self.torque_per_acceleration.map_or(0.0, |k| {
             k * self.scaling.drive_increments_per_second(out.acceleration)
         });
-        let torque_offset = torque
+        let limits = self.torque_limits(out);
+        let torque_offset = (torque + limits.additive)
             .round()
             .clamp(f64::from(i16::MIN), f64::from(i16::MAX)) as i16;
         let velocity_mode = !out.position_controlled && self.operational;
@@ -785,8 +870,35 @@ impl Cia402Link {
             target_velocity: if velocity_mode { v } else { 0 },
             velocity_offset: if velocity_mode { 0 } else { v },
             torque_offset,
+            max_torque: limits.max_torque,
+            positive_torque_limit: limits.positive,
+            negative_torque_limit: limits.negative,
             touch_probe_function: probe,
             ..DriveCommand::default()
+        }
+    }
+
+    /// The torque objects for the axis's torque jobs (see docs/io.md, 'Torque limits and
+    /// additive torque'): MC_TorqueLimiting's limit as max torque 0x6072, MC_TorqueRange's
+    /// limits as 0x60E0 / 0x60E1 (swapped with an inverted drive), MC_TorqueAdditive's torque
+    /// added to the torque offset 0x60B2, all in per mille of the rated torque. A limit rounds
+    /// to at least 1 ‰: 0 in these objects means "no limit from the controller".
+    fn torque_limits(&self, out: &DriveOutputs) -> TorqueObjects {
+        let Some(k) = self.per_mille_per_load else {
+            return TorqueObjects::default();
+        };
+        let per_mille = |x: f64| x.round().clamp(1.0, f64::from(u16::MAX)) as u16;
+        let t = &out.torque;
+        let (positive, negative) = t.range.map_or((0, 0), |(upper, lower)| {
+            let (a, b) = (upper * k, lower * k);
+            let (hi, lo) = (a.max(b), a.min(b));
+            (per_mille(hi), per_mille(-lo))
+        });
+        TorqueObjects {
+            max_torque: t.limit.map_or(0, |l| per_mille((l * k).abs())),
+            positive,
+            negative,
+            additive: t.additive * k,
         }
     }
 }

@@ -554,6 +554,7 @@ impl<'c> Executive<'c> {
         for link in &drives.links {
             if let Some(a) = axes.get_mut(link.axis) {
                 a.connect_drive();
+                a.set_torque_interface(link.per_mille_per_load.is_some());
             }
         }
         for link in &drives.analog.links {
@@ -846,6 +847,13 @@ impl<'c> Executive<'c> {
                     .inject_fault(d, code)
                     .map(|()| None)
                     .map_err(|_| ErrorId::IllegalObject);
+            }
+            Action::FixedStop { min, max } => {
+                let d = cell.devices.iter().position(|d| d.name == target);
+                return match d {
+                    Some(d) if self.drives.set_fixed_stops(d, min, max) => Ok(None),
+                    _ => Err(ErrorId::IllegalObject),
+                };
             }
         };
         if let Some(k) = self.names.encoder(target) {
@@ -1183,6 +1191,19 @@ impl<'c> Executive<'c> {
         device: usize,
     ) -> Option<&tandem_motion::plant::cia402::DriveCommand> {
         self.drives.external_command(device)
+    }
+
+    /// The RxPDO the last step wrote for drive `device` (simulated or external), if this
+    /// executive runs it.
+    pub fn drive_rx(&self, device: usize) -> Option<&tandem_motion::plant::cia402::DriveCommand> {
+        self.drives.command_of(device)
+    }
+
+    /// Moves the mechanical stops of simulated servo `device` (index in [`Cell::devices`]) to
+    /// `min` / `max`, positions of its axis's load (`None` removes one: the stop gives way);
+    /// `false` when this executive runs no such servo.
+    pub fn set_fixed_stops(&mut self, device: usize, min: Option<f64>, max: Option<f64>) -> bool {
+        self.drives.set_fixed_stops(device, min, max)
     }
 
     /// The TxPDO that drive `device` gave at the last boundary, if this executive runs it.

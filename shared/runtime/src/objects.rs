@@ -763,9 +763,10 @@ impl Objects {
         action: Action,
     ) -> Result<(), ErrorId> {
         match action {
-            Action::DriveFault { .. } | Action::SetInput { .. } | Action::SetInputValue { .. } => {
-                Err(ErrorId::IllegalObject)
-            }
+            Action::DriveFault { .. }
+            | Action::FixedStop { .. }
+            | Action::SetInput { .. }
+            | Action::SetInputValue { .. } => Err(ErrorId::IllegalObject),
             Action::OutputCam {
                 enable,
                 on_position,

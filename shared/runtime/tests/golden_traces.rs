@@ -26,6 +26,7 @@ const EXAMPLES: &[&str] = &[
     "print-mark-registration",
     "press",
     "servo",
+    "fixed-stop",
     "analog",
     "inputs",
     "hydraulic",

@@ -270,6 +270,20 @@ fn the_force_control_stages_step_without_allocating() {
     assert!(exec.commands == 7 && exec.rejected == 0);
 }
 
+/// MC_TorqueLimiting's fixed stop detection (`config/fixed-stop.toml`): a torque-limited move
+/// into the simulated servo's mechanical stop, the detection, clamping at the limit, a new
+/// limit while clamped, the stop giving way (alarm 542) and the reset, with 0 allocations.
+#[test]
+fn the_torque_limited_move_into_the_fixed_stop_steps_without_allocating() {
+    let cell = example_cell("fixed-stop");
+    let (mut exec, allocations) = run_counting(&cell, "fixed-stop");
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    // It did work: clamped at the stop, then the clamping alarm, acknowledged.
+    let st = exec.status()[0];
+    assert!((st.actual_position - 50.0).abs() < 1.0, "{st:?}");
+    assert!(exec.commands == 7 && exec.rejected == 0);
+}
+
 /// MC_DigitalCamSwitch_BkPlcMc (`config/hydraulic-cam-switch.toml`): the library's worked
 /// example on the ram, its two tracks on digital outputs through both moves and the mask
 /// change, with 0 allocations.

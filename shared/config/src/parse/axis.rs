@@ -10,6 +10,7 @@ use tandem_motion::kinematics::modulo::Modulo;
 use tandem_motion::objects::axis::{
     AxisConfig, AxisKind, EncoderType, FollowingErrorMonitoring, HomingConfig, HomingMark,
     MotionType, PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
+    TorqueConfig,
 };
 use tandem_motion::plant::drive::{DriveModel, Plant, ZeroMark};
 
@@ -112,6 +113,13 @@ pub(super) fn axis_config(a: &AxisSection, cycle: f64) -> Result<AxisConfig, Fie
         initial_position: a.initial_position,
         extrapolation,
         hydraulic,
+        torque: TorqueConfig {
+            limit_default: a.torque_limiting.limit_default,
+            keep_position_monitorings: a.torque_limiting.keep_position_monitorings,
+            clamping_deviation: a.clamping.following_error_deviation,
+            clamping_tolerance: a.clamping.position_tolerance,
+            position_unit_m: a.torque_limiting.position_unit_m,
+        },
     })
 }
 
@@ -197,6 +205,8 @@ fn plant(a: &AxisSection) -> Plant {
         }),
         hw_limit_min: hw.and_then(|h| h.min),
         hw_limit_max: hw.and_then(|h| h.max),
+        fixed_stop_min: a.plant.fixed_stop_min,
+        fixed_stop_max: a.plant.fixed_stop_max,
     }
 }
 

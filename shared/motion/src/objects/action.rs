@@ -79,6 +79,15 @@ pub enum Action {
         /// The error code, or 0.
         code: u16,
     },
+    /// The mechanical stops of the simulated servo named by the entry moved to `min` / `max`
+    /// (positions of its axis's load; `None`: no stop there, e.g. the stop gave way), from the
+    /// entry's time.
+    FixedStop {
+        /// The stop below the load, if any.
+        min: Option<f64>,
+        /// The stop above the load, if any.
+        max: Option<f64>,
+    },
     /// The simulated input signal named by the entry set to `value` at the entry's time
     /// exactly; with `pulse_ns > 0`, back to `!value` that long after.
     SetInput {

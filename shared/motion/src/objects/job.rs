@@ -106,6 +106,12 @@ pub enum Instruction {
     PhasingAbsolute,
     /// `MC_PhasingRelative`.
     PhasingRelative,
+    /// `MC_TorqueLimiting`: force/torque limiting and fixed stop detection.
+    TorqueLimiting,
+    /// `MC_TorqueAdditive`: an additive torque.
+    TorqueAdditive,
+    /// `MC_TorqueRange`: upper and lower torque limits.
+    TorqueRange,
 }
 
 impl Instruction {
@@ -155,6 +161,9 @@ impl Instruction {
             Self::OffsetRelative => "MC_OffsetRelative",
             Self::PhasingAbsolute => "MC_PhasingAbsolute",
             Self::PhasingRelative => "MC_PhasingRelative",
+            Self::TorqueLimiting => "MC_TorqueLimiting",
+            Self::TorqueAdditive => "MC_TorqueAdditive",
+            Self::TorqueRange => "MC_TorqueRange",
         }
     }
 }

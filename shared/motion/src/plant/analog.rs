@@ -753,6 +753,7 @@ impl AnalogConnection {
             // encoder's or a drive's measuring input would (homing modes 2, 3, 5, 8, 10).
             signals: AxisSignals::of_plant(&self.plant, prev, p),
             in_limitation: false,
+            torque_actual: 0.0,
             state: self.enable.drive_state(),
         }
     }

@@ -452,6 +452,14 @@ pub struct DriveCommand {
     /// the drive's own limit applies.
     #[doc(alias = "0x6072")]
     pub max_torque: u16,
+    /// Positive torque limit value 0x60E0 (per mille of the rated torque): the largest torque
+    /// in the positive direction; 0 as for 0x6072 (not sent: no limit from the controller).
+    #[doc(alias = "0x60E0")]
+    pub positive_torque_limit: u16,
+    /// Negative torque limit value 0x60E1 (per mille, a magnitude): the largest torque in the
+    /// negative direction; 0 as for 0x6072.
+    #[doc(alias = "0x60E1")]
+    pub negative_torque_limit: u16,
     /// Touch probe function 0x60B8 (see [`touch_probe`]).
     #[doc(alias = "0x60B8")]
     pub touch_probe_function: u16,

@@ -44,6 +44,12 @@ pub struct Plant {
     pub hw_limit_min: Option<f64>,
     /// Positive hardware limit switch: active at or above this physical position.
     pub hw_limit_max: Option<f64>,
+    /// A mechanical (fixed) stop the load cannot pass below this physical position (only the
+    /// simulated CiA 402 servo has one: the axis's own drive model has no torque).
+    pub fixed_stop_min: Option<f64>,
+    /// A mechanical stop the load cannot pass above this physical position (as
+    /// `fixed_stop_min`).
+    pub fixed_stop_max: Option<f64>,
 }
 
 impl Plant {

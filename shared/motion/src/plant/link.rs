@@ -111,6 +111,11 @@ pub struct DriveInputs {
     /// limit active", e.g. its torque limit): the axis shows StatusWord X27 "InLimitation".
     #[doc(alias = "InLimitation")]
     pub in_limitation: bool,
+    /// The drive's actual torque (CiA 402 torque actual value 0x6077) at the load, in the
+    /// axis's torque or force unit (N·m, or N on a linear axis); 0 for a drive without one
+    /// (`StatusTorqueData.ActualTorque`).
+    #[doc(alias = "ActualTorque")]
+    pub torque_actual: f64,
 }
 
 /// What the axis writes at the end of its cycle: the setpoint for the next cycle.
@@ -138,6 +143,27 @@ pub struct DriveOutputs {
     pub homing_latch: Option<HomingLatch>,
     /// A hydraulic axis' values for its valve's Finish stage (zero for other axes).
     pub hydraulic: HydValveOutputs,
+    /// The torque limits and the additive torque (MC_TorqueLimiting, MC_TorqueRange,
+    /// MC_TorqueAdditive), at the load; none without those jobs.
+    pub torque: TorqueOutputs,
+}
+
+/// What the torque instructions give the drive, at the load in the axis's torque or force unit
+/// (N·m, or N on a linear axis: S7-1500T Motion Control V4.0, 'Force/torque limiting'); the
+/// drive link converts them through the mechanics to the drive's per mille of the rated
+/// torque. In the axis's sense of direction (the link inverts them with the drive's
+/// direction).
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct TorqueOutputs {
+    /// MC_TorqueLimiting: the force/torque limit (>= 0), the same in both directions.
+    #[doc(alias = "MC_TorqueLimiting")]
+    pub limit: Option<f64>,
+    /// MC_TorqueRange: the upper and the lower torque limit (upper > lower).
+    #[doc(alias = "MC_TorqueRange")]
+    pub range: Option<(f64, f64)>,
+    /// MC_TorqueAdditive: the additive torque (0 without the job).
+    #[doc(alias = "MC_TorqueAdditive")]
+    pub additive: f64,
 }
 
 /// What a hydraulic axis gives its valve's Finish stage besides the setpoint (Beckhoff TwinCAT
@@ -251,6 +277,7 @@ impl SimPlant {
                 signals: AxisSignals::default(),
                 state: DriveState::Operational,
                 in_limitation: false,
+                torque_actual: 0.0,
             };
         }
         let inputs = self.inputs;
@@ -273,6 +300,7 @@ impl SimPlant {
             signals,
             state: DriveState::Operational,
             in_limitation: false,
+            torque_actual: 0.0,
         }
     }
 

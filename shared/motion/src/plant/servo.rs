@@ -578,6 +578,9 @@ pub struct SimServo {
     /// Marks on the load that switch the probe inputs: input `k` is high while the position
     /// (increments) is within `marks[k]`.
     marks: [Option<(f64, f64)>; 2],
+    /// Mechanical stops on the load (increments): rigid walls the motor cannot pass below the
+    /// first or above the second.
+    fixed_stops: (Option<f64>, Option<f64>),
 }
 
 impl SimServo {
@@ -612,7 +615,22 @@ impl SimServo {
             probes: [Probe::default(); 2],
             edges: [None; PROBE_EDGE_CAPACITY],
             marks: [None; 2],
+            fixed_stops: (None, None),
         })
+    }
+
+    /// Puts rigid mechanical stops in the way of the load (motor increments): the motor stops
+    /// dead when it reaches `min` from above or `max` from below (an inelastic impact) and
+    /// stays there while its torque pushes into the stop; `None` removes a stop (the stop
+    /// gives way). A stop moved to where the motor already is beyond it holds it there.
+    #[doc(alias = "fixed stop")]
+    pub fn set_fixed_stops(&mut self, min: Option<f64>, max: Option<f64>) {
+        self.fixed_stops = (min.filter(|x| x.is_finite()), max.filter(|x| x.is_finite()));
+    }
+
+    /// The mechanical stops (motor increments).
+    pub const fn fixed_stops(&self) -> (Option<f64>, Option<f64>) {
+        self.fixed_stops
     }
 
     /// Puts a mark on the load in front of touch probe input `probe` (1 or 2): the input is
@@ -828,8 +846,20 @@ impl SimServo {
             dt_ns as f64 * 1e-9,
         );
         let from = self.position;
-        let to = from + e.distance * self.counts_per_rad;
-        match e.stop {
+        let mut to = from + e.distance * self.counts_per_rad;
+        let mut omega = e.omega;
+        let mut stop = e.stop;
+        if let Some(m) = self.fixed_stops.1.filter(|&m| to > m) {
+            to = from.max(m);
+            omega = omega.min(0.0);
+            stop = None;
+        }
+        if let Some(m) = self.fixed_stops.0.filter(|&m| to < m) {
+            to = from.min(m);
+            omega = omega.max(0.0);
+            stop = None;
+        }
+        match stop {
             Some(d) => {
                 let turn = from + d * self.counts_per_rad;
                 self.zero_pulses(from, turn);
@@ -843,7 +873,7 @@ impl SimServo {
             }
         }
         self.position = to;
-        self.omega = e.omega;
+        self.omega = omega;
     }
 
     /// Latches the edges of the probe inputs' marks crossed moving monotonically from `from`
@@ -938,6 +968,20 @@ impl SimServo {
         self.params.rated_torque * f64::from(per_mille) * 1e-3
     }
 
+    /// The torque range of the loops (N·m): the limit in force, narrowed by the positive and
+    /// negative torque limit values 0x60E0 / 0x60E1 where they are not 0.
+    fn torque_bounds(&self) -> (f64, f64) {
+        let limit = self.torque_limit();
+        let of = |per_mille: u16| match per_mille {
+            0 => limit,
+            m => limit.min(self.params.rated_torque * f64::from(m) * 1e-3),
+        };
+        (
+            -of(self.command.negative_torque_limit),
+            of(self.command.positive_torque_limit),
+        )
+    }
+
     fn brake(&self, option: QuickStopOption) -> Actuation {
         use QuickStopOption as O;
         let p = &self.params;
@@ -981,8 +1025,8 @@ impl SimServo {
                 let demand = (i32::from(self.command.target_torque)
                     + i32::from(self.command.torque_offset)) as f64
                     * rated;
-                let limit = self.torque_limit();
-                let torque = demand.clamp(-limit, limit);
+                let (lo, hi) = self.torque_bounds();
+                let torque = demand.clamp(lo, hi);
                 Actuation::Torque {
                     torque,
                     limited: torque != demand,
@@ -1000,8 +1044,8 @@ impl SimServo {
         let ti = p.velocity_loop_integral_time;
         let integral_term = if ti > 0.0 { self.integral / ti } else { 0.0 };
         let demand = p.velocity_loop_gain * (error + integral_term) + feedforward;
-        let limit = self.torque_limit();
-        let torque = demand.clamp(-limit, limit);
+        let (lo, hi) = self.torque_bounds();
+        let torque = demand.clamp(lo, hi);
         let limited = torque != demand;
         if ti > 0.0 && (!limited || (demand > 0.0) != (error > 0.0)) {
             self.integral += error * h;

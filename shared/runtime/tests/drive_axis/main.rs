@@ -10,6 +10,7 @@
 mod homing;
 mod modes;
 mod stop;
+mod torque;
 
 use tandem_config::{AxisIndex, Cell};
 use tandem_motion::catalog::alarm::AlarmId;

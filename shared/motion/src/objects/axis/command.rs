@@ -656,6 +656,39 @@ pub enum Command {
         /// `PositionControlled`.
         position_controlled: bool,
     },
+    /// `MC_TorqueLimiting`: force/torque limiting (mode 0) or fixed stop detection (mode 1),
+    /// an enable-type job (S7-1500T Motion Control V4.0, 'MC_TorqueLimiting V4'). Sent each
+    /// cycle while enabled (Limit and Mode are re-read); `enable` false ends the job.
+    #[doc(alias = "MC_TorqueLimiting")]
+    TorqueLimiting {
+        /// `Enable`.
+        enable: bool,
+        /// `Limit` (N·m, or N on a linear axis): >= 0 used (0 too); < 0 the configured
+        /// `torque_limiting.limit_default`.
+        limit: f64,
+        /// `Mode`: 0 force/torque limiting, 1 fixed stop detection.
+        mode: i32,
+    },
+    /// `MC_TorqueAdditive`: an additive torque while enabled (S7-1500T Motion Control V4.0,
+    /// 'MC_TorqueAdditive V4').
+    #[doc(alias = "MC_TorqueAdditive")]
+    TorqueAdditive {
+        /// `Enable`.
+        enable: bool,
+        /// `Value` (N·m, or N on a linear axis; -1e12..1e12).
+        value: f64,
+    },
+    /// `MC_TorqueRange`: upper and lower torque limits while enabled (S7-1500T Motion Control
+    /// V4.0, 'MC_TorqueRange V4').
+    #[doc(alias = "MC_TorqueRange")]
+    TorqueRange {
+        /// `Enable`.
+        enable: bool,
+        /// `UpperLimit` (default 1e12).
+        upper_limit: f64,
+        /// `LowerLimit` (default -1e12).
+        lower_limit: f64,
+    },
     /// `MC_GearIn`: relative gearing; synchronizes with the given dynamics, then `InGear`.
     #[doc(alias = "MC_GearIn")]
     GearIn {

@@ -222,6 +222,47 @@ pub struct AxisConfig {
     /// displacement-based generator of the Beckhoff TwinCAT PLC Hydraulic Positioning library
     /// instead of the jerk-limited profile. `None`: an electric axis.
     pub hydraulic: Option<HydraulicProfile>,
+    /// `TorqueLimiting.*` and `Clamping.*`: MC_TorqueLimiting's default limit, fixed stop
+    /// detection and the monitorings under torque limits.
+    pub torque: TorqueConfig,
+}
+
+/// `TorqueLimiting.*` and `Clamping.*` (S7-1500T Motion Control V4.0, 'Force/torque limiting'
+/// and 'Fixed stop detection').
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct TorqueConfig {
+    /// `TorqueLimiting.LimitDefaults.Torque` / `.Force` (N·m, or N on a linear axis, >= 0):
+    /// the limit of MC_TorqueLimiting with `Limit` < 0. `None`: such a job is refused
+    /// (16#8043).
+    #[doc(alias = "LimitDefaults")]
+    pub limit_default: Option<f64>,
+    /// `TorqueLimiting.PositionBasedMonitorings` = 1: the following error and positioning
+    /// monitorings stay active under MC_TorqueLimiting and MC_TorqueRange (default false: off
+    /// while limiting).
+    #[doc(alias = "PositionBasedMonitorings")]
+    pub keep_position_monitorings: bool,
+    /// `Clamping.FollowingErrorDeviation` (position units, > 0): mode 1 detects the fixed stop
+    /// when the following error exceeds it.
+    #[doc(alias = "FollowingErrorDeviation")]
+    pub clamping_deviation: f64,
+    /// `Clamping.PositionTolerance` (position units, 0.001..deviation): while clamped, the
+    /// axis leaving this window around the clamping position raises alarm 542.
+    #[doc(alias = "PositionTolerance")]
+    pub clamping_tolerance: f64,
+    /// Metres per position unit of a linear axis (0.001: mm), so that its force is in N.
+    pub position_unit_m: f64,
+}
+
+impl Default for TorqueConfig {
+    fn default() -> Self {
+        Self {
+            limit_default: None,
+            keep_position_monitorings: false,
+            clamping_deviation: 1.0,
+            clamping_tolerance: 0.1,
+            position_unit_m: 0.001,
+        }
+    }
 }
 
 /// The displacement-based positioning of a hydraulic axis: the generator's parameters and the
@@ -287,6 +328,9 @@ pub enum AxisConfigProblem {
     HardwareLimitsReversed,
     /// A parameter of a hydraulic axis out of its range (the field is the library's name).
     HydraulicParameter,
+    /// `Clamping.PositionTolerance` not below `Clamping.FollowingErrorDeviation`, or the
+    /// deviation not below the maximum following error.
+    ClampingWindows,
 }
 
 impl AxisConfigProblem {
@@ -310,6 +354,7 @@ impl AxisConfigProblem {
             Self::ReferenceCamReversed => "must be [low, high] with high > low",
             Self::HardwareLimitsReversed => "must be greater than plant.hw_limit_min",
             Self::HydraulicParameter => "is out of its range (Beckhoff hydraulic positioning library, ST_TcHydAxParam)",
+            Self::ClampingWindows => "must satisfy 0.001 <= clamping.position_tolerance < clamping.following_error_deviation (and that < following_error.max_value with torque_limiting.keep_position_monitorings)",
         }
     }
 }
@@ -422,6 +467,7 @@ impl AxisConfig {
             extrapolation: ExtrapolationConfig::default(),
             leader_missing_reaction: None,
             hydraulic: None,
+            torque: TorqueConfig::default(),
         }
     }
 
@@ -447,6 +493,33 @@ impl AxisConfig {
         self.validate_plant()?;
         self.validate_extrapolation()?;
         self.validate_hydraulic()?;
+        self.validate_torque()?;
+        Ok(())
+    }
+
+    /// `TorqueLimiting.*` and `Clamping.*`: the tolerance below the deviation, the deviation
+    /// below the maximum following error when that monitoring stays on under limiting
+    /// (S7-1500T Motion Control V4.0, 'Fixed stop detection': "When following error
+    /// monitoring is activated, the configured following error must be greater").
+    fn validate_torque(&self) -> Result<(), AxisConfigError> {
+        let t = &self.torque;
+        if let Some(l) = t.limit_default {
+            non_negative("torque_limiting.limit_default", l)?;
+            finite("torque_limiting.limit_default", l)?;
+        }
+        positive("torque_limiting.position_unit_m", t.position_unit_m)?;
+        positive("clamping.following_error_deviation", t.clamping_deviation)?;
+        positive("clamping.position_tolerance", t.clamping_tolerance)?;
+        let fe = &self.following_error;
+        let windows = t.clamping_tolerance >= 0.001
+            && t.clamping_tolerance < t.clamping_deviation
+            && (!(fe.enable && t.keep_position_monitorings) || t.clamping_deviation < fe.max_value);
+        if !windows {
+            return Err(AxisConfigError {
+                field: "clamping.position_tolerance",
+                problem: AxisConfigProblem::ClampingWindows,
+            });
+        }
         Ok(())
     }
 

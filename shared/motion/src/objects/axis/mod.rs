@@ -18,6 +18,7 @@ mod hyd_slow_down;
 mod hydraulic;
 mod step;
 mod sync;
+mod torque;
 
 pub use adjustment::{AbsoluteOffset, RestoreOffsetError};
 pub use buffer::JOB_QUEUE_CAPACITY;
@@ -28,7 +29,7 @@ pub use command::{
 pub use config::{
     AxisConfig, AxisConfigError, AxisConfigProblem, AxisKind, EncoderType,
     FollowingErrorMonitoring, HomingConfig, HomingMark, HydraulicProfile, MotionType,
-    PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal,
+    PassiveDirection, PositioningMonitoring, Sense, SoftwareLimits, StandstillSignal, TorqueConfig,
     JOG_VELO_DEFAULTS,
 };
 pub use hyd_home::{
@@ -38,6 +39,7 @@ pub use hyd_home::{
 };
 pub use hydraulic::HydraulicStatus;
 pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
+pub use torque::{TorqueStatus, TORQUE_VALUE_MAX};
 
 use crate::catalog::alarm::{supplement, AlarmId, AlarmInstance, ErrorDetail, Reaction};
 use crate::catalog::error_id::ErrorId;
@@ -333,6 +335,8 @@ pub struct Axis {
     enabled: bool,
     /// The connected drive works at its own limit (StatusWord X27 "InLimitation").
     in_limitation: bool,
+    /// A torque job is active (`torque` has one): the cycle looks at `torque` only then.
+    torque_active: bool,
     pos_ctrl: bool,
     homed: bool,
     stop_lock: bool,
@@ -386,6 +390,9 @@ pub struct Axis {
     absolute: AbsoluteOffset,
     /// Jobs queued behind `main` (PLCopen BufferMode); read only when a job ends.
     queue: buffer::JobQueue,
+    /// MC_TorqueLimiting, MC_TorqueAdditive and MC_TorqueRange (read by the cycle only while
+    /// `torque_active`).
+    torque: torque::TorqueJobs,
 }
 
 fn sign(x: f64) -> f64 {
@@ -427,6 +434,7 @@ impl Axis {
             },
             enabled: false,
             in_limitation: false,
+            torque_active: false,
             pos_ctrl: false,
             offset: 0.0,
             absolute,
@@ -470,6 +478,7 @@ impl Axis {
             events: EventQueue::default(),
             next_id: 1,
             queue: buffer::JobQueue::default(),
+            torque: torque::TorqueJobs::default(),
             hyd: cfg
                 .hydraulic
                 .as_ref()
@@ -1091,6 +1100,9 @@ impl Axis {
             Command::MotionInPosition { .. } | Command::MotionInVelocity { .. } => {
                 self.apply_motion_in(cmd)
             }
+            Command::TorqueLimiting { .. }
+            | Command::TorqueAdditive { .. }
+            | Command::TorqueRange { .. } => self.apply_torque(cmd),
         }
     }
 
@@ -1172,6 +1184,7 @@ impl Axis {
                 VelocityDirection::Negative => -speed,
             }
         };
+        self.check_clamping(sign(v), position_controlled)?;
         self.warn_clamped(r.clamped);
         self.apply_override_table(NewJob::Positioning);
         self.fold_superimposed();
@@ -1270,6 +1283,13 @@ impl Axis {
         if absolute && !self.homed {
             return Err(ErrorId::NotHomed);
         }
+        // Clamped at a fixed stop: only away from it (16#8047).
+        let toward = if absolute {
+            value - self.total().p
+        } else {
+            value
+        };
+        self.check_clamping(sign(toward), true)?;
         let r = self
             .cfg
             .limits
@@ -1488,6 +1508,9 @@ impl Axis {
             ..dynamics
         };
         let r = self.cfg.limits.resolve(&self.cfg.defaults, &d, true)?;
+        if forward != backward {
+            self.check_clamping(if forward { 1.0 } else { -1.0 }, position_controlled)?;
+        }
         if forward && backward {
             // Both inputs: brake with the last valid deceleration and report 16#8007.
             if let Some(m) = running {

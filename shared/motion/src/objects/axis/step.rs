@@ -45,6 +45,9 @@ impl Axis {
         self.hyd_commands_cycle();
         self.hyd_direct_cycle();
         self.monitor(act.balanced + self.offset);
+        if self.torque_active {
+            self.torque_cycle();
+        }
         self.hyd_auto_zero();
 
         let out = self.outputs();
@@ -72,6 +75,11 @@ impl Axis {
             quick_stop: self.power.quick_stop && !self.enabled && !self.power.awaiting_drive,
             homing_latch: self.homing_latch(),
             hydraulic: self.hyd_valve_outputs(direct),
+            torque: if self.torque_active {
+                self.torque.outputs()
+            } else {
+                crate::plant::link::TorqueOutputs::default()
+            },
         }
     }
 
@@ -670,7 +678,9 @@ impl Axis {
                         return Some(true);
                     }
                     None
-                } else if self.now - pm.start_ns > ns(pmc.tolerance_time) {
+                } else if self.now - pm.start_ns > ns(pmc.tolerance_time)
+                    && !self.position_monitorings_off()
+                {
                     self.raise_alarm(
                         AlarmId::PositioningMonitoring,
                         supplement::TARGET_NOT_REACHED,
@@ -706,7 +716,7 @@ impl Axis {
         } else {
             0.0
         };
-        if !(fe_cfg.enable && self.enabled && self.pos_ctrl) {
+        if !(fe_cfg.enable && self.enabled && self.pos_ctrl) || self.position_monitorings_off() {
             return;
         }
         let v = self.total().v.abs();
@@ -866,6 +876,14 @@ impl Axis {
                 self.enabled && !self.pos_ctrl,
             )
             | bit(status_bit::IN_LIMITATION, self.in_limitation)
+            | bit(
+                status_bit::TORQUE_LIMITING_COMMAND,
+                self.torque_active && self.torque.limiting_active(),
+            )
+            | bit(
+                status_bit::IN_CLAMPING,
+                self.torque_active && self.torque.in_clamping(),
+            )
     }
 
     /// The PLCopen state from the alarm reaction, the enable and the running jobs.
