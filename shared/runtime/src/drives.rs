@@ -646,11 +646,13 @@ impl Cia402Link {
                 DriveState::Disabled
             }
         };
-        let oldest = self
-            .setpoints
-            .get((self.head + 1) % self.transport.max(1))
-            .copied()
-            .unwrap_or_default();
+        // `(head + 1) % transport` without an integer division (`head < transport`).
+        let next = if self.head + 1 >= self.transport {
+            0
+        } else {
+            self.head + 1
+        };
+        let oldest = self.setpoints.get(next).copied().unwrap_or_default();
         let di = fb.digital_inputs;
         let (zero_mark, reference_cam_left) = self.homing_marks(fb);
         DriveInputs {
@@ -828,14 +830,16 @@ impl Cia402Link {
             // follows the setpoint that tracks the actual value.
             self.controlword = DeviceCommand::QuickStop.controlword();
         }
-        self.head = (self.head + 1) % self.transport.max(1);
+        // `(head + 1) % transport` without an integer division (`head < transport`).
+        self.head = if self.head + 1 >= self.transport {
+            0
+        } else {
+            self.head + 1
+        };
         if let Some(s) = self.setpoints.get_mut(self.head) {
             *s = out.position;
         }
-        let v = self
-            .scaling
-            .drive_increments_per_second(out.velocity)
-            .round();
+        let v = self.scaling.drive_increments_per_second_i32(out.velocity);
         let mut probe = if self.probe_armed {
             touch_probe::ENABLE
                 | touch_probe::SOURCE_INPUT
@@ -850,7 +854,6 @@ impl Cia402Link {
         } else {
             homing
         };
-        let v = v.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
         let torque = self.torque_per_acceleration.map_or(0.0, |k| {
             k * self.scaling.drive_increments_per_second(out.acceleration)
         });

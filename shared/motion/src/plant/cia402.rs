@@ -904,6 +904,25 @@ impl EnableSequence {
         state: Option<Cia402State>,
     ) -> (u16, EnableStatus) {
         use Cia402State as S;
+        if self.enabled
+            && self.previous_enable
+            && !self.previous_fault_reset
+            && request.enable
+            && !request.quick_stop
+            && !request.fault_reset
+            && state == Some(S::OperationEnabled)
+            && self.latched.is_none()
+            && self.leave_fault_since.is_none()
+        {
+            // Enabled and staying so (every cycle of a moving axis): what the steps below
+            // decide in this case, without them (no edge, no fault, nothing latched; `enabled`
+            // implies no step in progress).
+            self.step = None;
+            return (
+                DeviceCommand::EnableOperation.controlword(),
+                EnableStatus::Enabled,
+            );
+        }
         let in_fault = state.is_some_and(Cia402State::is_fault);
         if request.fault_reset && !self.previous_fault_reset {
             // The acknowledgement: clears a latched time-out or loss, and arms a fault reset

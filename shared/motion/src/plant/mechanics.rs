@@ -501,6 +501,49 @@ struct Ratio {
     /// `hi` split in halves ([`split`]), for the exact products of [`Ratio::units`] (the same
     /// halves [`two_product`] would split it into each call).
     hi_split: (f64, f64),
+    /// `1 / hi`, for velocities in counts per second by a product.
+    per_hi: f64,
+    /// `(1 - lo / hi) / hi`, counts per unit to first order in `lo / hi`: the first estimate of
+    /// [`Ratio::counts`] by a product instead of a division.
+    per_unit: f64,
+    /// The counts per period as a double, when it is exact (`0.0` when not).
+    counts_per_period_f64: f64,
+    /// `|count|` below this has an exact product with `units_per_period` (at most 53
+    /// significant bits), for [`Ratio::units`]'s quotient; 0 when the units or the counts per
+    /// period are not exact doubles (the quotient is then never taken).
+    quotient_limit: u64,
+}
+
+/// The number of significant bits of the finite, non-zero `x` (1..=53; 53 for subnormals,
+/// which never occur here).
+fn significant_bits(x: f64) -> u32 {
+    let bits = x.to_bits();
+    let exponent = (bits >> 52) & 0x7FF;
+    if exponent == 0 {
+        return 53;
+    }
+    let mantissa = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+    53 - mantissa.trailing_zeros()
+}
+
+/// `x` rounded to an integer (ties away from zero, as `f64::round`) for `|x| < 2^52`, without
+/// the library call `f64::round` is without SSE4.1: `x as i64` truncates and the fraction
+/// `x - trunc(x)` is exact there. Beyond `2^52` (every double an integer) and for NaN (0) the
+/// saturating cast, as `f64::round` followed by `as i64`.
+#[inline]
+fn round_to_i64(x: f64) -> i64 {
+    if x.is_nan() || x.abs() >= 4_503_599_627_370_496.0 {
+        return x as i64;
+    }
+    let i = x as i64;
+    let f = x - i as f64;
+    if f >= 0.5 {
+        i + 1
+    } else if f <= -0.5 {
+        i - 1
+    } else {
+        i
+    }
 }
 
 impl Ratio {
@@ -516,6 +559,14 @@ impl Ratio {
         // a - hi * b, with a_hi - p exact (Sterbenz: p is within an ulp of a_hi).
         let residual = (((a_hi - p) - e) + a_lo) - hi * b_lo;
         let lo = residual / b_hi;
+        // The quotient `count * a / b` is one product and one division when both are exact
+        // doubles: the product exact for counts of at most `53 - significant_bits(a)` bits.
+        let exact = a_lo == 0.0 && b_lo == 0.0 && a_hi.is_finite() && a_hi != 0.0;
+        let quotient_limit = if exact {
+            1u64 << (53 - significant_bits(a_hi))
+        } else {
+            0
+        };
         Self {
             counts_per_period,
             units_per_period: a_hi,
@@ -523,12 +574,33 @@ impl Ratio {
             lo,
             lo_over_hi: lo / hi,
             hi_split: split(hi),
+            per_hi: 1.0 / hi,
+            per_unit: (1.0 - lo / hi) / hi,
+            counts_per_period_f64: if exact { b_hi } else { 0.0 },
+            quotient_limit,
         }
+    }
+
+    /// Units of `count`, the correctly rounded `count * a / b` by one exact product and one
+    /// division where [`Ratio::new`] found `a` (units per period) and `b` (counts per period)
+    /// exact doubles and `count * a` is exact (`|count| < quotient_limit`); the double-double
+    /// product ([`Ratio::units_double_double`]) elsewhere. The two agree wherever the
+    /// double-double product is correctly rounded (all but ties within 2^-100 of a rounding
+    /// boundary; a quotient of integers below 2^53 has none: `count * a / b` is either a
+    /// double or at least 2^-53 / b of an ulp from the half-way point), which the unit test
+    /// below checks on random scalings and counts.
+    #[inline]
+    fn units(&self, count: i64) -> f64 {
+        if count.unsigned_abs() < self.quotient_limit {
+            // Both operands exact: IEEE division rounds the exact quotient correctly.
+            return (count as f64 * self.units_per_period) / self.counts_per_period_f64;
+        }
+        self.units_double_double(count)
     }
 
     /// Units of `count`: the product with both parts, `count` itself split when beyond 2^53.
     #[inline]
-    fn units(&self, count: i64) -> f64 {
+    fn units_double_double(&self, count: i64) -> f64 {
         let c_hi = count as f64;
         let c_lo = if count.unsigned_abs() <= 1 << 53 {
             0.0
@@ -554,15 +626,23 @@ impl Ratio {
         if x.is_infinite() {
             return if x > 0.0 { i64::MAX } else { i64::MIN };
         }
+        // The common case without a division or the double-double products. For |c| <= 2^40
+        // (|lo| <= hi·2^-53): `c·hi - x` as computed is within 3·2^-12·hi of `units(c) - x`,
+        // and two neighbouring `units` are at least (1 - 2^-11)·hi apart. So `|c·hi - x| <
+        // 0.49·hi` puts `units(c)` within 0.491·hi of `x` and its neighbour towards `x` more
+        // than 0.508·hi away: `refine` would keep `c` at its first comparison, and no other
+        // count passes the test. So it does not matter how `c` was estimated: the product with
+        // `per_unit`, truncated after adding half a count, is the same count as the division
+        // below wherever it passes. Float to integer casts saturate.
+        let e = x * self.per_unit;
+        let c = (e + 0.5f64.copysign(e)) as i64;
+        if c.unsigned_abs() <= 1 << 40 && ((c as f64) * self.hi - x).abs() < 0.49 * self.hi {
+            return c;
+        }
         // x / (hi + lo) to first order in lo / hi: within a count of the nearest for
-        // |count| <= 2^52. Float to integer casts saturate.
+        // |count| <= 2^52.
         let q = x / self.hi;
         let c = (q - q * self.lo_over_hi).round() as i64;
-        // The common case without the double-double products. For |c| <= 2^40 (|lo| <=
-        // hi·2^-53): `c·hi - x` as computed is within 3·2^-12·hi of `units(c) - x`, and two
-        // neighbouring `units` are at least (1 - 2^-11)·hi apart. So `|c·hi - x| < 0.49·hi`
-        // puts `units(c)` within 0.491·hi of `x` and its neighbour towards `x` more than
-        // 0.508·hi away: `refine` would keep `c` at its first comparison. The same count.
         if c.unsigned_abs() <= 1 << 40 && ((c as f64) * self.hi - x).abs() < 0.49 * self.hi {
             return c;
         }
@@ -740,6 +820,28 @@ impl Scaling {
     #[doc(alias = "0x60FF")]
     pub fn drive_increments_per_second(&self, units_per_s: f64) -> f64 {
         self.drive_sign * units_per_s / self.drive.hi
+    }
+
+    /// [`drive_increments_per_second`](Self::drive_increments_per_second) rounded to the
+    /// nearest integer (ties away from zero) and saturated to an `i32`, as a CSV target 0x60FF
+    /// or a velocity offset 0x60B1 is written: the same integer, by a product with `1 / hi`
+    /// where that is provably the same. For `|r| < 2^31` the product and the quotient differ by
+    /// at most 2 ulp of `r`, below 2^-20; a product whose fraction is within 0.49999 of the
+    /// nearest integer `n` puts the quotient within 0.5 of `n` too. Elsewhere (near a tie, out
+    /// of range, NaN) the quotient, rounded as before.
+    #[inline]
+    pub fn drive_increments_per_second_i32(&self, units_per_s: f64) -> i32 {
+        let r = self.drive_sign * units_per_s * self.drive.per_hi;
+        if r.abs() < 2_147_483_647.0 {
+            let n = round_to_i64(r);
+            if (r - n as f64).abs() < 0.499_99 {
+                // |n| < 2^31: in range.
+                return n as i32;
+            }
+        }
+        self.drive_increments_per_second(units_per_s)
+            .round()
+            .clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
     }
 
     /// The load torque (rotary axis, in the motor torque's unit) or force (linear axis, in the
@@ -1021,5 +1123,111 @@ impl AbsoluteAdjustment {
             count: i64::from_le_bytes(count),
             fingerprint: u64::from_le_bytes(fingerprint),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+    use super::*;
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+
+    /// The drive's ratio of a scaling: `increments` per motor revolution, gear `n : d`, an
+    /// optional leadscrew `pitch` (rotary: 360° per load revolution).
+    fn drive_ratio(increments: u32, n: u32, d: u32, pitch: Option<f64>) -> Ratio {
+        let units = pitch.unwrap_or(DEGREES_PER_REVOLUTION);
+        Ratio::new(u128::from(increments) * u128::from(n), d, units)
+    }
+
+    /// Issue 11's drives bench: the quotient `count * a / b` of [`Ratio::units`] is the very
+    /// double the double-double product gives, on random scalings (some with inexact units
+    /// per period, which take the double-double path) and counts of every size up to 2^52,
+    /// and the velocity in increments/s by a product rounds to the integer the quotient does.
+    #[test]
+    fn the_quotient_is_the_double_double_product() {
+        let config = Config {
+            cases: 20_000,
+            failure_persistence: None,
+            ..Config::default()
+        };
+        let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &[11; 32]);
+        let mut runner = TestRunner::new_with_rng(config, rng);
+        let mechanics = (
+            prop::sample::select(vec![1000u32, 4096, 10_000, 1 << 20, 8_388_608, 1 << 23]),
+            1u32..100,
+            1u32..100,
+            prop::option::of(prop::sample::select(vec![5.0, 10.0, 2.54, 0.1, 7.5, 1e-3])),
+        );
+        let count = (0u32..53, any::<i64>(), -1e6f64..1e6);
+        let quotients = std::cell::Cell::new(0u32);
+        runner
+            .run(&(mechanics, count), |((inc, n, d, pitch), (bits, c, v))| {
+                let r = drive_ratio(inc, n, d, pitch);
+                // A count of `bits` bits at most, either sign.
+                let c = c >> (63 - bits);
+                prop_assert_eq!(
+                    r.units(c).to_bits(),
+                    r.units_double_double(c).to_bits(),
+                    "count {} of {:?}",
+                    c,
+                    r
+                );
+                if c.unsigned_abs() < r.quotient_limit && c != 0 {
+                    quotients.set(quotients.get() + 1);
+                }
+                let s = Scaling {
+                    encoder: EncoderConfig {
+                        kind: EncoderKind::Incremental,
+                        steps_per_revolution: inc,
+                        fine_resolution_bits: 0,
+                        determinable_revolutions: 1,
+                        raw_bits: 32,
+                        inverse: false,
+                        mounting: Mounting::MotorShaft,
+                    },
+                    mechanics: Mechanics::default(),
+                    sensor: r,
+                    drive: r,
+                    sensor_sign: 1.0,
+                    drive_sign: 1.0,
+                    torque_factor: 1.0,
+                };
+                let by_quotient =
+                    s.drive_increments_per_second(v)
+                        .round()
+                        .clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
+                prop_assert_eq!(s.drive_increments_per_second_i32(v), by_quotient);
+                Ok(())
+            })
+            .unwrap();
+        // The quotient was taken in a good share of the cases.
+        let quotients = quotients.get();
+        assert!(quotients > 5_000, "{quotients} quotients");
+    }
+
+    #[test]
+    fn rounding_without_the_library_call_is_f64_round() {
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.499_999_999_999_999_94,
+            1e15 + 0.5,
+            4.5e15,
+            -4.5e15,
+            9.3e18,
+            -9.3e18,
+            1e300,
+            f64::NAN,
+            f64::INFINITY,
+            -f64::INFINITY,
+        ] {
+            assert_eq!(round_to_i64(x), x.round() as i64, "{x}");
+        }
     }
 }
