@@ -466,3 +466,36 @@ proptest! {
         }
     }
 }
+
+/// docs/parameters.md lists every row of the table as the code has it (number, tag, unit,
+/// type, effect, range, ErrorID, section).
+#[test]
+fn the_documented_table_is_the_code_table() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let doc = std::fs::read_to_string(root.join("docs/parameters.md")).unwrap_or_default();
+    let mut missing = Vec::new();
+    for (i, e) in AXIS_PARAMETERS.iter().enumerate() {
+        let ty = match e.ty {
+            ParamType::Real => "LREAL",
+            ParamType::Bool => "BOOL",
+        };
+        let line = format!(
+            "| {} | `{}` | {} | {ty} | {} | {} | `16#{:04X}` | {} |",
+            i + 1,
+            e.key,
+            if e.unit.is_empty() { "–" } else { e.unit },
+            e.effect.code(),
+            e.range,
+            e.invalid.code(),
+            e.reference
+        );
+        if !doc.contains(&line) {
+            missing.push(line);
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "not in docs/parameters.md:\n{}",
+        missing.join("\n")
+    );
+}

@@ -143,16 +143,16 @@ const fn row(
 use ErrorId as E;
 use ParamType::{Bool, Real};
 
-const A215: &str = "A.2.15 'DynamicLimits tags'";
-const A216: &str = "A.2.16 'DynamicDefaults tags'";
-const A217: &str = "A.2.17 'PositionLimits_SW tags'";
-const A218: &str = "A.2.18 'PositionLimits_HW tags'";
-const A219: &str = "A.2.19 'Homing tags'";
-const A220: &str = "A.2.20 'Override tags'";
-const A221: &str = "A.2.21 'PositionControl tags'";
-const A223: &str = "A.2.23 'FollowingError tags'";
-const A224: &str = "A.2.24 'PositionMonitoring tags'";
-const A225: &str = "A.2.25 'StandstillSignal tags'";
+const A215: &str = "A.2.15 'DynamicLimits tags (positioning axis/synchronous axis)'";
+const A216: &str = "A.2.16 'DynamicDefaults tags (positioning axis/synchronous axis)'";
+const A217: &str = "A.2.17 'PositionLimits_SW tags (positioning axis/synchronous axis)'";
+const A218: &str = "A.2.18 'PositionLimits_HW tags (positioning axis/synchronous axis)'";
+const A219: &str = "A.2.19 'Homing tags (positioning axis/synchronous axis)'";
+const A220: &str = "A.2.20 'Override tags (positioning axis/synchronous axis)'";
+const A221: &str = "A.2.21 'PositionControl tags (positioning axis/synchronous axis)'";
+const A223: &str = "A.2.23 'FollowingError tags (positioning axis/synchronous axis)'";
+const A224: &str = "A.2.24 'PositionMonitoring tags (positioning axis/synchronous axis)'";
+const A225: &str = "A.2.25 'StandstillSignal tags (positioning axis/synchronous axis)'";
 
 /// The axis' parameters (S7-1500T Motion Control V4.0 function manual, the sections named in
 /// each row). Numbers: position + 1; append only.
