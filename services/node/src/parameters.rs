@@ -359,6 +359,55 @@ mod tests {
         assert_ne!(fingerprint(&a), fingerprint(&b));
     }
 
+    /// The example cell with its retained data in a fresh directory of its own.
+    fn example_cell(tag: &str) -> (Cell, std::path::PathBuf) {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut cell = tandem_config::load(&root.join("config/example-cell.toml")).unwrap();
+        let dir = std::env::temp_dir().join(format!("tandem_params_{tag}_{}", std::process::id()));
+        // A leftover of an earlier run with the same pid may or may not exist.
+        let _ = std::fs::remove_dir_all(&dir);
+        cell.retain_dir = dir.clone();
+        (cell, dir)
+    }
+
+    /// An accepted write is stored; at the next start it is applied over the cell file's
+    /// value; under another configuration of the axis the record is void.
+    #[test]
+    fn a_retained_write_is_restored_and_void_under_another_configuration() {
+        let (cell, dir) = example_cell("restore");
+        let n = cell.node("main").unwrap();
+        let slide = cell.axes.iter().position(|a| a.name == "slide").unwrap();
+        let jerk = axis_parameter_number("DynamicLimits.MaxJerk").unwrap();
+        let ovr = axis_parameter_number("Override.Velocity").unwrap();
+        let store = open(&cell, n).unwrap();
+        let mut retained = Retained::load(&cell, n, Some(Arc::clone(&store)));
+        let write = |parameter, value| {
+            write_of(
+                "slide",
+                &Action::Command(Command::WriteParameter { parameter, value }),
+            )
+        };
+        retained.record(write(jerk, 60_000.0).unwrap());
+        assert_eq!(write(ovr, 50.0), None, "the override is not retained");
+        let mut exec = Executive::new(&cell, Some(n)).unwrap();
+        assert_eq!(exec.read_parameter("slide", jerk), Ok(100_000.0));
+        restore(&mut exec, &cell, n, Some(&store));
+        assert_eq!(exec.read_parameter("slide", jerk), Ok(60_000.0));
+        // The record survives a second write of another tag, whole.
+        let window = axis_parameter_number("PositioningMonitoring.Window").unwrap();
+        retained.record(write(window, 0.5).unwrap());
+        let again = Retained::load(&cell, n, Some(Arc::clone(&store)));
+        let r = &again.records.iter().find(|(a, _)| a == "slide").unwrap().1;
+        assert_eq!(r.values, vec![(jerk, 60_000.0), (window, 0.5)]);
+        // Another configuration of the slide: the record is void, the cell file's value holds.
+        let mut changed = cell.clone();
+        changed.axes[slide].config.limits.max_velocity = 400.0;
+        let mut exec = Executive::new(&changed, Some(n)).unwrap();
+        restore(&mut exec, &changed, n, Some(&store));
+        assert_eq!(exec.read_parameter("slide", jerk), Ok(100_000.0));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     fn write_forever(dir: &Path) -> ! {
         let store = RetainStore::open(dir).unwrap();
         let mut k = match store.load(AXIS).unwrap() {
