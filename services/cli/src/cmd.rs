@@ -201,6 +201,20 @@ pub fn cmd(cell_path: &Path, r: &CmdRequest, out: &mut impl Write) -> Result<(),
     }
 }
 
+/// The node's words on an accepted instruction (MC_ReadParameter's `Tag = value`), after a
+/// colon; nothing when it said nothing.
+pub(crate) struct Said<'a>(pub(crate) &'a str);
+
+impl std::fmt::Display for Said<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.is_empty() {
+            Ok(())
+        } else {
+            write!(f, ": {}", self.0)
+        }
+    }
+}
+
 /// Prints an accepted reply; any other is the error it stands for.
 fn report(r: &CmdRequest, reply: &CommandReply, out: &mut impl Write) -> Result<(), CliError> {
     let (target, instruction) = (&r.target, &r.instruction);
@@ -216,9 +230,10 @@ fn report(r: &CmdRequest, reply: &CommandReply, out: &mut impl Write) -> Result<
         OUTCOME_ACCEPTED => {
             outln!(
                 out,
-                "{target} {instruction}: accepted, job {} at t={}",
+                "{target} {instruction}: accepted, job {} at t={}{}",
                 reply.job,
-                Secs(reply.t_ns)
+                Secs(reply.t_ns),
+                Said(reply.message.as_str())
             );
             Ok(())
         }

@@ -137,9 +137,10 @@ pub fn cmd_zenoh(
                 span.record("job", a.job);
                 outln!(
                     out,
-                    "{target} {instruction}: accepted, job {} at t={}",
+                    "{target} {instruction}: accepted, job {} at t={}{}",
                     a.job,
-                    Secs(a.t_ns)
+                    Secs(a.t_ns),
+                    crate::cmd::Said(&a.message)
                 );
             })
         };

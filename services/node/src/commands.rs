@@ -5,8 +5,10 @@
 use crate::audit::Audit;
 use crate::error::NodeError;
 use crate::owns;
+use crate::parameters::{write_of, Retained};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
+use std::sync::Arc;
 use std::time::Duration;
 use tandem_config::script::{split_command, ScriptEntry};
 use tandem_config::Cell;
@@ -18,6 +20,7 @@ use tandem_protocol::wire::{
     CommandReply, CommandRequest, Text, ANONYMOUS, OUTCOME_ACCEPTED, OUTCOME_BUSY, OUTCOME_INVALID,
 };
 use tandem_rt as rt;
+use tandem_rt::retain::RetainStore;
 use tracing::{debug, info, info_span, warn, Span};
 
 /// A command from the command thread: its id, what to apply.
@@ -45,6 +48,8 @@ pub(crate) struct CommandLinks {
     pub(crate) queue: SyncSender<Queued>,
     /// Their results.
     pub(crate) done: Receiver<Done>,
+    /// Where accepted MC_WriteParameter values are retained.
+    pub(crate) parameters: Option<Arc<RetainStore>>,
 }
 
 /// Serves node `node`'s commands until `stop` or a termination signal.
@@ -107,6 +112,8 @@ struct Pending {
     active: ActiveRequest,
     span: Span,
     request: CommandRequest,
+    /// An MC_WriteParameter to retain once accepted.
+    write: Option<(String, u16, f64)>,
 }
 
 /// The server side of one command request.
@@ -153,11 +160,18 @@ fn admit(
 }
 
 /// Sends the cycle's answer `d` to the request waiting for it, and audits it.
-fn reply(pending: &mut Vec<Pending>, d: Done, audit: &mut Audit) {
+fn reply(pending: &mut Vec<Pending>, d: Done, audit: &mut Audit, retained: &mut Retained) {
     let Some(i) = pending.iter().position(|x| x.id == d.id) else {
         return;
     };
-    let p = pending.swap_remove(i);
+    let mut p = pending.swap_remove(i);
+    if d.reply.outcome == OUTCOME_ACCEPTED {
+        if let Some(w) = p.write.take() {
+            // Retained before the reply leaves: a client that saw the reply finds the value
+            // after a restart.
+            retained.record(w);
+        }
+    }
     log_reply(&p.span, &d.reply);
     let sender = match p.request.sender.as_str() {
         "" => ANONYMOUS,
@@ -192,6 +206,7 @@ fn serve(
     .map_err(|e| NodeError::port(port, e))?;
     let n = cell.node(node);
     let mut audit = Audit::open(n.and_then(|n| cell.node_retain_dir(n)));
+    let mut retained = Retained::load(cell, n.unwrap_or(usize::MAX), links.parameters.clone());
     let mut rates = SenderRates::new(cell.command_rate_hz, cell.command_burst);
     let mut pending: Vec<Pending> = Vec::new();
     let mut id = 0u64;
@@ -215,12 +230,14 @@ fn serve(
                 instruction = entry.instruction,
                 job = tracing::field::Empty
             );
+            let write = write_of(&entry.axis, &entry.action);
             match links.queue.try_send(Queued { id, entry }) {
                 Ok(()) => pending.push(Pending {
                     id,
                     active,
                     span,
                     request: req,
+                    write,
                 }),
                 Err(TrySendError::Full(_)) => {
                     let _in = span.enter();
@@ -240,7 +257,7 @@ fn serve(
         let wait = if pending.is_empty() { 5 } else { 1 };
         let mut next = links.done.recv_timeout(Duration::from_millis(wait)).ok();
         while let Some(d) = next {
-            reply(&mut pending, d, &mut audit);
+            reply(&mut pending, d, &mut audit, &mut retained);
             next = links.done.try_recv().ok();
         }
         audit.sync();

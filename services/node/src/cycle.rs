@@ -17,7 +17,8 @@ use std::sync::mpsc::{Receiver, SyncSender};
 use tandem_config::script::ScriptEntry;
 use tandem_config::{AxisIndex, Cell};
 use tandem_motion::catalog::error_id::ErrorId;
-use tandem_motion::objects::axis::AxisStatus;
+use tandem_motion::objects::action::Action;
+use tandem_motion::objects::axis::{axis_parameter, AxisStatus, Command};
 use tandem_protocol::wire::{
     job_code, AxisTelemetry, CommandReply, Event, IoEvent, LeadingValueSample, NodeHealth,
     SignalEvent, Text, EVENT_JOB, EVENT_LOG, IO_MEASURED, IO_OUTPUT, OUTCOME_ACCEPTED,
@@ -261,7 +262,10 @@ impl<'c> NodeCycle<'c> {
                 .exec
                 .apply(t, &e.axis, e.instruction, e.action, &mut self.log)
                 .unwrap_or(Err(ErrorId::IllegalObject));
-            let reply = reply(t, applied);
+            let mut reply = reply(t, applied);
+            if applied.is_ok() {
+                parameter_reply(&self.exec, e, &mut reply);
+            }
             if self.links.done.try_send(Done { id: q.id, reply }).is_err() {
                 self.health.commands_unanswered += 1;
             }
@@ -599,6 +603,25 @@ fn reply(t: i64, applied: Applied) -> CommandReply {
         }
     }
     reply
+}
+
+/// MC_ReadParameter's and MC_WriteParameter's reply carries the value the axis has now:
+/// `DynamicLimits.MaxJerk = 50000` (formatted into the fixed text, no allocation).
+fn parameter_reply(exec: &Executive<'_>, e: &ScriptEntry, reply: &mut CommandReply) {
+    let n = match e.action {
+        Action::Command(
+            Command::ReadParameter { parameter } | Command::WriteParameter { parameter, .. },
+        ) => parameter,
+        _ => return,
+    };
+    let name = axis_parameter(n).map_or("?", |p| p.key);
+    if let Ok(value) = exec.read_parameter(&e.axis, n) {
+        // A TextWriter never fails: it cuts the text at its capacity.
+        let _ = core::fmt::Write::write_fmt(
+            &mut TextWriter(&mut reply.message),
+            format_args!("{name} = {value}"),
+        );
+    }
 }
 
 /// The event of a job note, its message formatted into the fixed text (no allocation).

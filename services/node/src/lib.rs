@@ -34,6 +34,7 @@ mod error;
 pub mod ethercat;
 mod logring;
 mod lvhealth;
+mod parameters;
 mod ports;
 mod recorder;
 mod report;
@@ -119,11 +120,14 @@ pub fn run(o: &Options) -> Result<Report, NodeError> {
         .collect();
     let stop = Arc::new(AtomicBool::new(false));
     let retained = retain::open(&cell, n);
-    let (threads, links) = start_threads(&cell, o, &owned, &stop, retained.clone())?;
+    let params = parameters::open(&cell, n);
+    let stores = (retained.clone(), params.clone());
+    let (threads, links) = start_threads(&cell, o, &owned, &stop, stores)?;
     let lost = Arc::clone(&links.lost);
     let start = Start {
         script: script.as_ref(),
         retained: retained.as_deref(),
+        parameters: params.as_deref(),
     };
     let result = cyclic(&cell, n, o, start, owned, links);
     stop.store(true, Ordering::SeqCst);
@@ -203,7 +207,7 @@ fn start_threads(
     o: &Options,
     owned: &[usize],
     stop: &Arc<AtomicBool>,
-    retained: Option<Arc<RetainStore>>,
+    (retained, params): (Option<Arc<RetainStore>>, Option<Arc<RetainStore>>),
 ) -> Result<(Vec<Thread>, Links), NodeError> {
     let (cmd_tx, cmd_rx) = sync_channel::<Queued>(32);
     let (done_tx, done_rx) = sync_channel::<Done>(64);
@@ -227,6 +231,7 @@ fn start_threads(
     let links = CommandLinks {
         queue: cmd_tx,
         done: done_rx,
+        parameters: params,
     };
     threads.push(spawn("commands", move || {
         command_thread(&c, &node, &s, &links)
@@ -296,6 +301,8 @@ struct Start<'a> {
     script: Option<&'a Script>,
     /// The node's retained data, if it has any.
     retained: Option<&'a RetainStore>,
+    /// The node's retained run-time parameters, if it has a directory for them.
+    parameters: Option<&'a RetainStore>,
 }
 
 /// Restores the retained data, opens the ports, then runs the cyclic executive on this
@@ -317,6 +324,7 @@ fn cyclic(
     let ethercat = ethercat::open(cell, n).map_err(NodeError::Ethercat)?;
     let mut exec = Executive::new(cell, Some(n)).map_err(|e| NodeError::Engine(e.into()))?;
     retain::restore(&mut exec, cell, start.retained);
+    parameters::restore(&mut exec, cell, n, start.parameters);
     let remote: Vec<(Leader, Coupling)> = exec.remote_leaders().collect();
     let ports = Ports::open(PortPlan {
         cell,

@@ -120,6 +120,9 @@ pub struct Accepted {
     pub job: u32,
     /// The cycle time it was applied at (ns).
     pub t_ns: i64,
+    /// The node's words on it: MC_ReadParameter's and MC_WriteParameter's `Tag = value`;
+    /// empty for most instructions.
+    pub message: String,
 }
 
 /// How an awaited job went: the events seen, the last one ending it.
@@ -326,6 +329,7 @@ impl Client {
             "accepted" => Ok(Accepted {
                 job: r.job,
                 t_ns: r.t_ns,
+                message: r.message,
             }),
             "rejected" => Err(ClientError::Rejected {
                 error_id: r.error_id,

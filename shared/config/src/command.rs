@@ -7,8 +7,8 @@
 use core::fmt;
 use tandem_motion::kinematics::dynamics::Dynamics;
 use tandem_motion::objects::axis::{
-    ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction, FlyingGearParams,
-    HydHomeInputs, HydHomingMode, HydJogMode, StartMode, StopMode, SyncDirection,
+    axis_parameter_number, ApplicationMode, BufferMode, BufferedMotion, CamId, Command, Direction,
+    FlyingGearParams, HydHomeInputs, HydHomingMode, HydJogMode, StartMode, StopMode, SyncDirection,
     SyncProfileReference, VelocityDirection,
 };
 use tandem_motion::objects::leading::LeaderId;
@@ -156,6 +156,16 @@ pub const INSTRUCTIONS: &[InstructionSpec] = &[
     InstructionSpec {
         name: "MC_SetOverride",
         params: &[("velocity", None)],
+    },
+    // A run-time parameter of the axis by its S7-1500T tag name or number
+    // (docs/parameters.md); a boolean value as true/false or 1/0.
+    InstructionSpec {
+        name: "MC_WriteParameter",
+        params: &[("tag", None), ("value", None)],
+    },
+    InstructionSpec {
+        name: "MC_ReadParameter",
+        params: &[("tag", None)],
     },
     // The Beckhoff hydraulic library's MC_Power with the feed enables of the two directions.
     InstructionSpec {
@@ -779,6 +789,12 @@ impl Args<'_> {
             })
     }
 
+    /// `tag`: the parameter number (a tag name was mapped to it by [`named_value`]); a number
+    /// the axis does not have is passed on as 0, which the axis refuses with 16#8080.
+    fn parameter(&self) -> Result<u16, CommandError> {
+        Ok(u16::try_from(self.code("tag")?).unwrap_or(0))
+    }
+
     /// `buffer_mode`: the PLCopen number (a name was mapped to it by [`named_value`]).
     fn buffer_mode(&self) -> Result<BufferMode, CommandError> {
         BufferMode::from_code(self.code("buffer_mode")?).ok_or(CommandError::BadValue {
@@ -831,11 +847,17 @@ const BUFFER_MODES: &str = "0..5 or Aborting, Buffered, BlendingLow, BlendingPre
      BlendingNext, BlendingHigh";
 
 /// The number a parameter given as a name stands for: `buffer_mode = "BlendingLow"` is 2 (the
-/// PLCopen names, with or without `mc`, and S7-Technology's `override`, `append`, `blend`).
+/// PLCopen names, with or without `mc`, and S7-Technology's `override`, `append`, `blend`);
+/// `tag = "DynamicLimits.MaxJerk"` is that tag's parameter number.
 /// `None` for other parameters and unknown names (the value is then refused as not a number).
 pub fn named_value(param: &str, name: &str) -> Option<Value> {
     match param {
         "buffer_mode" => BufferMode::from_name(name).map(|m| Value::Num(f64::from(m.code()))),
+        // An S7-1500T tag name (`DynamicLimits.MaxJerk`); an unknown one is number 0, refused
+        // by the axis with the reference's ErrorID (16#8080) like an unknown number.
+        "tag" => Some(Value::Num(f64::from(
+            axis_parameter_number(name).unwrap_or(0),
+        ))),
         _ => None,
     }
 }
@@ -1298,6 +1320,16 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
         },
         "MC_SetOverride" => Command::SetOverride {
             velocity: a.num("velocity")?,
+        },
+        "MC_WriteParameter" => Command::WriteParameter {
+            parameter: a.parameter()?,
+            value: match a.get("value")? {
+                Value::Num(x) => x,
+                Value::Bool(b) => f64::from(u8::from(b)),
+            },
+        },
+        "MC_ReadParameter" => Command::ReadParameter {
+            parameter: a.parameter()?,
         },
         "MC_MotionInPosition" => Command::MotionInPosition {
             enable: a.flag("enable")?,

@@ -434,7 +434,8 @@ pub struct ReplyJson {
     pub t_ns: i64,
     /// The ErrorID of a rejection, `16#8003 IllegalVelocity`; empty otherwise.
     pub error_id: String,
-    /// What went wrong, in words; empty when accepted.
+    /// What went wrong, in words; when accepted, empty or MC_ReadParameter's and
+    /// MC_WriteParameter's `Tag = value` (the value the axis has now).
     pub message: String,
 }
 

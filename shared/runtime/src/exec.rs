@@ -37,7 +37,7 @@ use tandem_config::{
 use tandem_motion::cam::{Cam, CamDefinition};
 use tandem_motion::catalog::error_id::ErrorId;
 use tandem_motion::objects::action::Action;
-use tandem_motion::objects::axis::{Axis, AxisStatus, CamId, Command};
+use tandem_motion::objects::axis::{axis_parameter, Axis, AxisStatus, CamId, Command};
 use tandem_motion::objects::encoder::{EncoderStatus, ExternalEncoder};
 use tandem_motion::objects::job::{Instruction, JobEvent, JobId};
 use tandem_motion::objects::leading::{
@@ -49,6 +49,16 @@ use tandem_motion::plant::sensor::InputEdge;
 /// A rejoin after an extrapolation is logged when the step it removed exceeds this (in the
 /// leader's unit; smaller ones are the rounding of an extrapolation at constant acceleration).
 const REJOIN_LOGGED: f64 = 1e-6;
+
+/// The parameter number of an MC_WriteParameter or MC_ReadParameter, for the log line.
+fn parameter_of(action: Action) -> Option<u16> {
+    match action {
+        Action::Command(
+            Command::WriteParameter { parameter, .. } | Command::ReadParameter { parameter },
+        ) => Some(parameter),
+        _ => None,
+    }
+}
 
 fn gcd(a: i64, b: i64) -> i64 {
     if b == 0 {
@@ -659,6 +669,36 @@ impl<'c> Executive<'c> {
         &self.encoder_status
     }
 
+    /// MC_ReadParameter on the owned axis `target`: the current value of parameter `number`
+    /// (docs/parameters.md), or the ErrorID that refuses it (16#8002 for an object that is
+    /// not an owned axis).
+    pub fn read_parameter(&self, target: &str, number: u16) -> Result<f64, ErrorId> {
+        let i = self
+            .names
+            .axis(target)
+            .map(AxisIndex)
+            .filter(|i| self.owned.axis(*i))
+            .ok_or(ErrorId::IllegalObject)?;
+        self.axes[i.0].read_parameter(number)
+    }
+
+    /// Writes the retained run-time parameters of owned axis `i` (docs/parameters.md) before
+    /// the first step: all of them or, refused with the number and ErrorID, none.
+    pub fn restore_parameters(
+        &mut self,
+        i: AxisIndex,
+        values: &[(u16, f64)],
+    ) -> Result<(), (u16, ErrorId)> {
+        let refused = (0, ErrorId::IllegalObject);
+        if !self.owned.axis(i) {
+            return Err(refused);
+        }
+        self.axes
+            .get_mut(i.0)
+            .ok_or(refused)?
+            .write_parameters(values)
+    }
+
     /// The axis `i` (for its alarms and details).
     pub fn axis(&self, i: AxisIndex) -> Option<&Axis> {
         self.axes.get(i.0)
@@ -794,7 +834,17 @@ impl<'c> Executive<'c> {
             Ok(_) if matches!(action, Action::InterpolateCam { .. }) => {
                 writeln!(log, "t={} {target} MC_InterpolateCam: Done", Secs(t))?;
             }
-            Ok(_) => {}
+            Ok(_) => {
+                if let Some(n) = parameter_of(action) {
+                    let name = axis_parameter(n).map_or("?", |e| e.key);
+                    let value = self.read_parameter(target, n).unwrap_or(f64::NAN);
+                    writeln!(
+                        log,
+                        "t={} {target} {instruction}: {name} = {value}",
+                        Secs(t)
+                    )?;
+                }
+            }
             Err(id) => {
                 self.rejected += 1;
                 writeln!(

@@ -23,6 +23,16 @@
 //! | `16#80F3` | [`ErrorId::JobRejectedInErrorStop`] | PLCopen ErrorStop: a motion job while a stopping technology alarm is pending and not acknowledged. S7-1500 has no own code for it; its manual only tells the user to check `ErrorDetail` before starting a job (S7-1500T Motion Control V4.0 function manual, 6.3 'Motion Control instructions'). |
 //! | `16#80F4` | [`ErrorId::BufferModeNotAllowed`] | S7-Technology rejects append and blend with `8055` while a synchronous operation or MC_Halt is active and a MoveVelocity appended to a MoveVelocity (S7-Technology V4.1 function manual, 6.2.6 'FB410 MC_MoveAbsolute - Absolute positioning', 6.2.10 'FB 414 MC_MoveVelocity - Motion with speed preset'); S7-1500 has no BufferMode (S7-1500T Motion Control V4.0 function manual, 3.4 'No buffering or blending in V4.0'), and tandem keeps its own codes in the free `16#80F0` block rather than take S7-Technology's number inside the reference's range. A full queue is the reference's [`ErrorId::NoJobMemory`] (`16#8014`, S7-Technology `8005`). |
 //!
+//! | `16#80F7` | [`ErrorId::IllegalParameterValue`] | S7-Technology's MC_WriteParameter answers an illegal value with `8043` (S7-Technology V4.1 function manual, 6.7.5 'FB407 MC_WriteParameter - Changing parameters'), which S7-1500 uses for an illegal torque limit. |
+//!
+//! # From S7-Technology
+//!
+//! S7-1500 V4.0 has no MC_ReadParameter / MC_WriteParameter (the user program writes the
+//! technology DB's tags). tandem's instructions answer with S7-Technology FB407's codes where
+//! they fall outside the ranges S7-1500 uses: `16#8080` [`ErrorId::InvalidParameterNumber`],
+//! `16#8081` [`ErrorId::ParameterNotWritable`], `16#8086` [`ErrorId::ParameterNotAvailable`],
+//! `16#808B` [`ErrorId::InvalidRealFormat`] (docs/parameters.md).
+//!
 //! Whether the axis reports a missing homing as alarm 321 (S7-compatible) or as
 //! [`ErrorId::NotHomed`] is the axis's choice. This module only defines the codes.
 
@@ -152,6 +162,25 @@ error_ids! {
         HomingActive = 0x8074 => "Job not possible: an MC_Home job is active (encoder switch refused).",
         NoSynchronousOperation = 0x8075 => "Job not possible: no synchronous operation is active on the axis.",
         SyncSimulationActive = 0x8076 => "Job not possible: synchronous operation is being simulated on the axis.",
+        /// **S7-Technology.** MC_ReadParameter / MC_WriteParameter: the axis has no parameter
+        /// of this number or tag (S7-Technology V4.1 function manual, 6.7.5 'FB407
+        /// MC_WriteParameter - Changing parameters', ErrorID `8080`).
+        #[doc(alias = "8080")]
+        InvalidParameterNumber = 0x8080 => "Invalid parameter number or tag: the technology object has no such parameter.",
+        /// **S7-Technology.** MC_WriteParameter on a parameter that cannot be written while
+        /// the axis runs: read-only, or (S7-1500 `RES`) effective only after a restart of the
+        /// technology object (S7-Technology V4.1 function manual, 6.7.5, ErrorID `8081`).
+        #[doc(alias = "8081")]
+        ParameterNotWritable = 0x8081 => "Parameter cannot be changed while running (read-only, or needs a restart of the technology object).",
+        /// **S7-Technology.** The parameter exists but not on this axis: a speed axis' position
+        /// control, a position controller in a connected drive, a hydraulic axis
+        /// (S7-Technology V4.1 function manual, 6.7.5, ErrorID `8086`).
+        #[doc(alias = "8086")]
+        ParameterNotAvailable = 0x8086 => "Parameter not available on this technology object.",
+        /// **S7-Technology.** The value is not a finite number (S7-Technology V4.1 function
+        /// manual, 6.7.5, ErrorID `808B` "Parameter value of invalid REAL format").
+        #[doc(alias = "808B")]
+        InvalidRealFormat = 0x808B => "Parameter value of invalid REAL format (not a finite number).",
         SyncJobActive = 0x80A1 => "MC_Home on a follower refused while MC_CamIn or MC_GearInPos is active.",
         MeasuringRangeInvalidModulo = 0x80A2 => "Measuring range invalid with the configured modulo settings.",
         MeasuringRejectedHomingActive = 0x80A3 => "PROFIdrive measuring job refused: a homing job is active.",
@@ -202,6 +231,14 @@ error_ids! {
         /// Beckhoff hydraulic library answers with `dwTcHydErrCdPosFdEna` (16#4358) or
         /// `dwTcHydErrCdNegFdEna` (16#4357); S7 has no direction enables.
         NoFeedEnable = 0x80F6 => "Tandem extension: move in a direction without its feed enable (Beckhoff hydraulic library: 16#4358 / 16#4357).",
+        /// **Tandem extension.** MC_WriteParameter with a value outside the parameter's range
+        /// or inconsistent with the other parameters (the check the configuration makes at
+        /// load), for a parameter that is not a velocity, acceleration, deceleration, jerk or
+        /// position (those answer `16#8003`..`16#8006`, `16#8009`). S7-Technology answers
+        /// `8043` "Illegal parameter value" (S7-Technology V4.1 function manual, 6.7.5 'FB407
+        /// MC_WriteParameter - Changing parameters'), which S7-1500 uses for an illegal
+        /// torque limit.
+        IllegalParameterValue = 0x80F7 => "Tandem extension: parameter value out of range or inconsistent (S7-Technology MC_WriteParameter: 8043).",
         Unspecified = 0x8FFF => "Unspecified error.",
     }
 }
@@ -229,6 +266,7 @@ impl ErrorId {
                 | ErrorId::BufferModeNotAllowed
                 | ErrorId::IllegalControllerParameter
                 | ErrorId::NoFeedEnable
+                | ErrorId::IllegalParameterValue
         )
     }
 }
@@ -310,13 +348,16 @@ mod tests {
             assert_eq!(ErrorId::from_code(code), None);
         }
         // 73 codes in S7-1500T Motion Control V4.0 function manual, A.9 'Error ID for Motion
-        // Control instructions', plus 7 tandem extensions.
+        // Control instructions', 4 of S7-Technology's MC_WriteParameter, plus 8 tandem
+        // extensions.
+        let s7t = |e: &&ErrorId| (0x8080..=0x808F).contains(&e.code());
         let reference = ErrorId::ALL
             .iter()
-            .filter(|e| !e.is_tandem_extension())
+            .filter(|e| !e.is_tandem_extension() && !s7t(e))
             .count();
         assert_eq!(reference, 73);
-        assert_eq!(ErrorId::ALL.len(), 80);
+        assert_eq!(ErrorId::ALL.iter().filter(s7t).count(), 4);
+        assert_eq!(ErrorId::ALL.len(), 85);
     }
 
     #[test]

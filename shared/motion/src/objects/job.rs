@@ -38,6 +38,10 @@ pub enum Instruction {
     MoveSuperimposed,
     /// `MC_SetOverride` (tandem: writes `Override.Velocity`).
     SetOverride,
+    /// `MC_WriteParameter` (a run-time parameter of the axis).
+    WriteParameter,
+    /// `MC_ReadParameter`.
+    ReadParameter,
     /// `MC_MotionInPosition`.
     MotionInPosition,
     /// `MC_MotionInVelocity`.
@@ -130,6 +134,8 @@ impl Instruction {
             Self::MoveJog => "MC_MoveJog",
             Self::MoveSuperimposed => "MC_MoveSuperimposed",
             Self::SetOverride => "MC_SetOverride",
+            Self::WriteParameter => "MC_WriteParameter",
+            Self::ReadParameter => "MC_ReadParameter",
             Self::MotionInPosition => "MC_MotionInPosition",
             Self::MotionInVelocity => "MC_MotionInVelocity",
             Self::PressureControl => "MC_AxCtrlPressure_BkPlcMc",

@@ -2,8 +2,8 @@
 //! operation ([`axis`]), the external encoder ([`encoder`]), leading values for followers
 //! ([`leading`]), output cams ([`output_cam`]), cam tracks ([`cam_track`]), the hydraulic library's
 //! digital cam switch ([`digital_cam_switch`]) and measuring inputs
-//! ([`measuring`]); the job bookkeeping they share ([`job`]) and the command type the runtime
-//! applies to them ([`action`]).
+//! ([`measuring`]); the job bookkeeping they share ([`job`]), the run-time parameter tables'
+//! mechanism ([`parameter`]) and the command type the runtime applies to them ([`action`]).
 
 pub mod action;
 pub mod axis;
@@ -14,4 +14,5 @@ pub mod job;
 pub mod leading;
 pub mod measuring;
 pub mod output_cam;
+pub mod parameter;
 pub mod rejoin;

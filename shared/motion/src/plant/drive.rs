@@ -137,6 +137,14 @@ pub struct SimDrive {
 }
 
 impl SimDrive {
+    /// `Kv` and `Kpc` (fraction) of the position-loop model, from the next step; the velocity
+    /// loop (`T_vtc`) and the state are kept, so the position does not jump.
+    pub fn set_gains(&mut self, kv: f64, kpc: f64) {
+        if let DriveModel::PositionLoop { t_vtc, .. } = self.model {
+            self.model = DriveModel::PositionLoop { kv, kpc, t_vtc };
+        }
+    }
+
     /// A drive at rest at physical position `p0`. `cycle` is the servo cycle (s, > 0).
     pub fn new(model: DriveModel, cycle: f64, stop_deceleration: f64, p0: f64) -> Self {
         let n = match model {

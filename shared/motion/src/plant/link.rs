@@ -215,6 +215,12 @@ pub struct SimPlant {
 }
 
 impl SimPlant {
+    /// `PositionControl.Kv` and `.Kpc` (fraction) of a position-loop drive model, from the next
+    /// sample (MC_WriteParameter); the other models have none.
+    pub fn set_gains(&mut self, kv: f64, kpc: f64) {
+        self.drive.set_gains(kv, kpc);
+    }
+
     /// A drive at rest at physical position `p0` on a servo cycle of `cycle` s, braking on
     /// `stop_deceleration` without its enable.
     pub fn new(

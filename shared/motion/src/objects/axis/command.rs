@@ -632,6 +632,24 @@ pub enum Command {
         /// Velocity override in %.
         velocity: f64,
     },
+    /// `MC_WriteParameter`: writes the run-time parameter `parameter` (the tag's number in
+    /// `AXIS_PARAMETERS`, docs/parameters.md) to `value` (a boolean as 0 or 1), effective as the
+    /// tag's row says; refused with the row's ErrorID (16#8080, 16#8081, 16#8086, 16#808B or
+    /// the value's), changing nothing.
+    #[doc(alias = "MC_WriteParameter")]
+    WriteParameter {
+        /// The parameter number (tag name mapped by the parser).
+        parameter: u16,
+        /// The new value.
+        value: f64,
+    },
+    /// `MC_ReadParameter`: checks that the axis has the parameter (Done) or refuses it (16#8080,
+    /// 16#8086); the value is read with `Axis::read_parameter`.
+    #[doc(alias = "MC_ReadParameter")]
+    ReadParameter {
+        /// The parameter number.
+        parameter: u16,
+    },
     /// `MC_MotionInPosition`: direct position setpoints, no profile, no limits.
     #[doc(alias = "MC_MotionInPosition")]
     MotionInPosition {

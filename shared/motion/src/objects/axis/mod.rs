@@ -16,6 +16,7 @@ mod hyd_home;
 mod hyd_joystick;
 mod hyd_slow_down;
 mod hydraulic;
+mod params;
 mod step;
 mod sync;
 mod torque;
@@ -38,6 +39,7 @@ pub use hyd_home::{
     HydHomingParamsError, HydHomingType, BLOCK_DETECT_DELAY_DEFAULT,
 };
 pub use hydraulic::HydraulicStatus;
+pub use params::{axis_parameter, axis_parameter_number, AxisParams, ParamExtras, AXIS_PARAMETERS};
 pub use sync::flying::{FlyingGear, FlyingGearError, FlyingGearParams, FlyingPhase, FlyingPoint};
 pub use torque::{TorqueStatus, TORQUE_VALUE_MAX};
 
@@ -393,6 +395,8 @@ pub struct Axis {
     /// MC_TorqueLimiting, MC_TorqueAdditive and MC_TorqueRange (read by the cycle only while
     /// `torque_active`).
     torque: torque::TorqueJobs,
+    /// The run-time parameters kept beside `cfg` (MC_WriteParameter).
+    param_extra: ParamExtras,
 }
 
 fn sign(x: f64) -> f64 {
@@ -486,6 +490,7 @@ impl Axis {
             now: 0,
             status: OnceCell::new(),
             status_kept: Cell::new(false),
+            param_extra: ParamExtras::new(&cfg),
             cfg,
         })
     }
@@ -1079,6 +1084,10 @@ impl Axis {
             | Command::Offset { .. }
             | Command::Phasing { .. } => self.apply_sync(cmd),
             Command::SetOverride { velocity } => self.cmd_set_override(velocity),
+            Command::WriteParameter { parameter, value } => {
+                self.cmd_write_parameter(parameter, value)
+            }
+            Command::ReadParameter { parameter } => self.cmd_read_parameter(parameter),
             Command::HydPower { .. }
             | Command::PressureControl { .. }
             | Command::PressureControlFf { .. }
@@ -1238,26 +1247,38 @@ impl Axis {
             return Err(ErrorId::IllegalOverride);
         }
         let id = self.new_id();
+        self.set_override(velocity);
+        self.emit(id, Instruction::SetOverride, JobEventKind::Done);
+        Ok(id)
+    }
+
+    /// Writes `Override.Velocity` (checked): the running positioning or velocity job is
+    /// replanned from the current setpoint with the new override.
+    fn set_override(&mut self, velocity: f64) {
         if velocity != self.override_pct {
             self.override_pct = velocity;
             if matches!(self.goal, Goal::Position { .. } | Goal::Velocity { .. }) {
                 self.replan();
-                let mut left = None;
-                if let Some(m) = self.main.as_mut() {
-                    if m.in_velocity {
-                        m.in_velocity = false;
-                        left = Some((m.id, m.instr));
-                    }
-                    // A positioning job that had stopped at override 0 moves again.
-                    m.monitoring = None;
-                }
-                if let Some((mid, instr)) = left {
-                    self.emit(mid, instr, JobEventKind::LeftVelocity);
-                }
+                self.running_job_replanned();
             }
         }
-        self.emit(id, Instruction::SetOverride, JobEventKind::Done);
-        Ok(id)
+    }
+
+    /// After the running positioning or velocity job was replanned with other dynamics: it
+    /// leaves its velocity (reached again with the new plan) and its positioning monitoring.
+    fn running_job_replanned(&mut self) {
+        let mut left = None;
+        if let Some(m) = self.main.as_mut() {
+            if m.in_velocity {
+                m.in_velocity = false;
+                left = Some((m.id, m.instr));
+            }
+            // A positioning job that had stopped at override 0 moves again.
+            m.monitoring = None;
+        }
+        if let Some((mid, instr)) = left {
+            self.emit(mid, instr, JobEventKind::LeftVelocity);
+        }
     }
 
     /// MC_MoveAbsolute (`value` = Position) and MC_MoveRelative (`value` = Distance): checks,
@@ -1875,6 +1896,8 @@ impl Axis {
                 ..DriveOutputs::default()
             },
         };
+        // The position controller is now the drive's (`PositionControl.*` are its parameters).
+        self.param_extra.own_position_loop = false;
     }
 
     /// Sets the switches read from input signals of the process image for the coming cycle,

@@ -720,7 +720,8 @@ impl Axis {
             return;
         }
         let v = self.total().v.abs();
-        let vmax = self.cfg.limits.max_velocity;
+        // `DynamicLimits.MaxVelocity` (the configured one, not the programmable `Velocity`).
+        let vmax = self.param_extra.max_velocity;
         let allowed = if v <= fe_cfg.min_velocity || vmax <= fe_cfg.min_velocity {
             fe_cfg.min_value
         } else {
