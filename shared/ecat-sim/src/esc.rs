@@ -9,7 +9,7 @@
 use core::fmt;
 
 use crate::coe::serve_mailbox;
-use crate::device::{Cia402Drive, DeviceKind, DeviceOptions, DigitalIo, Model};
+use crate::device::{AnalogIo, Cia402Drive, DeviceKind, DeviceOptions, DigitalIo, Model};
 use crate::sii::{Identity, SiiSpec, SmType};
 
 /// Size of the emulated memory: registers 0x0000..0x1000 and 4 KiB of process RAM.
@@ -193,6 +193,15 @@ impl Esc {
                 Model::DigitalIo(DigitalIo {
                     loopback: options.dio_loopback,
                     ..DigitalIo::default()
+                }),
+                false,
+            ),
+            DeviceKind::AnalogIo => (
+                AnalogIo::sii(serial),
+                Model::AnalogIo(AnalogIo {
+                    loopback: options.aio_loopback,
+                    inputs: options.analog_in,
+                    ..AnalogIo::default()
                 }),
                 false,
             ),

@@ -765,9 +765,10 @@ impl Objects {
         action: Action,
     ) -> Result<(), ErrorId> {
         match action {
-            Action::DriveFault { .. } | Action::SetInput { .. } | Action::SetInputValue { .. } => {
-                Err(ErrorId::IllegalObject)
-            }
+            Action::DriveFault { .. }
+            | Action::SetInput { .. }
+            | Action::SetInputValue { .. }
+            | Action::SetOutputValue { .. } => Err(ErrorId::IllegalObject),
             Action::OutputCam {
                 enable,
                 on_position,

@@ -568,6 +568,8 @@ fn connection(
         }
         DeviceKind::EthercatDio
         | DeviceKind::EthercatDioInputs
+        | DeviceKind::EthercatAio
+        | DeviceKind::EthercatAioInputs
         | DeviceKind::SimDigitalOutput(_)
         | DeviceKind::SimDigitalInput(_)
         | DeviceKind::SimAnalogInput(_)

@@ -54,7 +54,7 @@ pub(super) fn signals(
                 device: dev.name.clone(),
                 kind: dev.kind.name(),
                 needs: "a device with channels (`sim_digital_output`, `sim_digital_input`, \
-                        `sim_analog_input`, `sim_analog_output`, `sim_counter`, an EtherCAT `dio`)",
+                        `sim_analog_input`, `sim_analog_output`, `sim_counter`, an EtherCAT `dio` or `aio`)",
             };
             return Err(at("device", problem));
         };
@@ -147,7 +147,7 @@ fn declared_type(
 fn kinds_of(t: &str) -> &'static str {
     match t {
         "integer" => "`sim_counter`",
-        "float" => "`sim_analog_input`, `sim_analog_output`",
+        "float" => "`sim_analog_input`, `sim_analog_output`, an EtherCAT `aio`",
         _ => "`sim_digital_input`, `sim_digital_output`",
     }
 }
