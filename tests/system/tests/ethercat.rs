@@ -710,3 +710,89 @@ fn mc_reset_brings_a_lost_segment_back_to_op_and_the_axis_moves_again() {
     eprintln!("{end}");
     remove_dir(&dir);
 }
+
+/// The analog terminal of the cell file (`role = "aio"`, the emulator's `aio`) after the
+/// digital one, its output 1 and input 1 as float signals.
+const AIO: &str = r#"[[ethercat.subdevices]]
+name = "ai_ao"
+identity = { vendor = 0x00000002, product = 0x11163052, revision = 0x00100000 }
+role = "aio"
+inputs = "ai_ao_in"
+
+[signals.valve_cmd]
+device = "ai_ao"
+channel = 1
+type = "float"
+
+[signals.valve_back]
+device = "ai_ao_in"
+channel = 1
+type = "float"
+
+# An output signal on the terminal's channel 1"#;
+
+#[test]
+fn a_float_output_on_an_aio_terminal_comes_back_on_its_looped_input_quantized() {
+    let _turn = turn();
+    let ns = netns("a");
+    let _sim = start_sim(&ns, "drive,dio,aio", 3);
+    let dir = fresh_dir(&format!("tandem-ethercat-aio-{}", std::process::id()));
+    let cell = cell(&dir, "# An output signal on the terminal's channel 1", AIO);
+    let script = dir.join("script.toml");
+    let example = std::fs::read_to_string(root().join("config/ethercat.script.toml")).unwrap();
+    std::fs::write(
+        &script,
+        format!(
+            "{example}\n[[at]]\nt = 0.5\naxis = \"valve_cmd\"\ninstruction = \"SetOutput\"\n\
+             value = 2.5\n"
+        ),
+    )
+    .unwrap();
+    let rec = dir.join("rec");
+    let up = Spawned::start(
+        tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+            .arg("--script")
+            .arg(&script),
+    );
+    let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
+    assert!(status.success(), "tandem up failed: {status}\n{up_log}");
+    assert!(!up_log.contains("panicked"), "{up_log}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // The drive on the same segment still enables and moves.
+    assert!(log.contains("slide MC_MoveAbsolute job 3: Done"), "{log}");
+    assert!(!log.contains("slide alarm"), "{log}");
+    let line_of = |what: &str| -> (f64, String) {
+        let line = log
+            .lines()
+            .find(|l| l.contains(what))
+            .unwrap_or_else(|| panic!("no `{what}` in\n{log}"));
+        let t = line.trim_start_matches("t=").split(' ').next().unwrap();
+        (t.parse().unwrap(), line.to_string())
+    };
+    // SetOutput at 0.5 s: the output channel takes code 8192 (2.5 V · 32767 / 10, rounded).
+    let (out_t, out) = line_of("valve_cmd output = ");
+    assert_eq!(
+        out,
+        "t=0.500000000 valve_cmd output = 2.50007629627369 [8192]"
+    );
+    // The word goes out with the next exchange, the emulator's loop puts it on input 1, the
+    // node samples it as a float input: the same code, the same volts, in the log once.
+    let (back_t, back) = line_of("valve_back input = ");
+    assert!(
+        back.ends_with("valve_back input = 2.50007629627369 [8192]"),
+        "{back}"
+    );
+    assert_eq!(log.matches("valve_back input = ").count(), 1, "{log}");
+    let cycles = ((back_t - out_t) / 0.002).round();
+    eprintln!("aio loop: output at {out_t} s, back on the input at {back_t} s ({cycles} cycles)");
+    // 2 cycles without late ones: the script entry acts before the exchange of its boundary,
+    // so the word goes out with that exchange; the emulator puts it on its inputs after the
+    // datagram read them, the exchange a cycle later reads it, and the node takes that image
+    // back and samples it at the next boundary. The bound leaves room for late cycles on the
+    // shared host.
+    assert!(
+        (2.0..=10.0).contains(&cycles),
+        "output at {out_t} s, back at {back_t} s"
+    );
+    remove_dir(&dir);
+}
