@@ -544,6 +544,8 @@ struct Part {
     words_out: [i16; 2],
     /// The input words received (analog terminals).
     words_in: [i16; 2],
+    /// The counter value received (encoder terminals).
+    count: u32,
     /// The inputs byte received (digital terminals).
     inputs: u8,
     /// The inputs byte last logged.
@@ -770,6 +772,11 @@ impl Link {
                 if let Some(d) = self.drives.iter_mut().find(|d| d.0 == p.device) {
                     d.1 = p.feedback;
                 }
+                continue;
+            }
+            if p.role == EthercatRole::Enc {
+                // The counter value as the integer channel 1 of the terminal's own device.
+                exec.set_input_value(p.device, 1, t, f64::from(p.count));
                 continue;
             }
             if p.role == EthercatRole::Aio {
@@ -1355,7 +1362,7 @@ async fn check_and_map<DC>(
         }
         let map = match role {
             EthercatRole::Cia402 => Some(read_mapping(name, sd, &plan.interface).await?),
-            EthercatRole::Dio | EthercatRole::Aio => None,
+            EthercatRole::Dio | EthercatRole::Aio | EthercatRole::Enc => None,
         };
         parts.push(Part {
             device: *device,
@@ -1366,6 +1373,7 @@ async fn check_and_map<DC>(
             outputs: 0,
             words_out: [0; 2],
             words_in: [0; 2],
+            count: 0,
             inputs: 0,
             inputs_logged: 0,
             inputs_device: *inputs_device,
@@ -1500,6 +1508,10 @@ async fn serve<DC>(
                         for (c, w) in p.words_in.iter_mut().enumerate() {
                             *w = get(&input, 2 * c, 2, true) as i16;
                         }
+                    }
+                    // The status word, then the counter value 0x6000:11 (UINT32).
+                    None if p.role == EthercatRole::Enc => {
+                        p.count = get(&input, 2, 4, false) as u32
                     }
                     None => p.inputs = input.first().copied().unwrap_or(0),
                 }
@@ -1685,6 +1697,7 @@ mod tests {
             outputs: 0,
             words_out: [0; 2],
             words_in: [0; 2],
+            count: 0,
             inputs: 0,
             inputs_logged: 0,
             inputs_device: None,

@@ -172,7 +172,16 @@ pub enum DeviceKind {
     /// The 2 ±10 V inputs of such a terminal (`inputs = "<name>"` of its SubDevice), `float`
     /// channels of a device of their own.
     EthercatAioInputs,
+    /// An incremental encoder terminal on the node's EtherCAT segment (`role = "enc"`): its
+    /// 32-bit counter value as channel 1, an `integer` input read as a `sim_counter`'s.
+    EthercatEnc,
 }
+
+/// The counter of an EtherCAT encoder terminal (`role = "enc"`): 1 channel, 32 bits.
+pub const ETHERCAT_ENC_COUNTER: CounterParams = CounterParams {
+    channels: 1,
+    bits: 32,
+};
 
 /// The channels of an EtherCAT analog terminal (`role = "aio"`, both directions): 2 channels,
 /// ±10 V, 16-bit signed words, 0x7FFF = +10 V (the EL31xx/EL41xx presentation).
@@ -223,6 +232,8 @@ pub enum EthercatRole {
     Dio,
     /// An analog input/output terminal (2 inputs, 2 outputs, ±10 V, 16-bit words).
     Aio,
+    /// An incremental encoder terminal (a 32-bit counter value).
+    Enc,
 }
 
 /// One expected SubDevice of a segment.
@@ -268,6 +279,7 @@ impl DeviceKind {
             DeviceKind::EthercatDioInputs => "ethercat_dio_inputs",
             DeviceKind::EthercatAio => "ethercat_aio",
             DeviceKind::EthercatAioInputs => "ethercat_aio_inputs",
+            DeviceKind::EthercatEnc => "ethercat_enc",
         }
     }
 
@@ -283,6 +295,7 @@ impl DeviceKind {
             DeviceKind::EthercatDioInputs => Some((8, false, SignalDirection::Input)),
             DeviceKind::EthercatAio => Some((2, false, SignalDirection::Output)),
             DeviceKind::EthercatAioInputs => Some((2, false, SignalDirection::Input)),
+            DeviceKind::EthercatEnc => Some((1, false, SignalDirection::Input)),
             DeviceKind::SimDigitalOutput(p) => {
                 Some((p.channels, p.timestamped, SignalDirection::Output))
             }
@@ -315,7 +328,7 @@ impl DeviceKind {
             | DeviceKind::SimAnalogOutput(_)
             | DeviceKind::EthercatAio
             | DeviceKind::EthercatAioInputs => Some(SignalType::Float),
-            DeviceKind::SimCounter(_) => Some(SignalType::Integer),
+            DeviceKind::SimCounter(_) | DeviceKind::EthercatEnc => Some(SignalType::Integer),
         }
     }
 }

@@ -208,7 +208,7 @@ fn an_unknown_role_is_refused_with_the_roles() {
         p,
         Problem::NotOneOf {
             value: "analog".into(),
-            options: vec!["cia402", "dio", "aio"]
+            options: vec!["cia402", "dio", "aio", "enc"]
         }
     );
 }
@@ -407,4 +407,46 @@ fn an_aio_terminal_refuses_drive_keys_a_third_channel_and_a_bool_signal() {
         format!("{p}").contains("`ethercat_aio` with `float` channels"),
         "{p}"
     );
+}
+
+#[test]
+fn an_enc_terminal_is_one_integer_input_and_takes_no_inputs_device() {
+    let enc = "[[ethercat.subdevices]]\nname = \"wheel\"\n\
+               identity = { vendor = 0x00000002, product = 0x13ED3052, revision = 0x00100000 }\n\
+               role = \"enc\"\n\n[signals.wheel_count]\ndevice = \"wheel\"\nchannel = 1\n\n\
+               # An output signal on the terminal's channel 1";
+    let src = with("# An output signal on the terminal's channel 1", enc);
+    let cell = parse("c.toml", &src).unwrap();
+    let seg = &cell.ethercat[0];
+    assert_eq!(seg.subdevices[2].role, EthercatRole::Enc);
+    assert_eq!(
+        cell.devices[seg.subdevices[2].device.0].kind,
+        DeviceKind::EthercatEnc
+    );
+    let k = cell.signal("wheel_count").unwrap();
+    assert_eq!(
+        cell.signals[k.0].signal_type,
+        tandem_config::SignalType::Integer
+    );
+    assert_eq!(
+        cell.signals[k.0].direction,
+        tandem_config::SignalDirection::Input
+    );
+    let bad = src.replacen("role = \"enc\"", "role = \"enc\"\ninputs = \"wheel_in\"", 1);
+    let (_, key, p) = refused(&bad);
+    assert_eq!(key, "ethercat[0].subdevices[2].inputs");
+    assert_eq!(
+        p,
+        Problem::Invalid("only for `role = \"dio\"` or `role = \"aio\"`")
+    );
+    let bad = src.replacen(
+        "device = \"wheel\"\nchannel = 1",
+        "device = \"wheel\"\nchannel = 2",
+        1,
+    );
+    let (_, key, _) = refused(&bad);
+    assert_eq!(key, "signals.wheel_count.channel");
+    let bad = src.replacen("role = \"enc\"", "role = \"enc\"\ntransport_cycles = 4", 1);
+    let (_, key, _) = refused(&bad);
+    assert_eq!(key, "ethercat[0].subdevices[2].transport_cycles");
 }

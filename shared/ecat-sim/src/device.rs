@@ -41,6 +41,9 @@ pub enum DeviceKind {
     /// A 2-channel ±10 V analog input and 2-channel ±10 V analog output terminal without
     /// mailbox (`aio`).
     AnalogIo,
+    /// A 1-channel incremental encoder terminal with a 32-bit counter, without mailbox
+    /// (`enc`).
+    Encoder,
 }
 
 /// A device name that is not one of `drive`, `dio`.
@@ -49,7 +52,7 @@ pub struct UnknownDevice;
 
 impl fmt::Display for UnknownDevice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("unknown device kind (expected `drive`, `dio` or `aio`)")
+        f.write_str("unknown device kind (expected `drive`, `dio`, `aio` or `enc`)")
     }
 }
 
@@ -62,6 +65,7 @@ impl FromStr for DeviceKind {
             "drive" => Ok(Self::Cia402Drive),
             "dio" => Ok(Self::DigitalIo),
             "aio" => Ok(Self::AnalogIo),
+            "enc" => Ok(Self::Encoder),
             _ => Err(UnknownDevice),
         }
     }
@@ -80,6 +84,8 @@ pub struct DeviceOptions {
     /// What the analog inputs of every analog I/O terminal read when not looped back: the
     /// 16-bit codes of channels 1 and 2.
     pub analog_in: [i16; 2],
+    /// The velocity every encoder terminal counts at (increments per second).
+    pub encoder_velocity: i64,
 }
 
 impl Default for DeviceOptions {
@@ -89,6 +95,7 @@ impl Default for DeviceOptions {
             dio_loopback: false,
             aio_loopback: false,
             analog_in: [0; 2],
+            encoder_velocity: 0,
         }
     }
 }
@@ -271,6 +278,90 @@ impl AnalogIo {
             if let Some(dst) = inputs.get_mut(2 * c..2 * c + 2) {
                 dst.copy_from_slice(&w.to_le_bytes());
             }
+        }
+    }
+}
+
+/// Product code of the encoder terminal: that of an EL5101 (incremental encoder interface),
+/// (5101 << 16) | 0x3052.
+pub const ENC_PRODUCT_CODE: u32 = 0x13ED_3052;
+
+/// The encoder terminal: 6 input bytes (SM0 at 0x1000): the status word 0x6000:01 (16 bit,
+/// always 0 here) and the counter value 0x6000:11 (UINT32), little-endian, in one TxPDO
+/// 0x1A00 (the EL5101's newer layout keeps the status as single bits 0x6000:01..10; the
+/// emulation presents them as one word). No outputs (an EL5101's control word and set counter
+/// value are not emulated). The counter counts `velocity` increments per second from the
+/// first exchange, modulo 2^32.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct EncoderTerminal {
+    /// Increments per second.
+    pub velocity: i64,
+    /// The counter value of the last exchange.
+    pub count: u32,
+    first_ns: Option<u64>,
+}
+
+impl EncoderTerminal {
+    /// A terminal counting `velocity` increments per second from its first exchange.
+    pub fn new(velocity: i64) -> Self {
+        Self {
+            velocity,
+            ..Self::default()
+        }
+    }
+
+    /// The SII of the terminal.
+    pub fn sii(serial: u32) -> SiiSpec {
+        SiiSpec {
+            identity: Identity {
+                vendor: BECKHOFF_VENDOR_ID,
+                product: ENC_PRODUCT_CODE,
+                revision: 0x0010_0000,
+                serial,
+            },
+            order: "EL5101",
+            name: "EL5101 1Ch. Enc. Interface (emulated)",
+            mailbox_protocols: 0,
+            coe_details: 0,
+            fmmus: vec![FmmuUsage::Inputs],
+            sync_managers: vec![SmSpec {
+                start: 0x1000,
+                length: 6,
+                control: 0x20,
+                kind: SmType::Inputs,
+            }],
+            tx_pdos: vec![PdoSpec {
+                index: 0x1A00,
+                sync_manager: 0,
+                entries: vec![
+                    PdoEntry {
+                        index: 0x6000,
+                        subindex: 0x01,
+                        bits: 16,
+                    },
+                    PdoEntry {
+                        index: 0x6000,
+                        subindex: 0x11,
+                        bits: 32,
+                    },
+                ],
+            }],
+            rx_pdos: Vec::new(),
+        }
+    }
+
+    /// The count at `now_ns`: `velocity` · (time since the first exchange), modulo 2^32.
+    fn cycle(&mut self, inputs: &mut [u8], now_ns: u64) {
+        let first = *self.first_ns.get_or_insert(now_ns);
+        let dt = i128::from(now_ns.saturating_sub(first));
+        let counts = i128::from(self.velocity) * dt / 1_000_000_000;
+        // Modulo 2^32: the register wraps.
+        self.count = counts as u32;
+        for (dst, src) in inputs
+            .iter_mut()
+            .zip([0u8, 0].into_iter().chain(self.count.to_le_bytes()))
+        {
+            *dst = src;
         }
     }
 }
@@ -542,6 +633,8 @@ pub enum Model {
     DigitalIo(DigitalIo),
     /// An analog I/O terminal.
     AnalogIo(AnalogIo),
+    /// An encoder terminal.
+    Encoder(EncoderTerminal),
     /// A CiA 402 drive.
     Drive(Box<Cia402Drive>),
 }
@@ -550,7 +643,7 @@ impl Model {
     /// The object dictionary, for devices with CoE.
     pub fn od_mut(&mut self) -> Option<&mut ObjectDictionary> {
         match self {
-            Self::DigitalIo(_) | Self::AnalogIo(_) => None,
+            Self::DigitalIo(_) | Self::AnalogIo(_) | Self::Encoder(_) => None,
             Self::Drive(d) => Some(&mut d.od),
         }
     }
@@ -560,6 +653,7 @@ impl Model {
         match self {
             Self::DigitalIo(_) => (1, 1),
             Self::AnalogIo(_) => (4, 4),
+            Self::Encoder(_) => (0, 6),
             Self::Drive(d) => d.image_sizes(),
         }
     }
@@ -576,6 +670,7 @@ impl Model {
         match self {
             Self::DigitalIo(d) => d.cycle(outputs, inputs, op),
             Self::AnalogIo(d) => d.cycle(outputs, inputs, op),
+            Self::Encoder(d) => d.cycle(inputs, now_ns),
             Self::Drive(d) => d.cycle(outputs, inputs, op, now_ns),
         }
     }
@@ -614,6 +709,31 @@ mod tests {
         };
         fixed.cycle(&out, &mut inp, true);
         assert_eq!(inp, [0x00, 0xE0, 0x05, 0x00]);
+    }
+
+    #[test]
+    fn the_encoder_terminal_counts_its_velocity_from_the_first_exchange_modulo_2_32() {
+        let mut e = EncoderTerminal {
+            velocity: 500_000,
+            ..EncoderTerminal::default()
+        };
+        let mut inp = [0xFFu8; 6];
+        e.cycle(&mut inp, 7_000_000_000);
+        assert_eq!(inp, [0; 6]);
+        e.cycle(&mut inp, 7_002_000_000);
+        assert_eq!(e.count, 1000);
+        assert_eq!(inp, [0, 0, 0xE8, 0x03, 0, 0]);
+        let mut back = EncoderTerminal {
+            velocity: -1000,
+            ..EncoderTerminal::default()
+        };
+        back.cycle(&mut inp, 0);
+        back.cycle(&mut inp, 1_000_000);
+        assert_eq!(back.count, u32::MAX, "-1 wraps");
+        let sii = EncoderTerminal::sii(1);
+        assert_eq!(sii.identity.product, 0x13ED_3052);
+        assert_eq!(sii.sync_manager(SmType::Inputs).unwrap().1.length, 6);
+        assert!(sii.sync_manager(SmType::Outputs).is_none());
     }
 
     #[test]

@@ -9,7 +9,9 @@
 use core::fmt;
 
 use crate::coe::serve_mailbox;
-use crate::device::{AnalogIo, Cia402Drive, DeviceKind, DeviceOptions, DigitalIo, Model};
+use crate::device::{
+    AnalogIo, Cia402Drive, DeviceKind, DeviceOptions, DigitalIo, EncoderTerminal, Model,
+};
 use crate::sii::{Identity, SiiSpec, SmType};
 
 /// Size of the emulated memory: registers 0x0000..0x1000 and 4 KiB of process RAM.
@@ -203,6 +205,11 @@ impl Esc {
                     inputs: options.analog_in,
                     ..AnalogIo::default()
                 }),
+                false,
+            ),
+            DeviceKind::Encoder => (
+                EncoderTerminal::sii(serial),
+                Model::Encoder(EncoderTerminal::new(options.encoder_velocity)),
                 false,
             ),
             DeviceKind::Cia402Drive => {

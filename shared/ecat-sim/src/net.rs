@@ -46,8 +46,10 @@ pub enum UsageError {
     },
     /// An option is not known.
     UnknownOption,
-    /// A device kind in `--devices` is not `drive`, `dio` or `aio`.
+    /// A device kind in `--devices` is not `drive`, `dio`, `aio` or `enc`.
     UnknownDevice,
+    /// `--encoder-velocity` is not an integer.
+    BadEncoderVelocity,
     /// `--analog-in` is not `CH=VOLTS` with channel 1 or 2 and volts within ±10.
     BadAnalogIn,
     /// `--cycle-us` is not a positive integer.
@@ -64,8 +66,11 @@ impl fmt::Display for UsageError {
             Self::NoInterface => f.write_str("--interface <name> is required"),
             Self::MissingValue { option } => write!(f, "{option} needs a value"),
             Self::UnknownOption => f.write_str("unknown option"),
-            Self::UnknownDevice => {
-                f.write_str("--devices takes a comma-separated list of `drive`, `dio`, `aio`")
+            Self::UnknownDevice => f.write_str(
+                "--devices takes a comma-separated list of `drive`, `dio`, `aio`, `enc`",
+            ),
+            Self::BadEncoderVelocity => {
+                f.write_str("--encoder-velocity takes increments per second (an integer)")
             }
             Self::BadAnalogIn => {
                 f.write_str("--analog-in takes CH=VOLTS: channel 1 or 2, a voltage from -10 to 10")
@@ -93,7 +98,7 @@ impl fmt::Display for RunError {
 impl std::error::Error for RunError {}
 
 /// The command line.
-pub const USAGE: &str = "usage: tandem-ecat-sim --interface <name> [--devices drive,dio,aio,...] [--cycle-us <n>] [--loopback] [--analog-in CH=VOLTS]... [--drop <share> [--seed <n>] [--drop-log <file>]]";
+pub const USAGE: &str = "usage: tandem-ecat-sim --interface <name> [--devices drive,dio,aio,enc,...] [--cycle-us <n>] [--loopback] [--analog-in CH=VOLTS]... [--encoder-velocity <inc/s>] [--drop <share> [--seed <n>] [--drop-log <file>]]";
 
 /// What the emulator runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -181,6 +186,11 @@ impl Options {
                 "--loopback" => {
                     device.dio_loopback = true;
                     device.aio_loopback = true;
+                }
+                "--encoder-velocity" => {
+                    device.encoder_velocity = value("--encoder-velocity")?
+                        .parse()
+                        .map_err(|_| UsageError::BadEncoderVelocity)?;
                 }
                 "--analog-in" => {
                     let (c, code) = analog_in(value("--analog-in")?)?;

@@ -35,6 +35,7 @@
 
 use tandem_config::{
     AnalogChannelParams, Cell, CounterParams, DeviceKind, SignalDirection, ETHERCAT_AIO_CHANNELS,
+    ETHERCAT_ENC_COUNTER,
 };
 use tandem_motion::catalog::error_id::ErrorId;
 
@@ -194,6 +195,7 @@ impl Values {
                 DeviceKind::EthercatAio | DeviceKind::EthercatAioInputs => {
                     Reading::Analog(ETHERCAT_AIO_CHANNELS)
                 }
+                DeviceKind::EthercatEnc => Reading::Counter(ETHERCAT_ENC_COUNTER),
                 _ => continue,
             };
             if node.is_some_and(|n| n != d.node) {

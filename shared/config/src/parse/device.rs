@@ -570,6 +570,7 @@ fn connection(
         | DeviceKind::EthercatDioInputs
         | DeviceKind::EthercatAio
         | DeviceKind::EthercatAioInputs
+        | DeviceKind::EthercatEnc
         | DeviceKind::SimDigitalOutput(_)
         | DeviceKind::SimDigitalInput(_)
         | DeviceKind::SimAnalogInput(_)

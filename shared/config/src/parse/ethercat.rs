@@ -11,11 +11,12 @@ use crate::cell::{
 use crate::error::{ConfigError, Problem};
 use crate::schema::{CellFile, EthercatSection, SubDeviceSection};
 
-/// The roles by name (room for the timestamped output and encoder terminals).
-const ROLES: [(&str, EthercatRole); 3] = [
+/// The roles by name (room for the timestamped output terminal).
+const ROLES: [(&str, EthercatRole); 4] = [
     ("cia402", EthercatRole::Cia402),
     ("dio", EthercatRole::Dio),
     ("aio", EthercatRole::Aio),
+    ("enc", EthercatRole::Enc),
 ];
 
 /// The increments per revolution of a drive without `increments_per_revolution`: 2^20, those
@@ -102,7 +103,7 @@ pub(super) fn segments(
                 kind,
             });
             if let Some(inputs) = &s.inputs {
-                let problem = if role == EthercatRole::Cia402 {
+                let problem = if matches!(role, EthercatRole::Cia402 | EthercatRole::Enc) {
                     Some(Problem::Invalid(
                         "only for `role = \"dio\"` or `role = \"aio\"`",
                     ))
@@ -263,7 +264,7 @@ fn subdevice(
                 transport_cycles,
             })
         }
-        EthercatRole::Dio | EthercatRole::Aio => {
+        EthercatRole::Dio | EthercatRole::Aio | EthercatRole::Enc => {
             let drive_key = if s.increments_per_revolution.is_some() {
                 Some("increments_per_revolution")
             } else if s.transport_cycles.is_some() {
@@ -279,10 +280,10 @@ fn subdevice(
                     Problem::Invalid("only for `role = \"cia402\"`"),
                 ));
             }
-            if role == EthercatRole::Aio {
-                DeviceKind::EthercatAio
-            } else {
-                DeviceKind::EthercatDio
+            match role {
+                EthercatRole::Aio => DeviceKind::EthercatAio,
+                EthercatRole::Enc => DeviceKind::EthercatEnc,
+                _ => DeviceKind::EthercatDio,
             }
         }
     };
