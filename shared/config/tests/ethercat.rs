@@ -432,7 +432,11 @@ fn an_enc_terminal_is_one_integer_input_and_takes_no_inputs_device() {
         cell.signals[k.0].direction,
         tandem_config::SignalDirection::Input
     );
-    let bad = src.replacen("role = \"enc\"", "role = \"enc\"\ninputs = \"wheel_in\"", 1);
+    let bad = src.replacen(
+        "\nrole = \"enc\"",
+        "\nrole = \"enc\"\ninputs = \"wheel_in\"",
+        1,
+    );
     let (_, key, p) = refused(&bad);
     assert_eq!(key, "ethercat[0].subdevices[2].inputs");
     assert_eq!(
@@ -446,7 +450,11 @@ fn an_enc_terminal_is_one_integer_input_and_takes_no_inputs_device() {
     );
     let (_, key, _) = refused(&bad);
     assert_eq!(key, "signals.wheel_count.channel");
-    let bad = src.replacen("role = \"enc\"", "role = \"enc\"\ntransport_cycles = 4", 1);
+    let bad = src.replacen(
+        "\nrole = \"enc\"",
+        "\nrole = \"enc\"\ntransport_cycles = 4",
+        1,
+    );
     let (_, key, _) = refused(&bad);
     assert_eq!(key, "ethercat[0].subdevices[2].transport_cycles");
 }
