@@ -95,6 +95,9 @@ pub(crate) struct NodeCycle<'c> {
     /// Per signal of the cell: its device, channel and whether it is timestamped (to name an
     /// output switch's signal without searching the cell's names).
     signals: Vec<(usize, u8, bool)>,
+    /// Per signal of the cell: whether it is an input (a float output set by `SetOutput`
+    /// reports its change as an input's does, without the input flag).
+    signal_inputs: Vec<bool>,
     /// The node's EtherCAT segment, if it has one.
     ethercat: Option<crate::ethercat::Link>,
 }
@@ -161,6 +164,12 @@ impl<'c> NodeCycle<'c> {
                     let ts = s.signal_type == tandem_config::SignalType::TimestampedBool;
                     (s.device.0, s.channel, ts)
                 })
+                .collect(),
+            signal_inputs: p
+                .cell
+                .signals
+                .iter()
+                .map(|s| s.direction == tandem_config::SignalDirection::Input)
                 .collect(),
             ethercat: p.ethercat,
         }
@@ -385,7 +394,10 @@ impl<'c> NodeCycle<'c> {
             };
             failed += u64::from(port.send_copy(ev).is_err());
         });
+        let inputs = &self.signal_inputs;
         self.exec.drain_input_values(|e| {
+            // A float output set by `SetOutput` comes this way too, without the input flag.
+            let input = inputs.get(e.signal).copied().unwrap_or(true);
             let (flags, value) = match e.value {
                 SignalValue::Integer(v) => (SIGNAL_INTEGER, v as f64),
                 SignalValue::Float(v) => (SIGNAL_FLOAT, v),
@@ -395,7 +407,7 @@ impl<'c> NodeCycle<'c> {
                 ref_ns: e.sampled_ns,
                 signal: e.signal as u32,
                 level: u32::from(value != 0.0),
-                flags: SIGNAL_INPUT | flags,
+                flags: if input { SIGNAL_INPUT } else { 0 } | flags,
                 reserved: 0,
                 value,
             };

@@ -513,12 +513,28 @@ async fn futures_poll_once<F: Future + Unpin>(mut f: F) -> Poll<F::Output> {
     std::future::poll_fn(|cx| Poll::Ready(Pin::new(&mut f).poll(cx))).await
 }
 
+/// The volts of an `aio` terminal's 16-bit word: `w · 10 / 32767` (0x7FFF = +10 V, the
+/// EL31xx/EL41xx presentation; `tandem_config::ETHERCAT_AIO_CHANNELS`).
+fn aio_volts(w: i16) -> f64 {
+    let p = tandem_config::ETHERCAT_AIO_CHANNELS;
+    f64::from(w) * p.range / f64::from(p.full_scale_code())
+}
+
+/// The 16-bit word of `volts` on an `aio` terminal's output: the channel's quantization
+/// (`AnalogChannelParams::quantize`), full scale at ±10 V.
+fn aio_word(volts: f64) -> i16 {
+    let (code, _) = tandem_config::ETHERCAT_AIO_CHANNELS.quantize(volts);
+    code.clamp(-32767, 32767) as i16
+}
+
 /// One SubDevice's part of the process image the two threads hand over.
 #[derive(Debug)]
 struct Part {
     /// Its device (index in the cell).
     device: usize,
-    /// A drive's mapping; `None` for a digital terminal.
+    /// What it is.
+    role: EthercatRole,
+    /// A drive's mapping; `None` for a digital or analog terminal.
     map: Option<DriveMap>,
     /// The command to send (drives).
     command: DriveCommand,
@@ -526,6 +542,12 @@ struct Part {
     feedback: DriveFeedback,
     /// The outputs byte (digital terminals).
     outputs: u8,
+    /// The output words (analog terminals: channel 1, channel 2; 0x7FFF = +10 V).
+    words_out: [i16; 2],
+    /// The input words received (analog terminals).
+    words_in: [i16; 2],
+    /// The counter value received (encoder terminals).
+    count: u32,
     /// The inputs byte received (digital terminals).
     inputs: u8,
     /// The inputs byte last logged.
@@ -754,6 +776,20 @@ impl Link {
                 }
                 continue;
             }
+            if p.role == EthercatRole::Enc {
+                // The counter value as the integer channel 1 of the terminal's own device.
+                exec.set_input_value(p.device, 1, t, f64::from(p.count));
+                continue;
+            }
+            if p.role == EthercatRole::Aio {
+                if let Some(d) = p.inputs_device {
+                    for (c, w) in (1u8..).zip(p.words_in) {
+                        // The word as volts; the terminal's stage quantizes it back to `w`.
+                        exec.set_input_value(d, c, t, aio_volts(w));
+                    }
+                }
+                continue;
+            }
             if let Some(d) = p.inputs_device {
                 exec.set_input_levels(d, t, u32::from(p.inputs));
             }
@@ -779,6 +815,13 @@ impl Link {
             if p.map.is_some() {
                 p.command = exec.drive_command(p.device).copied().unwrap_or_default();
                 fault_reset |= p.command.controlword & controlword::FAULT_RESET != 0;
+            } else if p.role == EthercatRole::Aio {
+                // The values the last step left on its output channels, as 16-bit words.
+                if let Some(v) = exec.value_device(p.device) {
+                    for (w, x) in p.words_out.iter_mut().zip(v.values) {
+                        *w = aio_word(x.as_f64());
+                    }
+                }
             } else {
                 // The levels the last step left on its output channels (bit c - 1: channel c).
                 p.outputs = exec
@@ -1321,14 +1364,18 @@ async fn check_and_map<DC>(
         }
         let map = match role {
             EthercatRole::Cia402 => Some(read_mapping(name, sd, &plan.interface).await?),
-            EthercatRole::Dio => None,
+            EthercatRole::Dio | EthercatRole::Aio | EthercatRole::Enc => None,
         };
         parts.push(Part {
             device: *device,
+            role: *role,
             map,
             command: DriveCommand::default(),
             feedback: DriveFeedback::default(),
             outputs: 0,
+            words_out: [0; 2],
+            words_in: [0; 2],
+            count: 0,
             inputs: 0,
             inputs_logged: 0,
             inputs_device: *inputs_device,
@@ -1436,6 +1483,11 @@ async fn serve<DC>(
             let mut out = sd.outputs_raw_mut();
             match &p.map {
                 Some(map) => encode(map, &p.command, &mut out),
+                None if p.role == EthercatRole::Aio => {
+                    for (c, w) in p.words_out.iter().enumerate() {
+                        put(&mut out, 2 * c, 2, i64::from(*w));
+                    }
+                }
                 None => put(&mut out, 0, 1, i64::from(p.outputs)),
             }
         }
@@ -1454,6 +1506,15 @@ async fn serve<DC>(
                 let input = sd.inputs_raw();
                 match &p.map {
                     Some(map) => p.feedback = decode(map, &input),
+                    None if p.role == EthercatRole::Aio => {
+                        for (c, w) in p.words_in.iter_mut().enumerate() {
+                            *w = get(&input, 2 * c, 2, true) as i16;
+                        }
+                    }
+                    // The status word, then the counter value 0x6000:11 (UINT32).
+                    None if p.role == EthercatRole::Enc => {
+                        p.count = get(&input, 2, 4, false) as u32
+                    }
                     None => p.inputs = input.first().copied().unwrap_or(0),
                 }
             }
@@ -1631,10 +1692,14 @@ mod tests {
         let (bus_out, from_bus) = sync_channel(1);
         let part = Part {
             device: drive,
+            role: EthercatRole::Cia402,
             map: Some(emulated()),
             command: DriveCommand::default(),
             feedback: DriveFeedback::default(),
             outputs: 0,
+            words_out: [0; 2],
+            words_in: [0; 2],
+            count: 0,
             inputs: 0,
             inputs_logged: 0,
             inputs_device: None,
@@ -1914,6 +1979,17 @@ mod tests {
                 .unwrap()
                 .contains("miss 1 in a row (working counter 2 of 3)"));
         });
+    }
+
+    #[test]
+    fn an_aio_word_is_the_channel_quantization_of_plus_minus_10_v() {
+        assert_eq!(aio_word(2.5), 8192);
+        assert_eq!(aio_word(-10.0), -32767);
+        assert_eq!(aio_word(12.0), 32767);
+        assert_eq!(aio_volts(8192), 8192.0 * 10.0 / 32767.0);
+        for w in [-32767i16, -1, 0, 1, 8192, 32767] {
+            assert_eq!(aio_word(aio_volts(w)), w, "the word back from its volts");
+        }
     }
 
     #[test]

@@ -410,11 +410,12 @@ pub(crate) fn owns(cell: &Cell, n: usize, target: &str, action: &Action) -> bool
             .iter()
             .find(|d| d.name == target)
             .map(|d| d.node),
-        Action::SetInput { .. } | Action::SetInputValue { .. } => cell
-            .signal(target)
-            .and_then(|k| cell.signals.get(k.0))
-            .and_then(|s| cell.devices.get(s.device.0))
-            .map(|d| d.node),
+        Action::SetInput { .. } | Action::SetInputValue { .. } | Action::SetOutputValue { .. } => {
+            cell.signal(target)
+                .and_then(|k| cell.signals.get(k.0))
+                .and_then(|s| cell.devices.get(s.device.0))
+                .map(|d| d.node)
+        }
         Action::Command(_) => cell
             .axes
             .iter()

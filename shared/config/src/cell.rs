@@ -166,7 +166,30 @@ pub enum DeviceKind {
     /// The 8 inputs of such a terminal (`inputs = "<name>"` of its SubDevice), a device of
     /// their own.
     EthercatDioInputs,
+    /// An analog input/output terminal on the node's EtherCAT segment (`role = "aio"`): its 2
+    /// ±10 V outputs ([`ETHERCAT_AIO_CHANNELS`]), `float` channels.
+    EthercatAio,
+    /// The 2 ±10 V inputs of such a terminal (`inputs = "<name>"` of its SubDevice), `float`
+    /// channels of a device of their own.
+    EthercatAioInputs,
+    /// An incremental encoder terminal on the node's EtherCAT segment (`role = "enc"`): its
+    /// 32-bit counter value as channel 1, an `integer` input read as a `sim_counter`'s.
+    EthercatEnc,
 }
+
+/// The counter of an EtherCAT encoder terminal (`role = "enc"`): 1 channel, 32 bits.
+pub const ETHERCAT_ENC_COUNTER: CounterParams = CounterParams {
+    channels: 1,
+    bits: 32,
+};
+
+/// The channels of an EtherCAT analog terminal (`role = "aio"`, both directions): 2 channels,
+/// ±10 V, 16-bit signed words, 0x7FFF = +10 V (the EL31xx/EL41xx presentation).
+pub const ETHERCAT_AIO_CHANNELS: AnalogChannelParams = AnalogChannelParams {
+    channels: 2,
+    range: 10.0,
+    bits: 16,
+};
 
 /// What the configuration knows of a CiA 402 drive on an EtherCAT segment.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -207,6 +230,10 @@ pub enum EthercatRole {
     Cia402,
     /// A digital input/output terminal (8 inputs, 8 outputs, one bit each).
     Dio,
+    /// An analog input/output terminal (2 inputs, 2 outputs, ±10 V, 16-bit words).
+    Aio,
+    /// An incremental encoder terminal (a 32-bit counter value).
+    Enc,
 }
 
 /// One expected SubDevice of a segment.
@@ -250,6 +277,9 @@ impl DeviceKind {
             DeviceKind::EthercatCia402(_) => "ethercat_cia402",
             DeviceKind::EthercatDio => "ethercat_dio",
             DeviceKind::EthercatDioInputs => "ethercat_dio_inputs",
+            DeviceKind::EthercatAio => "ethercat_aio",
+            DeviceKind::EthercatAioInputs => "ethercat_aio_inputs",
+            DeviceKind::EthercatEnc => "ethercat_enc",
         }
     }
 
@@ -263,6 +293,9 @@ impl DeviceKind {
             | DeviceKind::EthercatCia402(_) => None,
             DeviceKind::EthercatDio => Some((8, false, SignalDirection::Output)),
             DeviceKind::EthercatDioInputs => Some((8, false, SignalDirection::Input)),
+            DeviceKind::EthercatAio => Some((2, false, SignalDirection::Output)),
+            DeviceKind::EthercatAioInputs => Some((2, false, SignalDirection::Input)),
+            DeviceKind::EthercatEnc => Some((1, false, SignalDirection::Input)),
             DeviceKind::SimDigitalOutput(p) => {
                 Some((p.channels, p.timestamped, SignalDirection::Output))
             }
@@ -291,10 +324,11 @@ impl DeviceKind {
                     SignalType::Bool
                 })
             }
-            DeviceKind::SimAnalogInput(_) | DeviceKind::SimAnalogOutput(_) => {
-                Some(SignalType::Float)
-            }
-            DeviceKind::SimCounter(_) => Some(SignalType::Integer),
+            DeviceKind::SimAnalogInput(_)
+            | DeviceKind::SimAnalogOutput(_)
+            | DeviceKind::EthercatAio
+            | DeviceKind::EthercatAioInputs => Some(SignalType::Float),
+            DeviceKind::SimCounter(_) | DeviceKind::EthercatEnc => Some(SignalType::Integer),
         }
     }
 }

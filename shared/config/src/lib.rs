@@ -61,7 +61,8 @@ pub use cell::{
     EncoderEntry, EncoderIndex, EncoderSource, EthercatDriveParams, EthercatIdentity, EthercatRole,
     EthercatSegment, EthercatSubDevice, InputBindings, Leader, LeadingValueConfig,
     MeasuringInputEntry, Node, OutputCamEntry, Realtime, Registration, SensorEntry,
-    SignalDirection, SignalEntry, SignalIndex, SignalType, LEADING_BUFFER, MAX_CHANNELS,
+    SignalDirection, SignalEntry, SignalIndex, SignalType, ETHERCAT_AIO_CHANNELS,
+    ETHERCAT_ENC_COUNTER, LEADING_BUFFER, MAX_CHANNELS,
 };
 pub use error::{ConfigError, DelayShortfall, Problem, SegmentProblem};
 pub use parse::{load, locate, locate_in_array, parse};

@@ -58,6 +58,9 @@ pub struct ObjectNames<'a> {
     /// The input signals among them that take a number (`integer`, `float`), and whether
     /// it must be whole (`integer`).
     pub value_signals: Vec<(&'a str, bool)>,
+    /// The `float` output signals (`SetOutput`: on a `sim_analog_output` or an EtherCAT
+    /// `aio`).
+    pub float_outputs: Vec<&'a str>,
 }
 
 /// One timed command.
@@ -146,13 +149,20 @@ pub fn parse_cell(file: &str, src: &str, cell: &crate::Cell) -> Result<Script, C
                 (x.name.as_str(), whole)
             })
             .collect(),
+        float_outputs: cell
+            .signals
+            .iter()
+            .filter(|x| x.direction == crate::cell::SignalDirection::Output)
+            .filter(|x| x.signal_type == crate::cell::SignalType::Float)
+            .map(|x| x.name.as_str())
+            .collect(),
     };
     parse_with(file, src, &names, &cams, &objects)
 }
 
 /// The instructions of output cams, cam tracks, measuring inputs and simulated devices: name,
 /// the kind of object it addresses (0 output cam, 1 cam track, 2 measuring input, 3 device,
-/// 4 input signal, 5 digital cam switch) and parameters with defaults.
+/// 4 input signal, 5 digital cam switch, 6 float output signal) and parameters with defaults.
 type ObjectInstruction = (&'static str, u8, &'static [(&'static str, Value)]);
 
 const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
@@ -210,6 +220,7 @@ const OBJECT_INSTRUCTIONS: &[ObjectInstruction] = &[
         4,
         &[("value", Value::Bool(true)), ("pulse", Value::Num(0.0))],
     ),
+    ("SetOutput", 6, &[("value", Value::Num(0.0))]),
     (
         "MC_DigitalCamSwitch_BkPlcMc",
         5,
@@ -298,6 +309,12 @@ fn object_entry(t: &toml_edit::Table, spec: &ObjectInstruction) -> Result<Action
                 .and_then(seconds_to_ns)
                 .ok_or(wrong("pulse", Expected::Number))?,
         },
+        "SetOutput" => {
+            if !t.contains_key("value") {
+                return Err(wrong("value", Expected::Number));
+            }
+            Action::SetOutputValue { value: x(0) }
+        }
         "MC_DigitalCamSwitch_BkPlcMc" => Action::DigitalCamSwitch {
             enable: b(0),
             enable_mask: Some(x(1))
@@ -438,6 +455,7 @@ fn object_instruction<'t>(
         2 => (&objects.measuring_inputs, "measuring input"),
         3 => (&objects.devices, "device"),
         5 => (&objects.digital_cam_switches, "digital cam switch"),
+        6 => (&objects.float_outputs, "float output signal"),
         _ => (&objects.input_signals, "input signal"),
     };
     if !list.contains(&target) {

@@ -208,7 +208,7 @@ fn an_unknown_role_is_refused_with_the_roles() {
         p,
         Problem::NotOneOf {
             value: "analog".into(),
-            options: vec!["cia402", "dio"]
+            options: vec!["cia402", "dio", "aio", "enc"]
         }
     );
 }
@@ -270,7 +270,10 @@ fn a_dio_inputs_device_is_refused_on_a_drive_taken_or_not_plain() {
     let (line, key, p) = refused(&src);
     assert_eq!(key, "ethercat[0].subdevices[0].inputs");
     assert_eq!(line, Some(line_of(&src, "inputs = \"servo_in\"")));
-    assert_eq!(p, Problem::Invalid("only for `role = \"dio\"`"));
+    assert_eq!(
+        p,
+        Problem::Invalid("only for `role = \"dio\"` or `role = \"aio\"`")
+    );
     for (name, want) in [
         ("slide_servo", Problem::NameTaken("slide_servo".into())),
         ("io", Problem::NameTaken("io".into())),
@@ -326,4 +329,132 @@ fn an_axis_cannot_take_the_digital_terminal_as_its_drive() {
         matches!(&p, Problem::DeviceKind { device, kind: "ethercat_dio", .. } if device == "io"),
         "{p:?}"
     );
+}
+
+/// The example with an analog terminal after the digital one, its output 1 and input 1 bound
+/// to `float` signals, and `extra` appended to its SubDevice table.
+fn with_aio(extra: &str) -> String {
+    with(
+        "# An output signal on the terminal's channel 1",
+        &format!(
+            "[[ethercat.subdevices]]\nname = \"ai_ao\"\n\
+             identity = {{ vendor = 0x00000002, product = 0x11163052, revision = 0x00100000 }}\n\
+             role = \"aio\"\ninputs = \"ai_ao_in\"\n{extra}\n\
+             [signals.valve_cmd]\ndevice = \"ai_ao\"\nchannel = 1\ntype = \"float\"\n\n\
+             [signals.valve_back]\ndevice = \"ai_ao_in\"\nchannel = 1\n\n\
+             # An output signal on the terminal's channel 1"
+        ),
+    )
+}
+
+#[test]
+fn an_aio_terminal_gives_two_float_outputs_and_an_inputs_device_of_two_float_inputs() {
+    let cell = parse("c.toml", &with_aio("")).unwrap();
+    let seg = &cell.ethercat[0];
+    assert_eq!(seg.subdevices[2].role, EthercatRole::Aio);
+    assert_eq!(
+        seg.subdevices[2].identity,
+        EthercatIdentity {
+            vendor: 2,
+            product: 0x1116_3052,
+            revision: 0x0010_0000
+        }
+    );
+    let out = seg.subdevices[2].device.0;
+    assert_eq!(cell.devices[out].kind, DeviceKind::EthercatAio);
+    let inputs = seg.subdevices[2].inputs.unwrap().0;
+    assert_eq!(cell.devices[inputs].kind, DeviceKind::EthercatAioInputs);
+    assert_eq!(cell.devices[inputs].name, "ai_ao_in");
+    let cmd = cell.signal("valve_cmd").unwrap();
+    let back = cell.signal("valve_back").unwrap();
+    assert_eq!(
+        cell.signals[cmd.0].signal_type,
+        tandem_config::SignalType::Float
+    );
+    assert_eq!(
+        cell.signals[back.0].signal_type,
+        tandem_config::SignalType::Float
+    );
+    assert_eq!(
+        cell.signals[cmd.0].direction,
+        tandem_config::SignalDirection::Output
+    );
+    assert_eq!(
+        cell.signals[back.0].direction,
+        tandem_config::SignalDirection::Input
+    );
+}
+
+#[test]
+fn an_aio_terminal_refuses_drive_keys_a_third_channel_and_a_bool_signal() {
+    let (_, key, p) = refused(&with_aio("transport_cycles = 4"));
+    assert_eq!(key, "ethercat[0].subdevices[2].transport_cycles");
+    assert_eq!(p, Problem::Invalid("only for `role = \"cia402\"`"));
+    let (_, key, _) = refused(&with_aio("increments_per_revolution = 4096"));
+    assert_eq!(key, "ethercat[0].subdevices[2].increments_per_revolution");
+    let src = with_aio("").replacen(
+        "device = \"ai_ao_in\"\nchannel = 1",
+        "device = \"ai_ao_in\"\nchannel = 3",
+        1,
+    );
+    let (line, key, _) = refused(&src);
+    assert_eq!(key, "signals.valve_back.channel");
+    assert_eq!(line, Some(line_of(&src, "channel = 3")));
+    let src = with_aio("").replacen("type = \"float\"", "type = \"bool\"", 1);
+    let (_, key, p) = refused(&src);
+    assert_eq!(key, "signals.valve_cmd.type");
+    assert!(
+        format!("{p}").contains("`ethercat_aio` with `float` channels"),
+        "{p}"
+    );
+}
+
+#[test]
+fn an_enc_terminal_is_one_integer_input_and_takes_no_inputs_device() {
+    let enc = "[[ethercat.subdevices]]\nname = \"wheel\"\n\
+               identity = { vendor = 0x00000002, product = 0x13ED3052, revision = 0x00100000 }\n\
+               role = \"enc\"\n\n[signals.wheel_count]\ndevice = \"wheel\"\nchannel = 1\n\n\
+               # An output signal on the terminal's channel 1";
+    let src = with("# An output signal on the terminal's channel 1", enc);
+    let cell = parse("c.toml", &src).unwrap();
+    let seg = &cell.ethercat[0];
+    assert_eq!(seg.subdevices[2].role, EthercatRole::Enc);
+    assert_eq!(
+        cell.devices[seg.subdevices[2].device.0].kind,
+        DeviceKind::EthercatEnc
+    );
+    let k = cell.signal("wheel_count").unwrap();
+    assert_eq!(
+        cell.signals[k.0].signal_type,
+        tandem_config::SignalType::Integer
+    );
+    assert_eq!(
+        cell.signals[k.0].direction,
+        tandem_config::SignalDirection::Input
+    );
+    let bad = src.replacen(
+        "\nrole = \"enc\"",
+        "\nrole = \"enc\"\ninputs = \"wheel_in\"",
+        1,
+    );
+    let (_, key, p) = refused(&bad);
+    assert_eq!(key, "ethercat[0].subdevices[2].inputs");
+    assert_eq!(
+        p,
+        Problem::Invalid("only for `role = \"dio\"` or `role = \"aio\"`")
+    );
+    let bad = src.replacen(
+        "device = \"wheel\"\nchannel = 1",
+        "device = \"wheel\"\nchannel = 2",
+        1,
+    );
+    let (_, key, _) = refused(&bad);
+    assert_eq!(key, "signals.wheel_count.channel");
+    let bad = src.replacen(
+        "\nrole = \"enc\"",
+        "\nrole = \"enc\"\ntransport_cycles = 4",
+        1,
+    );
+    let (_, key, _) = refused(&bad);
+    assert_eq!(key, "ethercat[0].subdevices[2].transport_cycles");
 }

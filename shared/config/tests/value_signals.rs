@@ -253,3 +253,38 @@ fn set_input_takes_a_number_on_a_value_signal_only() {
         assert!(e.contains(want), "{body}: {e}");
     }
 }
+
+#[test]
+fn set_output_takes_a_number_on_a_float_output_only() {
+    let src = with(
+        "[[measuring_inputs]]\nname = \"mark_reader\"",
+        "[devices.aq]\nnode = \"line\"\nkind = \"sim_analog_output\"\nchannels = 1\n\n\
+         [signals.valve_command]\ndevice = \"aq\"\nchannel = 1\n\n\
+         [[measuring_inputs]]\nname = \"mark_reader\"",
+    );
+    let c = parse("inputs.toml", &src).unwrap();
+    let script = |body: &str| {
+        let src = format!(
+            "[sim]\nduration = 1.0\n\n[[at]]\nt = 0.1\ninstruction = \"SetOutput\"\n{body}\n"
+        );
+        parse_cell("s.toml", &src, &c)
+    };
+    let ok = script("axis = \"valve_command\"\nvalue = 2.5").unwrap();
+    assert_eq!(
+        ok.entries[0].action,
+        tandem_motion::objects::action::Action::SetOutputValue { value: 2.5 }
+    );
+    for (body, want) in [
+        ("axis = \"valve_command\"", "value"),
+        ("axis = \"valve_command\"\nvalue = true", "a number"),
+        (
+            "axis = \"valve_command\"\nvalue = 1.0\npulse = 0.1",
+            "pulse",
+        ),
+        ("axis = \"web_tension\"\nvalue = 1.0", "float output signal"),
+        ("axis = \"probe\"\nvalue = 1.0", "float output signal"),
+    ] {
+        let e = script(body).expect_err(body).to_string();
+        assert!(e.contains(want), "{body}: {e}");
+    }
+}

@@ -1,4 +1,5 @@
-//! The emulated devices behind the ESCs: a digital input/output terminal and a CiA 402 servo
+//! The emulated devices behind the ESCs: a digital input/output terminal, an analog
+//! input/output terminal and a CiA 402 servo
 //! drive (the project's simulated drive, [`SimServo`], behind a CoE object dictionary).
 
 use core::fmt;
@@ -37,6 +38,12 @@ pub enum DeviceKind {
     Cia402Drive,
     /// An 8-channel digital input and output terminal without mailbox (`dio`).
     DigitalIo,
+    /// A 2-channel ±10 V analog input and 2-channel ±10 V analog output terminal without
+    /// mailbox (`aio`).
+    AnalogIo,
+    /// A 1-channel incremental encoder terminal with a 32-bit counter, without mailbox
+    /// (`enc`).
+    Encoder,
 }
 
 /// A device name that is not one of `drive`, `dio`.
@@ -45,7 +52,7 @@ pub struct UnknownDevice;
 
 impl fmt::Display for UnknownDevice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("unknown device kind (expected `drive` or `dio`)")
+        f.write_str("unknown device kind (expected `drive`, `dio`, `aio` or `enc`)")
     }
 }
 
@@ -57,6 +64,8 @@ impl FromStr for DeviceKind {
         match s {
             "drive" => Ok(Self::Cia402Drive),
             "dio" => Ok(Self::DigitalIo),
+            "aio" => Ok(Self::AnalogIo),
+            "enc" => Ok(Self::Encoder),
             _ => Err(UnknownDevice),
         }
     }
@@ -69,6 +78,14 @@ pub struct DeviceOptions {
     pub cycle_ns: i64,
     /// Digital I/O terminals read their own outputs on their inputs (a wired loop).
     pub dio_loopback: bool,
+    /// Analog I/O terminals read their own outputs on their inputs (output channel c wired
+    /// to input channel c).
+    pub aio_loopback: bool,
+    /// What the analog inputs of every analog I/O terminal read when not looped back: the
+    /// 16-bit codes of channels 1 and 2.
+    pub analog_in: [i16; 2],
+    /// The velocity every encoder terminal counts at (increments per second).
+    pub encoder_velocity: i64,
 }
 
 impl Default for DeviceOptions {
@@ -76,6 +93,9 @@ impl Default for DeviceOptions {
         Self {
             cycle_ns: DEFAULT_CYCLE_NS,
             dio_loopback: false,
+            aio_loopback: false,
+            analog_in: [0; 2],
+            encoder_velocity: 0,
         }
     }
 }
@@ -155,6 +175,193 @@ impl DigitalIo {
             } else {
                 self.inputs
             };
+        }
+    }
+}
+
+/// Product code of the analog I/O terminal: that of an EL4374 (2 analog inputs and 2 analog
+/// outputs, ±10 V among its ranges, 16 bit), (4374 << 16) | 0x3052. The emulation keeps only
+/// the value words (see [`AnalogIo`]).
+pub const AIO_PRODUCT_CODE: u32 = 0x1116_3052;
+
+/// Full scale of the analog terminal's 16-bit words: 0x7FFF stands for +10 V (the signed
+/// presentation of the EL31xx/EL41xx terminals).
+pub const AIO_FULL_SCALE: f64 = 10.0;
+
+/// The analog I/O terminal: 2 output words (SM0 at 0x1000, 4 bytes: channel 1, channel 2,
+/// INT16 little-endian) and 2 input words (SM1 at 0x1100, 4 bytes). A word is the signed
+/// 16-bit code, 0x7FFF = +10 V, 0x8001 = -10 V. No mailbox: the PDOs are those of the SII
+/// (RxPDO 0x1600 → 0x7000:11, 0x1601 → 0x7010:11; TxPDO 0x1A00 → 0x6000:11, 0x1A01 →
+/// 0x6010:11: the value entries of the EL3102/EL4132-like compact PDOs, without their status
+/// words).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct AnalogIo {
+    /// The output words as the terminal drives them (0 V outside OP).
+    pub outputs: [i16; 2],
+    /// The input words (what the plant presents), unless looped back.
+    pub inputs: [i16; 2],
+    /// Inputs read the outputs (output channel c on input channel c).
+    pub loopback: bool,
+}
+
+impl AnalogIo {
+    /// The code of `volts` on a ±10 V 16-bit word: `round(v · 32767 / 10)` clamped to ±32767.
+    pub fn code(volts: f64) -> i16 {
+        let full = f64::from(i16::MAX);
+        (volts * full / AIO_FULL_SCALE).round().clamp(-full, full) as i16
+    }
+
+    /// The SII of the terminal.
+    pub fn sii(serial: u32) -> SiiSpec {
+        let word = |index: u16| PdoEntry {
+            index,
+            subindex: 0x11,
+            bits: 16,
+        };
+        SiiSpec {
+            identity: Identity {
+                vendor: BECKHOFF_VENDOR_ID,
+                product: AIO_PRODUCT_CODE,
+                revision: 0x0010_0000,
+                serial,
+            },
+            order: "EL4374",
+            name: "EL4374 2Ch. Ana. In/Out +/-10V (emulated)",
+            mailbox_protocols: 0,
+            coe_details: 0,
+            fmmus: vec![FmmuUsage::Outputs, FmmuUsage::Inputs],
+            sync_managers: vec![
+                SmSpec {
+                    start: 0x1000,
+                    length: 4,
+                    control: 0x64,
+                    kind: SmType::Outputs,
+                },
+                SmSpec {
+                    start: 0x1100,
+                    length: 4,
+                    control: 0x20,
+                    kind: SmType::Inputs,
+                },
+            ],
+            tx_pdos: (0..2u16)
+                .map(|ch| PdoSpec {
+                    index: 0x1A00 + ch,
+                    sync_manager: 1,
+                    entries: vec![word(0x6000 + 0x10 * ch)],
+                })
+                .collect(),
+            rx_pdos: (0..2u16)
+                .map(|ch| PdoSpec {
+                    index: 0x1600 + ch,
+                    sync_manager: 0,
+                    entries: vec![word(0x7000 + 0x10 * ch)],
+                })
+                .collect(),
+        }
+    }
+
+    fn cycle(&mut self, outputs: &[u8], inputs: &mut [u8], op: bool) {
+        for (c, out) in self.outputs.iter_mut().enumerate() {
+            let w = outputs
+                .get(2 * c..2 * c + 2)
+                .map_or(0, |b| i16::from_le_bytes([b[0], b[1]]));
+            // Outside OP the outputs are in their safe state (0 V).
+            *out = if op { w } else { 0 };
+        }
+        let words = if self.loopback {
+            self.outputs
+        } else {
+            self.inputs
+        };
+        for (c, w) in words.iter().enumerate() {
+            if let Some(dst) = inputs.get_mut(2 * c..2 * c + 2) {
+                dst.copy_from_slice(&w.to_le_bytes());
+            }
+        }
+    }
+}
+
+/// Product code of the encoder terminal: that of an EL5101 (incremental encoder interface),
+/// (5101 << 16) | 0x3052.
+pub const ENC_PRODUCT_CODE: u32 = 0x13ED_3052;
+
+/// The encoder terminal: 6 input bytes (SM0 at 0x1000): the status word 0x6000:01 (16 bit,
+/// always 0 here) and the counter value 0x6000:11 (UINT32), little-endian, in one TxPDO
+/// 0x1A00 (the EL5101's newer layout keeps the status as single bits 0x6000:01..10; the
+/// emulation presents them as one word). No outputs (an EL5101's control word and set counter
+/// value are not emulated). The counter counts `velocity` increments per second from the
+/// first exchange, modulo 2^32.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct EncoderTerminal {
+    /// Increments per second.
+    pub velocity: i64,
+    /// The counter value of the last exchange.
+    pub count: u32,
+    first_ns: Option<u64>,
+}
+
+impl EncoderTerminal {
+    /// A terminal counting `velocity` increments per second from its first exchange.
+    pub fn new(velocity: i64) -> Self {
+        Self {
+            velocity,
+            ..Self::default()
+        }
+    }
+
+    /// The SII of the terminal.
+    pub fn sii(serial: u32) -> SiiSpec {
+        SiiSpec {
+            identity: Identity {
+                vendor: BECKHOFF_VENDOR_ID,
+                product: ENC_PRODUCT_CODE,
+                revision: 0x0010_0000,
+                serial,
+            },
+            order: "EL5101",
+            name: "EL5101 1Ch. Enc. Interface (emulated)",
+            mailbox_protocols: 0,
+            coe_details: 0,
+            fmmus: vec![FmmuUsage::Inputs],
+            sync_managers: vec![SmSpec {
+                start: 0x1000,
+                length: 6,
+                control: 0x20,
+                kind: SmType::Inputs,
+            }],
+            tx_pdos: vec![PdoSpec {
+                index: 0x1A00,
+                sync_manager: 0,
+                entries: vec![
+                    PdoEntry {
+                        index: 0x6000,
+                        subindex: 0x01,
+                        bits: 16,
+                    },
+                    PdoEntry {
+                        index: 0x6000,
+                        subindex: 0x11,
+                        bits: 32,
+                    },
+                ],
+            }],
+            rx_pdos: Vec::new(),
+        }
+    }
+
+    /// The count at `now_ns`: `velocity` · (time since the first exchange), modulo 2^32.
+    fn cycle(&mut self, inputs: &mut [u8], now_ns: u64) {
+        let first = *self.first_ns.get_or_insert(now_ns);
+        let dt = i128::from(now_ns.saturating_sub(first));
+        let counts = i128::from(self.velocity) * dt / 1_000_000_000;
+        // Modulo 2^32: the register wraps.
+        self.count = counts as u32;
+        for (dst, src) in inputs
+            .iter_mut()
+            .zip([0u8, 0].into_iter().chain(self.count.to_le_bytes()))
+        {
+            *dst = src;
         }
     }
 }
@@ -428,6 +635,10 @@ fn dictionary(id: Identity) -> Vec<Entry> {
 pub enum Model {
     /// A digital I/O terminal.
     DigitalIo(DigitalIo),
+    /// An analog I/O terminal.
+    AnalogIo(AnalogIo),
+    /// An encoder terminal.
+    Encoder(EncoderTerminal),
     /// A CiA 402 drive.
     Drive(Box<Cia402Drive>),
 }
@@ -436,7 +647,7 @@ impl Model {
     /// The object dictionary, for devices with CoE.
     pub fn od_mut(&mut self) -> Option<&mut ObjectDictionary> {
         match self {
-            Self::DigitalIo(_) => None,
+            Self::DigitalIo(_) | Self::AnalogIo(_) | Self::Encoder(_) => None,
             Self::Drive(d) => Some(&mut d.od),
         }
     }
@@ -445,6 +656,8 @@ impl Model {
     pub fn image_sizes(&self) -> (usize, usize) {
         match self {
             Self::DigitalIo(_) => (1, 1),
+            Self::AnalogIo(_) => (4, 4),
+            Self::Encoder(_) => (0, 6),
             Self::Drive(d) => d.image_sizes(),
         }
     }
@@ -460,7 +673,86 @@ impl Model {
     pub(crate) fn cycle(&mut self, outputs: &[u8], inputs: &mut [u8], op: bool, now_ns: u64) {
         match self {
             Self::DigitalIo(d) => d.cycle(outputs, inputs, op),
+            Self::AnalogIo(d) => d.cycle(outputs, inputs, op),
+            Self::Encoder(d) => d.cycle(inputs, now_ns),
             Self::Drive(d) => d.cycle(outputs, inputs, op, now_ns),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn the_analog_words_are_the_signed_16_bit_codes_of_plus_minus_10_v() {
+        assert_eq!(AnalogIo::code(2.5), 8192);
+        assert_eq!(AnalogIo::code(1.0), 3277);
+        assert_eq!(AnalogIo::code(10.0), 0x7FFF);
+        assert_eq!(AnalogIo::code(-10.0), -0x7FFF);
+        assert_eq!(AnalogIo::code(12.0), 0x7FFF, "clamped to full scale");
+    }
+
+    #[test]
+    fn the_analog_terminal_loops_its_outputs_back_in_op_only() {
+        let mut t = AnalogIo {
+            loopback: true,
+            ..AnalogIo::default()
+        };
+        let out = [0x00, 0x20, 0x01, 0x80];
+        let mut inp = [0u8; 4];
+        t.cycle(&out, &mut inp, false);
+        assert_eq!(inp, [0; 4], "SAFE-OP: 0 V on the outputs");
+        t.cycle(&out, &mut inp, true);
+        assert_eq!(t.outputs, [8192, -32767]);
+        assert_eq!(inp, out);
+        let mut fixed = AnalogIo {
+            inputs: [AnalogIo::code(-2.5), 5],
+            ..AnalogIo::default()
+        };
+        fixed.cycle(&out, &mut inp, true);
+        assert_eq!(inp, [0x00, 0xE0, 0x05, 0x00]);
+    }
+
+    #[test]
+    fn the_encoder_terminal_counts_its_velocity_from_the_first_exchange_modulo_2_32() {
+        let mut e = EncoderTerminal {
+            velocity: 500_000,
+            ..EncoderTerminal::default()
+        };
+        let mut inp = [0xFFu8; 6];
+        e.cycle(&mut inp, 7_000_000_000);
+        assert_eq!(inp, [0; 6]);
+        e.cycle(&mut inp, 7_002_000_000);
+        assert_eq!(e.count, 1000);
+        assert_eq!(inp, [0, 0, 0xE8, 0x03, 0, 0]);
+        let mut back = EncoderTerminal {
+            velocity: -1000,
+            ..EncoderTerminal::default()
+        };
+        back.cycle(&mut inp, 0);
+        back.cycle(&mut inp, 1_000_000);
+        assert_eq!(back.count, u32::MAX, "-1 wraps");
+        let sii = EncoderTerminal::sii(1);
+        assert_eq!(sii.identity.product, 0x13ED_3052);
+        assert_eq!(sii.sync_manager(SmType::Inputs).unwrap().1.length, 6);
+        assert!(sii.sync_manager(SmType::Outputs).is_none());
+    }
+
+    #[test]
+    fn the_analog_terminal_describes_two_words_each_way_in_its_sii() {
+        let sii = AnalogIo::sii(3);
+        assert_eq!(sii.identity.vendor, BECKHOFF_VENDOR_ID);
+        assert_eq!(sii.identity.product, 0x1116_3052);
+        let bits = |p: &[PdoSpec]| -> u32 {
+            p.iter()
+                .flat_map(|p| p.entries.iter())
+                .map(|e| u32::from(e.bits))
+                .sum()
+        };
+        assert_eq!((bits(&sii.rx_pdos), bits(&sii.tx_pdos)), (32, 32));
+        assert_eq!(sii.sync_manager(SmType::Outputs).unwrap().1.length, 4);
+        assert_eq!(sii.sync_manager(SmType::Inputs).unwrap().1.length, 4);
     }
 }

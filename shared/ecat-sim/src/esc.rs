@@ -9,7 +9,9 @@
 use core::fmt;
 
 use crate::coe::serve_mailbox;
-use crate::device::{Cia402Drive, DeviceKind, DeviceOptions, DigitalIo, Model};
+use crate::device::{
+    AnalogIo, Cia402Drive, DeviceKind, DeviceOptions, DigitalIo, EncoderTerminal, Model,
+};
 use crate::sii::{Identity, SiiSpec, SmType};
 
 /// Size of the emulated memory: registers 0x0000..0x1000 and 4 KiB of process RAM.
@@ -194,6 +196,20 @@ impl Esc {
                     loopback: options.dio_loopback,
                     ..DigitalIo::default()
                 }),
+                false,
+            ),
+            DeviceKind::AnalogIo => (
+                AnalogIo::sii(serial),
+                Model::AnalogIo(AnalogIo {
+                    loopback: options.aio_loopback,
+                    inputs: options.analog_in,
+                    ..AnalogIo::default()
+                }),
+                false,
+            ),
+            DeviceKind::Encoder => (
+                EncoderTerminal::sii(serial),
+                Model::Encoder(EncoderTerminal::new(options.encoder_velocity)),
                 false,
             ),
             DeviceKind::Cia402Drive => {

@@ -46,8 +46,12 @@ pub enum UsageError {
     },
     /// An option is not known.
     UnknownOption,
-    /// A device kind in `--devices` is not `drive` or `dio`.
+    /// A device kind in `--devices` is not `drive`, `dio`, `aio` or `enc`.
     UnknownDevice,
+    /// `--encoder-velocity` is not an integer.
+    BadEncoderVelocity,
+    /// `--analog-in` is not `CH=VOLTS` with channel 1 or 2 and volts within ±10.
+    BadAnalogIn,
     /// `--cycle-us` is not a positive integer.
     BadCycle,
     /// `--drop` is not a share between 0 and 1.
@@ -62,8 +66,14 @@ impl fmt::Display for UsageError {
             Self::NoInterface => f.write_str("--interface <name> is required"),
             Self::MissingValue { option } => write!(f, "{option} needs a value"),
             Self::UnknownOption => f.write_str("unknown option"),
-            Self::UnknownDevice => {
-                f.write_str("--devices takes a comma-separated list of `drive`, `dio`")
+            Self::UnknownDevice => f.write_str(
+                "--devices takes a comma-separated list of `drive`, `dio`, `aio`, `enc`",
+            ),
+            Self::BadEncoderVelocity => {
+                f.write_str("--encoder-velocity takes increments per second (an integer)")
+            }
+            Self::BadAnalogIn => {
+                f.write_str("--analog-in takes CH=VOLTS: channel 1 or 2, a voltage from -10 to 10")
             }
             Self::BadCycle => f.write_str("--cycle-us takes a positive integer"),
             Self::BadDrop => f.write_str("--drop takes a share of frames from 0 to 1 (0.01: 1 %)"),
@@ -88,7 +98,7 @@ impl fmt::Display for RunError {
 impl std::error::Error for RunError {}
 
 /// The command line.
-pub const USAGE: &str = "usage: tandem-ecat-sim --interface <name> [--devices drive,dio,...] [--cycle-us <n>] [--loopback] [--drop <share> [--seed <n>] [--drop-log <file>]]";
+pub const USAGE: &str = "usage: tandem-ecat-sim --interface <name> [--devices drive,dio,aio,enc,...] [--cycle-us <n>] [--loopback] [--analog-in CH=VOLTS]... [--encoder-velocity <inc/s>] [--drop <share> [--seed <n>] [--drop-log <file>]]";
 
 /// What the emulator runs.
 #[derive(Clone, Debug, PartialEq)]
@@ -145,7 +155,8 @@ impl FrameDrop {
 
 impl Options {
     /// Parses `--interface`, `--devices` (default `drive,dio`), `--cycle-us` (default 1000),
-    /// `--loopback` (digital outputs read back on the inputs), `--drop <share>` with `--seed
+    /// `--loopback` (digital and analog outputs read back on the inputs), `--analog-in
+    /// CH=VOLTS` (an analog input's reading, repeatable), `--drop <share>` with `--seed
     /// <n>` (default 1) and `--drop-log <file>`.
     pub fn parse(args: &[String]) -> Result<Self, UsageError> {
         let mut interface = None;
@@ -172,7 +183,19 @@ impl Options {
                     }
                     device.cycle_ns = us.saturating_mul(1000);
                 }
-                "--loopback" => device.dio_loopback = true,
+                "--loopback" => {
+                    device.dio_loopback = true;
+                    device.aio_loopback = true;
+                }
+                "--encoder-velocity" => {
+                    device.encoder_velocity = value("--encoder-velocity")?
+                        .parse()
+                        .map_err(|_| UsageError::BadEncoderVelocity)?;
+                }
+                "--analog-in" => {
+                    let (c, code) = analog_in(value("--analog-in")?)?;
+                    device.analog_in[c] = code;
+                }
                 "--drop" => {
                     let v: f64 = value("--drop")?.parse().map_err(|_| UsageError::BadDrop)?;
                     share = Some(v);
@@ -190,6 +213,22 @@ impl Options {
             drop_log,
         })
     }
+}
+
+/// `CH=VOLTS` of `--analog-in`: the channel's index (0 or 1) and the 16-bit code of the
+/// voltage (0x7FFF = +10 V).
+fn analog_in(arg: &str) -> Result<(usize, i16), UsageError> {
+    let (ch, volts) = arg.split_once('=').ok_or(UsageError::BadAnalogIn)?;
+    let c = match ch.trim() {
+        "1" => 0,
+        "2" => 1,
+        _ => return Err(UsageError::BadAnalogIn),
+    };
+    let v: f64 = volts.trim().parse().map_err(|_| UsageError::BadAnalogIn)?;
+    if !(v.is_finite() && v.abs() <= crate::device::AIO_FULL_SCALE) {
+        return Err(UsageError::BadAnalogIn);
+    }
+    Ok((c, crate::device::AnalogIo::code(v)))
 }
 
 /// CLOCK_MONOTONIC in ns: the ESCs' local clock (the same clock ethercrab's `ethercat_now`

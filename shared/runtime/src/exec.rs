@@ -885,6 +885,10 @@ impl<'c> Executive<'c> {
                 let k = cell.signal(target).ok_or(ErrorId::IllegalObject)?;
                 return self.values.set(k.0, t, value).map(|()| None);
             }
+            Action::SetOutputValue { value } => {
+                let k = cell.signal(target).ok_or(ErrorId::IllegalObject)?;
+                return self.values.set_output(k.0, t, value).map(|()| None);
+            }
             Action::DriveFault { code } => {
                 let d = cell.devices.iter().position(|d| d.name == target);
                 let Some(d) = d.filter(|&d| self.drives.runs(d)) else {
@@ -1124,7 +1128,21 @@ impl<'c> Executive<'c> {
                 SignalValue::Integer(v) => writeln!(log, "t={} {name} input = {v}", Secs(t))?,
             }
         }
-        Ok(())
+        let cell = self.cell;
+        let mut result = Ok(());
+        self.values.take_output_changes(|e| {
+            let name = (cell.signals.get(e.signal)).map_or("?", |s| s.name.as_str());
+            if result.is_ok() {
+                result = writeln!(
+                    log,
+                    "t={} {name} output = {} [{}]",
+                    Secs(e.sampled_ns),
+                    e.value.as_f64(),
+                    e.raw
+                );
+            }
+        });
+        result
     }
 
     /// Once the cycle motions are known: the input signals' sensors add their edges to the
@@ -1232,6 +1250,14 @@ impl<'c> Executive<'c> {
     /// this executive runs no such device.
     pub fn set_input_levels(&mut self, device: usize, t: i64, levels: u32) -> bool {
         self.inputs.set_levels(device, t, levels)
+    }
+
+    /// Channel `channel` (1-based) of analog terminal `device` reads `value` (V) from `t`:
+    /// the node's EtherCAT segment sets an `aio` terminal's inputs with it before the step at
+    /// `t`, which samples them as a simulated terminal's (quantized, logged, kept for
+    /// [`Executive::drain_input_values`]). `false` when this executive runs no such terminal.
+    pub fn set_input_value(&mut self, device: usize, channel: u8, t: i64, value: f64) -> bool {
+        self.values.set_channel(device, channel, t, value)
     }
 
     /// The RxPDO the last step wrote for external drive `device`, which the edge sends at the

@@ -766,7 +766,8 @@ impl Objects {
             Action::DriveFault { .. }
             | Action::FixedStop { .. }
             | Action::SetInput { .. }
-            | Action::SetInputValue { .. } => Err(ErrorId::IllegalObject),
+            | Action::SetInputValue { .. }
+            | Action::SetOutputValue { .. } => Err(ErrorId::IllegalObject),
             Action::OutputCam {
                 enable,
                 on_position,

@@ -24,12 +24,19 @@
 //! input (the manual's actual values come from the drive and encoder connection, 'Drive and
 //! encoder connection'), so the values go to the log, the status and the signal events only.
 //!
-//! An analog output terminal holds 0 V: no technology object writes a float output (an
-//! analog drive's setpoint is its own device's word).
+//! An analog output terminal holds 0 V until a script's `SetOutput` sets a channel
+//! ([`Values::set_output`]): the channel takes the value as it quantizes it at once, the
+//! change is logged (`output = <v> [<code>]`) at the next boundary and kept for the drain as
+//! an input's is. No technology object writes a float output (an analog drive's setpoint is
+//! its own device's word). An EtherCAT `aio` terminal's inputs are set by the node's segment
+//! at each boundary ([`Values::set_channel`]) and read as a simulated terminal's.
 //!
 //! Nothing here allocates after [`Values::new`].
 
-use tandem_config::{AnalogChannelParams, Cell, CounterParams, DeviceKind, SignalDirection};
+use tandem_config::{
+    AnalogChannelParams, Cell, CounterParams, DeviceKind, SignalDirection, ETHERCAT_AIO_CHANNELS,
+    ETHERCAT_ENC_COUNTER,
+};
 use tandem_motion::catalog::error_id::ErrorId;
 
 /// Most value changes kept between two [`crate::exec::Executive::drain_input_values`]; more
@@ -170,6 +177,8 @@ pub(crate) struct Values {
     frame: Vec<InputSignalValue>,
     /// The changes since the last drain.
     kept: Vec<InputSignalValue>,
+    /// The output changes not logged yet.
+    out_changes: Vec<InputSignalValue>,
 }
 
 impl Values {
@@ -183,6 +192,10 @@ impl Values {
                     Reading::Analog(*p)
                 }
                 DeviceKind::SimCounter(p) => Reading::Counter(*p),
+                DeviceKind::EthercatAio | DeviceKind::EthercatAioInputs => {
+                    Reading::Analog(ETHERCAT_AIO_CHANNELS)
+                }
+                DeviceKind::EthercatEnc => Reading::Counter(ETHERCAT_ENC_COUNTER),
                 _ => continue,
             };
             if node.is_some_and(|n| n != d.node) {
@@ -227,6 +240,7 @@ impl Values {
             input,
             frame: Vec::with_capacity(FRAME_MAX),
             kept: Vec::with_capacity(INPUT_VALUES),
+            out_changes: Vec::with_capacity(FRAME_MAX),
         }
     }
 
@@ -265,6 +279,99 @@ impl Values {
             },
         );
         Ok(())
+    }
+
+    /// Sets channel `channel` (1-based) of terminal `device` (index in [`Cell::devices`]) to
+    /// `value` from `at_ns`, as a script's `SetInput` sets its signal (the node's EtherCAT
+    /// segment: an `aio` terminal's input words). `false` if the terminal is not here or the
+    /// value is not finite; a full pending list drops the value (counted).
+    pub(crate) fn set_channel(
+        &mut self,
+        device: usize,
+        channel: u8,
+        at_ns: i64,
+        value: f64,
+    ) -> bool {
+        let Some(d) = self.terminals.iter_mut().find(|d| d.device == device) else {
+            return false;
+        };
+        if !value.is_finite() || channel == 0 || usize::from(channel) > CHANNELS {
+            return false;
+        }
+        if d.pending.len() == d.pending.capacity() {
+            d.status.dropped += 1;
+            return true;
+        }
+        let at = d.pending.partition_point(|x| x.at_ns <= at_ns);
+        // Within the capacity the list was made with: no allocation.
+        d.pending.insert(
+            at,
+            Stimulus {
+                at_ns,
+                channel,
+                value,
+            },
+        );
+        true
+    }
+
+    /// Sets `float` output signal `signal` to `value` at `at_ns` (a script's `SetOutput`):
+    /// its channel takes the quantized value at once. `Err` if the signal is not an analog
+    /// output of a terminal here or the value is not finite.
+    pub(crate) fn set_output(
+        &mut self,
+        signal: usize,
+        at_ns: i64,
+        value: f64,
+    ) -> Result<(), ErrorId> {
+        let (t, channel) = self
+            .slots
+            .get(signal)
+            .copied()
+            .flatten()
+            .filter(|_| !self.input.get(signal).copied().unwrap_or(true))
+            .ok_or(ErrorId::IllegalObject)?;
+        let d = self.terminals.get_mut(t).ok_or(ErrorId::IllegalObject)?;
+        if !value.is_finite() || !matches!(d.reading, Reading::Analog(_)) {
+            return Err(ErrorId::IllegalObject);
+        }
+        let (read, raw, clipped) = d.reading.read(value);
+        d.status.clipped += u64::from(clipped);
+        let c = usize::from(channel.saturating_sub(1));
+        let (Some(old), Some(slot)) = (d.raw.get_mut(c), d.status.values.get_mut(c)) else {
+            return Err(ErrorId::IllegalObject);
+        };
+        if *old == raw {
+            return Ok(());
+        }
+        *old = raw;
+        *slot = read;
+        d.status.changes += 1;
+        let e = InputSignalValue {
+            signal,
+            device: d.device,
+            channel,
+            value: read,
+            raw,
+            sampled_ns: at_ns,
+        };
+        if self.out_changes.len() < self.out_changes.capacity() {
+            self.out_changes.push(e);
+        } else {
+            d.status.dropped += 1;
+        }
+        if self.kept.len() < self.kept.capacity() {
+            self.kept.push(e);
+        } else {
+            d.status.unreported += 1;
+        }
+        Ok(())
+    }
+
+    /// The output changes since the last call (to log), then forgotten.
+    pub(crate) fn take_output_changes(&mut self, f: impl FnMut(&InputSignalValue)) {
+        self.out_changes.iter().for_each(f);
+        self.out_changes.clear();
     }
 
     /// Samples the terminals due at `t` with the values set at or before `t`: a new frame.

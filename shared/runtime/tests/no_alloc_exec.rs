@@ -403,3 +403,53 @@ fn the_input_stage_steps_without_allocating() {
     assert_eq!((edges, measured), (5, 2));
     assert_eq!(exec.status()[0].error_detail.number, 531);
 }
+
+/// The value stage as a node's EtherCAT segment drives it (`config/inputs.toml` with a
+/// `sim_analog_output` added): every cycle an analog input set from outside
+/// (`Executive::set_input_value`, an `aio`'s input word) and a float output set by
+/// `SetOutput`, both changing, sampled, logged and drained, with 0 allocations.
+#[test]
+fn the_value_stage_set_from_outside_and_by_set_output_does_not_allocate() {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let src = std::fs::read_to_string(root.join("config/inputs.toml"))
+        .unwrap()
+        .replacen(
+            "[devices.piece_counter]",
+            "[devices.valve_ao]\nnode = \"line\"\nkind = \"sim_analog_output\"\nchannels = 2\n\n\
+             [signals.valve_cmd]\ndevice = \"valve_ao\"\nchannel = 1\n\n[devices.piece_counter]",
+            1,
+        );
+    let cell = tandem_config::parse("inputs.toml", &src).unwrap();
+    let ai = cell
+        .devices
+        .iter()
+        .position(|d| d.name == "tension_ai")
+        .unwrap();
+    let ao = cell
+        .devices
+        .iter()
+        .position(|d| d.name == "valve_ao")
+        .unwrap();
+    let mut exec = Executive::new(&cell, None).unwrap();
+    let mut log = Vec::with_capacity(1 << 20);
+    let (mut allocations, mut values) = (0, 0u64);
+    for k in 0..2000i64 {
+        let t = k * 1_000_000;
+        let v = (k % 200) as f64 * 0.05 - 5.0;
+        arm();
+        assert!(exec.set_input_value(ai, 1, t, v));
+        let action = tandem_motion::objects::action::Action::SetOutputValue { value: -v };
+        let applied = exec.apply_at(t, t, "valve_cmd", "SetOutput", action, &mut log);
+        exec.step(t, &mut log).unwrap();
+        exec.drain_input_values(|_| values += 1);
+        exec.drain_job_notes(|_| {});
+        exec.drain_io_notes(|_| {});
+        exec.drain_input_edges(|_| {});
+        allocations += disarm().0;
+        assert!(matches!(applied, Ok(Ok(_))), "{applied:?}");
+    }
+    assert_eq!(allocations, 0, "allocations on the cyclic path");
+    // It did work: both channels changed every cycle (from 0 V to -5 V at the first).
+    assert_eq!(values, 2 * 2000, "input and output changes");
+    assert_eq!(exec.value_device(ao).unwrap().changes, 2000);
+}

@@ -201,3 +201,88 @@ fn a_value_for_a_bool_input_or_an_unknown_signal_is_refused() {
     r.step();
     assert!(r.values.is_empty());
 }
+
+/// `config/inputs.toml` with a ±10 V 16-bit `sim_analog_output` `valve_ao` and its channel 1
+/// as the float output `valve_cmd`.
+fn with_analog_output(s: String) -> String {
+    s.replacen(
+        "[devices.piece_counter]",
+        "[devices.valve_ao]\nnode = \"line\"\nkind = \"sim_analog_output\"\nchannels = 2\n\n\
+         [signals.valve_cmd]\ndevice = \"valve_ao\"\nchannel = 1\n\n[devices.piece_counter]",
+        1,
+    )
+}
+
+#[test]
+fn set_output_drives_a_float_output_quantized_at_once_and_logs_it() {
+    let c = cell(with_analog_output);
+    let cmd = c.signal("valve_cmd").unwrap();
+    let ao = c.devices.iter().position(|d| d.name == "valve_ao").unwrap();
+    let mut r = Run::new(&c);
+    for _ in 0..3 {
+        r.step();
+    }
+    assert_eq!(
+        r.value(cmd),
+        SignalValue::Float(0.0),
+        "0 V before any SetOutput"
+    );
+    let t = r.k * MS;
+    let action = Action::SetOutputValue { value: 2.5 };
+    let applied = (r.exec)
+        .apply_at(t, t, "valve_cmd", "SetOutput", action, &mut r.log)
+        .unwrap();
+    assert!(applied.is_ok(), "{applied:?}");
+    // At once, before the step: the writer of an EtherCAT `aio` takes it at the next boundary.
+    assert_eq!(r.value(cmd), SignalValue::Float(8192.0 * 10.0 / 32767.0));
+    assert_eq!(r.exec.value_device(ao).unwrap().changes, 1);
+    r.step();
+    let log = String::from_utf8_lossy(&r.log);
+    assert!(
+        log.contains("t=0.003000000 valve_cmd output = 2.50007629627369 [8192]"),
+        "{log}"
+    );
+    assert_eq!(r.values.len(), 1);
+    assert_eq!((r.values[0].raw, r.values[0].sampled_ns), (8192, 3 * MS));
+    // An input is not an output, and an output not an input.
+    for (signal, action) in [
+        ("web_tension", Action::SetOutputValue { value: 1.0 }),
+        ("valve_cmd", Action::SetInputValue { value: 1.0 }),
+    ] {
+        let t = r.k * MS;
+        let refused = (r.exec)
+            .apply_at(t, t, signal, "SetOutput", action, &mut r.log)
+            .unwrap();
+        assert!(refused.is_err(), "{signal}");
+    }
+}
+
+#[test]
+fn an_analog_channel_set_from_outside_is_sampled_at_its_boundary_as_a_script_value() {
+    let c = cell(|s| s);
+    let tension = c.signal("web_tension").unwrap();
+    let ai = c
+        .devices
+        .iter()
+        .position(|d| d.name == "tension_ai")
+        .unwrap();
+    let mut r = Run::new(&c);
+    r.step();
+    // The node's EtherCAT segment hands the word 8192 in as volts before the step at 1 ms.
+    assert!(r.exec.set_input_value(ai, 1, MS, 8192.0 * 10.0 / 32767.0));
+    assert!(
+        !r.exec.set_input_value(ai + 1000, 1, MS, 1.0),
+        "no such terminal"
+    );
+    r.step();
+    assert_eq!(
+        r.value(tension),
+        SignalValue::Float(8192.0 * 10.0 / 32767.0)
+    );
+    assert_eq!(r.values.last().map(|e| e.raw), Some(8192));
+    let log = String::from_utf8_lossy(&r.log);
+    assert!(
+        log.contains("t=0.001000000 web_tension input = 2.50007629627369 [8192]"),
+        "{log}"
+    );
+}

@@ -15,7 +15,8 @@
 //! the last complete one, exactly 3 cycles after it plus the late cycles the node counted; 1 %
 //! of the frames dropped by the emulator: no alarm, every drop counted as a miss (within 1),
 //! the setpoints without a jump; the emulator killed and started again: MC_Reset brings the
-//! segment back to OP and the axis moves again.
+//! segment back to OP and the axis moves again; a float output on an analog terminal (`aio`)
+//! set to 2.5 V comes back on its looped input as code 8192, 2.50007629627369 V.
 //!
 //! Every wait has a timeout.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -708,5 +709,157 @@ fn mc_reset_brings_a_lost_segment_back_to_op_and_the_axis_moves_again() {
         .unwrap();
     assert!((actual - 50.0).abs() < 0.01, "actual position {actual}");
     eprintln!("{end}");
+    remove_dir(&dir);
+}
+
+/// The analog terminal of the cell file (`role = "aio"`, the emulator's `aio`) after the
+/// digital one, its output 1 and input 1 as float signals.
+const AIO: &str = r#"[[ethercat.subdevices]]
+name = "ai_ao"
+identity = { vendor = 0x00000002, product = 0x11163052, revision = 0x00100000 }
+role = "aio"
+inputs = "ai_ao_in"
+
+[signals.valve_cmd]
+device = "ai_ao"
+channel = 1
+type = "float"
+
+[signals.valve_back]
+device = "ai_ao_in"
+channel = 1
+type = "float"
+
+# An output signal on the terminal's channel 1"#;
+
+/// The drive enabled at standstill (a move would make the test depend on the host's late
+/// cycles, which the motion test judges), the analog output set to 2.5 V at 0.5 s.
+const AIO_SCRIPT: &str = r#"
+[sim]
+duration = 1.5
+
+[[at]]
+t = 0.0
+axis = "slide"
+instruction = "MC_Power"
+
+[[at]]
+t = 0.5
+axis = "valve_cmd"
+instruction = "SetOutput"
+value = 2.5
+"#;
+
+#[test]
+fn a_float_output_on_an_aio_terminal_comes_back_on_its_looped_input_quantized() {
+    let _turn = turn();
+    let ns = netns("a");
+    let _sim = start_sim(&ns, "drive,dio,aio", 3);
+    let dir = fresh_dir(&format!("tandem-ethercat-aio-{}", std::process::id()));
+    let cell = cell(&dir, "# An output signal on the terminal's channel 1", AIO);
+    let script = dir.join("script.toml");
+    std::fs::write(&script, AIO_SCRIPT).unwrap();
+    let rec = dir.join("rec");
+    let up = Spawned::start(
+        tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+            .arg("--script")
+            .arg(&script),
+    );
+    let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
+    assert!(status.success(), "tandem up failed: {status}\n{up_log}");
+    assert!(!up_log.contains("panicked"), "{up_log}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // The drive on the same segment enables and holds its position.
+    assert!(log.contains("slide MC_Power job 1: Status TRUE"), "{log}");
+    assert!(!log.contains("slide alarm"), "{log}");
+    let line_of = |what: &str| -> (f64, String) {
+        let line = log
+            .lines()
+            .find(|l| l.contains(what))
+            .unwrap_or_else(|| panic!("no `{what}` in\n{log}"));
+        let t = line.trim_start_matches("t=").split(' ').next().unwrap();
+        (t.parse().unwrap(), line.to_string())
+    };
+    // SetOutput at 0.5 s: the output channel takes code 8192 (2.5 V · 32767 / 10, rounded).
+    let (out_t, out) = line_of("valve_cmd output = ");
+    assert_eq!(
+        out,
+        "t=0.500000000 valve_cmd output = 2.50007629627369 [8192]"
+    );
+    // The word goes out with the next exchange, the emulator's loop puts it on input 1, the
+    // node samples it as a float input: the same code, the same volts, in the log once.
+    let (back_t, back) = line_of("valve_back input = ");
+    assert!(
+        back.ends_with("valve_back input = 2.50007629627369 [8192]"),
+        "{back}"
+    );
+    assert_eq!(log.matches("valve_back input = ").count(), 1, "{log}");
+    let cycles = ((back_t - out_t) / 0.002).round();
+    eprintln!("aio loop: output at {out_t} s, back on the input at {back_t} s ({cycles} cycles)");
+    // 2 cycles without late ones: the script entry acts before the exchange of its boundary,
+    // so the word goes out with that exchange; the emulator puts it on its inputs after the
+    // datagram read them, the exchange a cycle later reads it, and the node takes that image
+    // back and samples it at the next boundary. The bound leaves room for late cycles on the
+    // shared host.
+    assert!(
+        (2.0..=10.0).contains(&cycles),
+        "output at {out_t} s, back at {back_t} s"
+    );
+    remove_dir(&dir);
+}
+
+#[test]
+fn an_enc_terminal_s_counter_is_an_integer_input_counting_up() {
+    let _turn = turn();
+    let ns = netns("e");
+    let _sim = start_sim_with(&ns, "drive,dio,enc", 3, &["--encoder-velocity", "500000"]);
+    let dir = fresh_dir(&format!("tandem-ethercat-enc-{}", std::process::id()));
+    let enc = "[[ethercat.subdevices]]\nname = \"wheel\"\n\
+               identity = { vendor = 0x00000002, product = 0x13ED3052, revision = 0x00100000 }\n\
+               role = \"enc\"\n\n[signals.wheel_count]\ndevice = \"wheel\"\nchannel = 1\n\
+               type = \"integer\"\n\n# An output signal on the terminal's channel 1";
+    let cell = cell(&dir, "# An output signal on the terminal's channel 1", enc);
+    let script = dir.join("script.toml");
+    std::fs::write(&script, "[sim]\nduration = 1.0\n").unwrap();
+    let rec = dir.join("rec");
+    let up = Spawned::start(
+        tandem_testkit::tandem::up(ns.exec(&bin("tandem")), &cell, &rec)
+            .arg("--script")
+            .arg(&script),
+    );
+    let (status, up_log) = up.wait(Duration::from_secs(120), "tandem up");
+    assert!(status.success(), "tandem up failed: {status}\n{up_log}");
+    assert!(!up_log.contains("panicked"), "{up_log}");
+    let log = std::fs::read_to_string(rec.join("drives.log")).unwrap();
+    // (t, count) of every reading the node logged: `t=0.004000000 wheel_count input = 1000`.
+    let readings: Vec<(f64, i64)> = log
+        .lines()
+        .filter(|l| l.contains(" wheel_count input = "))
+        .map(|l| {
+            let t = l.trim_start_matches("t=").split(' ').next().unwrap();
+            let v = l.rsplit(' ').next().unwrap();
+            (t.parse().unwrap(), v.parse().unwrap())
+        })
+        .collect();
+    // A reading per cycle with a new count: most of the 500 cycles (a late or missed cycle
+    // keeps the last one).
+    assert!(readings.len() > 100, "{} readings\n{log}", readings.len());
+    assert!(
+        readings
+            .windows(2)
+            .all(|w| w[1].1 > w[0].1 && w[1].0 > w[0].0),
+        "the count goes up with time\n{log}"
+    );
+    let (first, last) = (readings[0], readings[readings.len() - 1]);
+    let rate = (last.1 - first.1) as f64 / (last.0 - first.0);
+    // Measured, not asserted: the emulator counts on its own clock at each frame.
+    eprintln!(
+        "enc: {} readings, {} to {} increments from t={} to t={} s: {rate:.0} increments/s",
+        readings.len(),
+        first.1,
+        last.1,
+        first.0,
+        last.0
+    );
     remove_dir(&dir);
 }

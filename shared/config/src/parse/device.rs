@@ -568,6 +568,9 @@ fn connection(
         }
         DeviceKind::EthercatDio
         | DeviceKind::EthercatDioInputs
+        | DeviceKind::EthercatAio
+        | DeviceKind::EthercatAioInputs
+        | DeviceKind::EthercatEnc
         | DeviceKind::SimDigitalOutput(_)
         | DeviceKind::SimDigitalInput(_)
         | DeviceKind::SimAnalogInput(_)

@@ -11,9 +11,13 @@ use crate::cell::{
 use crate::error::{ConfigError, Problem};
 use crate::schema::{CellFile, EthercatSection, SubDeviceSection};
 
-/// The roles by name (room for the timestamped output, analog and encoder terminals).
-const ROLES: [(&str, EthercatRole); 2] =
-    [("cia402", EthercatRole::Cia402), ("dio", EthercatRole::Dio)];
+/// The roles by name (room for the timestamped output terminal).
+const ROLES: [(&str, EthercatRole); 4] = [
+    ("cia402", EthercatRole::Cia402),
+    ("dio", EthercatRole::Dio),
+    ("aio", EthercatRole::Aio),
+    ("enc", EthercatRole::Enc),
+];
 
 /// The increments per revolution of a drive without `increments_per_revolution`: 2^20, those
 /// of `tandem-ecat-sim`'s drive (a 20-bit motor encoder).
@@ -99,8 +103,10 @@ pub(super) fn segments(
                 kind,
             });
             if let Some(inputs) = &s.inputs {
-                let problem = if role != EthercatRole::Dio {
-                    Some(Problem::Invalid("only for `role = \"dio\"`"))
+                let problem = if matches!(role, EthercatRole::Cia402 | EthercatRole::Enc) {
+                    Some(Problem::Invalid(
+                        "only for `role = \"dio\"` or `role = \"aio\"`",
+                    ))
                 } else if !plain_name(inputs) {
                     Some(Problem::BadName {
                         what: "device",
@@ -117,7 +123,11 @@ pub(super) fn segments(
                 devices.push(DeviceEntry {
                     name: inputs.clone(),
                     node,
-                    kind: DeviceKind::EthercatDioInputs,
+                    kind: if role == EthercatRole::Aio {
+                        DeviceKind::EthercatAioInputs
+                    } else {
+                        DeviceKind::EthercatDioInputs
+                    },
                 });
             }
             subs.push((s.name.clone(), identity, role, s.inputs.clone()));
@@ -254,7 +264,7 @@ fn subdevice(
                 transport_cycles,
             })
         }
-        EthercatRole::Dio => {
+        EthercatRole::Dio | EthercatRole::Aio | EthercatRole::Enc => {
             let drive_key = if s.increments_per_revolution.is_some() {
                 Some("increments_per_revolution")
             } else if s.transport_cycles.is_some() {
@@ -270,7 +280,11 @@ fn subdevice(
                     Problem::Invalid("only for `role = \"cia402\"`"),
                 ));
             }
-            DeviceKind::EthercatDio
+            match role {
+                EthercatRole::Aio => DeviceKind::EthercatAio,
+                EthercatRole::Enc => DeviceKind::EthercatEnc,
+                _ => DeviceKind::EthercatDio,
+            }
         }
     };
     let identity = EthercatIdentity {

@@ -54,7 +54,7 @@ pub(super) fn signals(
                 device: dev.name.clone(),
                 kind: dev.kind.name(),
                 needs: "a device with channels (`sim_digital_output`, `sim_digital_input`, \
-                        `sim_analog_input`, `sim_analog_output`, `sim_counter`, an EtherCAT `dio`)",
+                        `sim_analog_input`, `sim_analog_output`, `sim_counter`, an EtherCAT `dio`, `aio` or `enc`)",
             };
             return Err(at("device", problem));
         };
@@ -146,8 +146,8 @@ fn declared_type(
 /// The device kinds whose channels have signal type `t` (a name of [`SIGNAL_TYPES`]).
 fn kinds_of(t: &str) -> &'static str {
     match t {
-        "integer" => "`sim_counter`",
-        "float" => "`sim_analog_input`, `sim_analog_output`",
+        "integer" => "`sim_counter`, an EtherCAT `enc`",
+        "float" => "`sim_analog_input`, `sim_analog_output`, an EtherCAT `aio`",
         _ => "`sim_digital_input`, `sim_digital_output`",
     }
 }

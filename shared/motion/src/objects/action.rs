@@ -102,4 +102,10 @@ pub enum Action {
         /// The value from the entry's time.
         value: f64,
     },
+    /// The `float` output signal named by the entry set to `value` (its channel's units, V)
+    /// from the entry's time: the terminal drives the value as its channel quantizes it.
+    SetOutputValue {
+        /// The value from the entry's time.
+        value: f64,
+    },
 }
