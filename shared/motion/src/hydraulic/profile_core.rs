@@ -1,5 +1,6 @@
-//! What the two set value generators of a hydraulic axis share: the set values, the state, the
-//! feed enables and the stops (`MC_Stop_BkPlcMc`, `MC_EmergencyStop_BkPlcMc`, a setpoint taken
+//! What the two set value generators of a hydraulic axis share: their parameters, states,
+//! errors and output (re-exported by [`super::generator`]), the set values, the feed enables
+//! and the stops (`MC_Stop_BkPlcMc`, `MC_EmergencyStop_BkPlcMc`, a setpoint taken
 //! over), and the one interface the axis runs either through ([`ProfileGenerator`]).
 //!
 //! The displacement-based generator ([`super::generator::CtrlBasedGenerator`]) and the
@@ -9,7 +10,201 @@
 //!
 //! Pure: no IO, no clock, no allocation.
 
-use super::generator::{GeneratorError, GeneratorParams, HydState, Setpoint};
+use crate::catalog::hyd_error::HydErrorCode;
+
+/// The generator's state, as the library names it (`E_TcHydAxState`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum HydState {
+    /// `iTcHydStateIdle`: not moving; the set position is the target.
+    Idle,
+    /// `iTcHydStateTcAccP` / `TcAccM`: the time-controlled start ramp.
+    TcAcc,
+    /// `iTcHydStateConstVeloP` / `ConstVeloM`: travel at the command's velocity.
+    ConstVelo,
+    /// `iTcHydStatePcDecP` / `PcDecM`: the displacement-controlled braking ramp.
+    PcDec,
+    /// `iTcHydStateCreepVeloP` / `CreepVeloM`: creep to the target.
+    CreepVelo,
+    /// `iTcHydStateTcDecP` / `TcDecM`: a regular stop with `fStopRamp`.
+    TcDec,
+    /// `iTcHydStateEmergencyBreak`: an emergency stop with `fEmergencyRamp`.
+    EmergencyBreak,
+    /// `iTcHydStateFeedStopPos` / `FeedStopNeg`: an intermediate stop with `fStopRamp` for a
+    /// missing feed enable of the direction (`Enable_Positive` / `Enable_Negative` of
+    /// MC_Power_BkPlcMc); the move waits, then goes on when the enable returns.
+    FeedStop,
+}
+
+impl HydState {
+    /// The library's name of the state in direction `positive`.
+    pub const fn name(self, positive: bool) -> &'static str {
+        match (self, positive) {
+            (Self::Idle, _) => "iTcHydStateIdle",
+            (Self::TcAcc, true) => "iTcHydStateTcAccP",
+            (Self::TcAcc, false) => "iTcHydStateTcAccM",
+            (Self::ConstVelo, true) => "iTcHydStateConstVeloP",
+            (Self::ConstVelo, false) => "iTcHydStateConstVeloM",
+            (Self::PcDec, true) => "iTcHydStatePcDecP",
+            (Self::PcDec, false) => "iTcHydStatePcDecM",
+            (Self::CreepVelo, true) => "iTcHydStateCreepVeloP",
+            (Self::CreepVelo, false) => "iTcHydStateCreepVeloM",
+            (Self::TcDec, true) => "iTcHydStateTcDecP",
+            (Self::TcDec, false) => "iTcHydStateTcDecM",
+            (Self::EmergencyBreak, _) => "iTcHydStateEmergencyBreak",
+            (Self::FeedStop, true) => "iTcHydStateFeedStopPos",
+            (Self::FeedStop, false) => "iTcHydStateFeedStopNeg",
+        }
+    }
+}
+
+/// The target approach of one direction (members of `ST_TcHydAxParam`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Approach {
+    /// `fCreepSpeedP/M` (mm/s, > 0).
+    pub creep_speed: f64,
+    /// `fCreepDistanceP/M` (mm, >= 0).
+    pub creep_distance: f64,
+    /// `fBrakeDistanceP/M` (mm, >= 0).
+    pub brake_distance: f64,
+    /// `fBrakeDeadTimeP/M` (s, >= 0).
+    pub brake_dead_time: f64,
+}
+
+/// The generator's parameters (members of `ST_TcHydAxParam`; defaults as the library's).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct GeneratorParams {
+    /// `fRefVelo` (mm/s, > 0).
+    pub ref_velo: f64,
+    /// `fMaxVelo` (mm/s, > 0; above `fRefVelo` it is `fRefVelo`).
+    pub max_velo: f64,
+    /// `fAcc` (mm/s², > 0).
+    pub acc: f64,
+    /// `fMaxAcc` (mm/s², > 0).
+    pub max_acc: f64,
+    /// `fDec` (mm/s², > 0).
+    pub dec: f64,
+    /// `fMaxDec` (mm/s², > 0).
+    pub max_dec: f64,
+    /// The approach of the positive direction (and of both without asymmetrical targeting).
+    pub approach_p: Approach,
+    /// The approach of the negative direction, with [`GeneratorParams::asymmetrical`].
+    pub approach_m: Approach,
+    /// `bAsymmetricalTargeting`.
+    pub asymmetrical: bool,
+    /// `fStopRamp` (s, > 0): a stop's ramp from `fRefVelo` to 0.
+    pub stop_ramp: f64,
+    /// `fEmergencyRamp` (s, > 0): an emergency stop's ramp from `fRefVelo` to 0.
+    pub emergency_ramp: f64,
+    /// `fTargetClamping` (V, 0..10): when greater than 0, at the target this output is given
+    /// with the sign of the approach and the position control is suppressed (a pressing axis).
+    pub target_clamping: f64,
+    /// `fReposDistance` (mm, >= 0): when greater than 0, an idle axis further than this from
+    /// its target starts a positioning to it again by itself.
+    pub repos_distance: f64,
+}
+
+impl Default for GeneratorParams {
+    /// The library's defaults: `fRefVelo` and `fMaxVelo` 500 mm/s, `fAcc`/`fDec` 2000 mm/s²,
+    /// `fMaxAcc`/`fMaxDec` 500 mm/s², creep 80 mm/s from 1.0 mm, brake distance 0.1 mm, no dead
+    /// time, stop ramp 1.0 s, emergency ramp 0.1 s, no target clamping, no repositioning.
+    fn default() -> Self {
+        let approach = Approach {
+            creep_speed: 80.0,
+            creep_distance: 1.0,
+            brake_distance: 0.1,
+            brake_dead_time: 0.0,
+        };
+        Self {
+            ref_velo: 500.0,
+            max_velo: 500.0,
+            acc: 2000.0,
+            max_acc: 500.0,
+            dec: 2000.0,
+            max_dec: 500.0,
+            approach_p: approach,
+            approach_m: approach,
+            asymmetrical: false,
+            stop_ramp: 1.0,
+            emergency_ramp: 0.1,
+            target_clamping: 0.0,
+            repos_distance: 0.0,
+        }
+    }
+}
+
+/// Why the generator refused parameters or a command (nothing changes).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum GeneratorError {
+    /// A parameter or a command's value that must be finite and above 0 (or at least 0).
+    Invalid {
+        /// Its name (the library's for parameters; `Position`, `Velocity`, `Acceleration`,
+        /// `Deceleration` for a command's inputs).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A move in a direction whose feed enable is missing (`positive`: the positive one).
+    FeedEnable {
+        /// The direction of the move.
+        positive: bool,
+    },
+}
+
+impl GeneratorError {
+    /// The library's error code: `dwTcHydErrCdRefVelo`, `dwTcHydErrCdSetVelo` (a command's
+    /// velocity, `fMaxVelo`), `dwTcHydErrCdAcc`, `dwTcHydErrCdDec`, else
+    /// `dwTcHydAdsErrIllegalValue`.
+    pub fn code(&self) -> HydErrorCode {
+        let name = match *self {
+            Self::Invalid { name, .. } => name,
+            Self::FeedEnable { positive: true } => return HydErrorCode::POS_FD_ENA,
+            Self::FeedEnable { positive: false } => return HydErrorCode::NEG_FD_ENA,
+        };
+        match name {
+            "fRefVelo" => HydErrorCode::REF_VELO,
+            "Velocity" | "fMaxVelo" => HydErrorCode::SET_VELO,
+            "Acceleration" | "fAcc" | "fMaxAcc" => HydErrorCode::ACC,
+            "Deceleration" | "fDec" | "fMaxDec" => HydErrorCode::DEC,
+            _ => HydErrorCode::ILLEGAL_VALUE,
+        }
+    }
+}
+
+impl core::fmt::Display for GeneratorError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::Invalid { name, value } => write!(f, "{name} = {value} is not valid here"),
+            Self::FeedEnable { positive } => write!(
+                f,
+                "no feed enable for the {} direction (Enable_{})",
+                if positive { "positive" } else { "negative" },
+                if positive { "Positive" } else { "Negative" }
+            ),
+        }
+    }
+}
+
+impl std::error::Error for GeneratorError {}
+
+/// One cycle of the generator's output.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Setpoint {
+    /// `fSetVelo` (mm/s): the control value.
+    pub velocity: f64,
+    /// `fSetPos` (mm): the set position (the integral of the set velocity while moving, the
+    /// target when idle).
+    pub position: f64,
+    /// The state after the cycle.
+    pub state: HydState,
+    /// The direction of the motion (`true`: positive).
+    pub positive: bool,
+    /// `fClampingOutput` (V): at the target with `fTargetClamping`, that output with the sign
+    /// of the approach; 0 otherwise.
+    pub clamping_output: f64,
+    /// The position controller acts (idle at the target without target clamping; the library's
+    /// displacement mode closes the loop only at standstill).
+    pub position_control: bool,
+}
 
 /// The state both generators keep alike.
 #[derive(Copy, Clone, Debug, PartialEq)]
