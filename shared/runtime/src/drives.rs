@@ -232,6 +232,47 @@ fn step_number(step: EnableStep) -> u8 {
     }
 }
 
+/// Wires the simulated plant into a simulated servo at its physical positions, in the drive's
+/// increments: the axis' mechanical stops, its reference cam (on the homing probe's input as
+/// well) and the mark of a measuring input on touch probe 1.
+fn wire_sim_servo(
+    servo: &mut SimServo,
+    cell: &Cell,
+    a: &tandem_config::AxisEntry,
+    c: &Cia402Connection,
+    link: &Cia402Link,
+) {
+    let at = |x: f64| f64::from(c.scaling.drive_increments(x));
+    let (lo, hi) = (
+        a.config.plant.fixed_stop_min.map(at),
+        a.config.plant.fixed_stop_max.map(at),
+    );
+    // The drive's increments run the other way with an inverted drive.
+    let (lo, hi) = if c.scaling.mechanics().inverse_drive {
+        (hi, lo)
+    } else {
+        (lo, hi)
+    };
+    servo.set_fixed_stops(lo, hi);
+    if let Some((lo, hi)) = a.config.plant.reference_cam {
+        // The home switch is wired to the homing probe's input as well (the simulated plant's
+        // reference cam, at its physical position).
+        let (lo, hi) = (at(lo), at(hi));
+        // Probe 1 or 2 exists: refused only for another probe number.
+        let _ = servo.set_probe_mark(link.homing_probe, Some((lo.min(hi), lo.max(hi))));
+    }
+    let mark = link
+        .probe_input
+        .and_then(|k| cell.measuring_inputs.get(k))
+        .and_then(|m| m.sensor);
+    if let Some(sensor) = mark {
+        // The mark at its physical position (the axis's coordinate at start).
+        let (lo, hi) = (at(sensor.position), at(sensor.position + sensor.width));
+        // Probe 1 exists: refused only for another probe number.
+        let _ = servo.set_probe_mark(1, Some((lo.min(hi), lo.max(hi))));
+    }
+}
+
 impl Drives {
     /// The devices of the owned nodes and the links of the owned axes (`owned[i]`) on them.
     pub(crate) fn new(cell: &Cell, owned: &[bool]) -> Result<Self, ExecError> {
@@ -306,44 +347,7 @@ impl Drives {
                 ..
             })) = slots.get_mut(c.device.0)
             {
-                let at = |x: Option<f64>| x.map(|x| f64::from(c.scaling.drive_increments(x)));
-                let (lo, hi) = (
-                    at(a.config.plant.fixed_stop_min),
-                    at(a.config.plant.fixed_stop_max),
-                );
-                // The drive's increments run the other way with an inverted drive.
-                let (lo, hi) = if c.scaling.mechanics().inverse_drive {
-                    (hi, lo)
-                } else {
-                    (lo, hi)
-                };
-                servo.set_fixed_stops(lo, hi);
-            }
-            if let (Some((lo, hi)), Some(Some(slot))) =
-                (a.config.plant.reference_cam, slots.get_mut(c.device.0))
-            {
-                let Device::SimServo(servo) = &mut slot.device else {
-                    links.push(link);
-                    continue;
-                };
-                // The home switch is wired to the homing probe's input as well (the simulated
-                // plant's reference cam, at its physical position).
-                let at = |x: f64| f64::from(c.scaling.drive_increments(x));
-                let (lo, hi) = (at(lo), at(hi));
-                // Probe 1 or 2 exists: refused only for another probe number.
-                let _ = servo.set_probe_mark(link.homing_probe, Some((lo.min(hi), lo.max(hi))));
-            }
-            if let (Some(m), Some(Some(slot))) = (
-                link.probe_input.and_then(|k| cell.measuring_inputs.get(k)),
-                slots.get_mut(c.device.0),
-            ) {
-                if let (Some(sensor), Device::SimServo(servo)) = (m.sensor, &mut slot.device) {
-                    // The mark at its physical position (the axis's coordinate at start).
-                    let at = |x: f64| f64::from(c.scaling.drive_increments(x));
-                    let (lo, hi) = (at(sensor.position), at(sensor.position + sensor.width));
-                    // Probe 1 exists: refused only for another probe number.
-                    let _ = servo.set_probe_mark(1, Some((lo.min(hi), lo.max(hi))));
-                }
+                wire_sim_servo(servo, cell, a, c, &link);
             }
             links.push(link);
         }
