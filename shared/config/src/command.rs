@@ -1321,6 +1321,14 @@ fn single_axis_command(a: &Args<'_>) -> Result<Command, CommandError> {
         "MC_SetOverride" => Command::SetOverride {
             velocity: a.num("velocity")?,
         },
+        other => return parameter_or_torque_command(a, other),
+    })
+}
+
+/// MC_WriteParameter / MC_ReadParameter and the torque instructions (MC_TorqueLimiting,
+/// MC_TorqueAdditive, MC_TorqueRange).
+fn parameter_or_torque_command(a: &Args<'_>, name: &'static str) -> Result<Command, CommandError> {
+    Ok(match name {
         "MC_WriteParameter" => Command::WriteParameter {
             parameter: a.parameter()?,
             value: match a.get("value")? {
