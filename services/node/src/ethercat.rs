@@ -1403,6 +1403,37 @@ where
     }
 }
 
+impl Part {
+    /// Writes this SubDevice's part of the process image into its output bytes `out`: a
+    /// drive's RxPDO, an analog terminal's output words, a digital terminal's output byte.
+    fn put_outputs(&self, out: &mut [u8]) {
+        match &self.map {
+            Some(map) => encode(map, &self.command, out),
+            None if self.role == EthercatRole::Aio => {
+                for (c, w) in self.words_out.iter().enumerate() {
+                    put(out, 2 * c, 2, i64::from(*w));
+                }
+            }
+            None => put(out, 0, 1, i64::from(self.outputs)),
+        }
+    }
+
+    /// Reads this SubDevice's input bytes `input` of a complete exchange into its part.
+    fn take_inputs(&mut self, input: &[u8]) {
+        match &self.map {
+            Some(map) => self.feedback = decode(map, input),
+            None if self.role == EthercatRole::Aio => {
+                for (c, w) in self.words_in.iter_mut().enumerate() {
+                    *w = get(input, 2 * c, 2, true) as i16;
+                }
+            }
+            // The status word, then the counter value 0x6000:11 (UINT32).
+            None if self.role == EthercatRole::Enc => self.count = get(input, 2, 4, false) as u32,
+            None => self.inputs = input.first().copied().unwrap_or(0),
+        }
+    }
+}
+
 /// In OP: reports the segment ready (or, after a re-init, exchanges the `held` image with the
 /// mappings read anew), then one exchange per image handed over until the cyclic thread's end
 /// of the channel goes or an image asks for a re-init.
@@ -1480,16 +1511,7 @@ async fn serve<DC>(
             return Served::Reinit(image);
         }
         for (p, sd) in image.parts.iter().zip(group.iter(md)) {
-            let mut out = sd.outputs_raw_mut();
-            match &p.map {
-                Some(map) => encode(map, &p.command, &mut out),
-                None if p.role == EthercatRole::Aio => {
-                    for (c, w) in p.words_out.iter().enumerate() {
-                        put(&mut out, 2 * c, 2, i64::from(*w));
-                    }
-                }
-                None => put(&mut out, 0, 1, i64::from(p.outputs)),
-            }
+            p.put_outputs(&mut sd.outputs_raw_mut());
         }
         let (verdict, round_trip) = attempt(
             md,
@@ -1503,20 +1525,7 @@ async fn serve<DC>(
         image.round_trip_ns = round_trip;
         if verdict == Verdict::Complete {
             for (p, sd) in image.parts.iter_mut().zip(group.iter(md)) {
-                let input = sd.inputs_raw();
-                match &p.map {
-                    Some(map) => p.feedback = decode(map, &input),
-                    None if p.role == EthercatRole::Aio => {
-                        for (c, w) in p.words_in.iter_mut().enumerate() {
-                            *w = get(&input, 2 * c, 2, true) as i16;
-                        }
-                    }
-                    // The status word, then the counter value 0x6000:11 (UINT32).
-                    None if p.role == EthercatRole::Enc => {
-                        p.count = get(&input, 2, 4, false) as u32
-                    }
-                    None => p.inputs = input.first().copied().unwrap_or(0),
-                }
+                p.take_inputs(&sd.inputs_raw());
             }
         }
         if ends.bus_out.send(image).is_err() {
