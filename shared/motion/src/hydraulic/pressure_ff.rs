@@ -179,23 +179,24 @@ impl MovingAverage {
         }
     }
 
-    /// Takes `x`; the mean of the values taken, at most the last `n` (`n` <= 1: `x`).
+    /// Takes `x`; the mean of the values taken, at most the last `n` (`n` <= 1, or above
+    /// [`MAX_FILTER`], which the parameters' check refuses: `x`).
     fn push(&mut self, x: f64) -> f64 {
-        if self.n <= 1 {
+        let Some(slot) = self.values.get_mut(self.next).filter(|_| self.n > 1) else {
             return x;
-        }
+        };
         if self.len == self.n {
-            self.sum -= self.values[self.next];
+            self.sum -= *slot;
         } else {
             self.len += 1;
         }
-        self.values[self.next] = x;
+        *slot = x;
         self.sum += x;
         self.next = (self.next + 1) % self.n;
         // Summed afresh once per pass through the buffer, so that the running sum does not
         // collect rounding (n additions every n cycles).
         if self.next == 0 {
-            self.sum = self.values[..self.len].iter().sum();
+            self.sum = self.values.iter().take(self.len).sum();
         }
         self.sum / self.len as f64
     }
