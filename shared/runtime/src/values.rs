@@ -355,16 +355,8 @@ impl Values {
             raw,
             sampled_ns: at_ns,
         };
-        if self.out_changes.len() < self.out_changes.capacity() {
-            self.out_changes.push(e);
-        } else {
-            d.status.dropped += 1;
-        }
-        if self.kept.len() < self.kept.capacity() {
-            self.kept.push(e);
-        } else {
-            d.status.unreported += 1;
-        }
+        d.status.dropped += u64::from(!push_within_capacity(&mut self.out_changes, e));
+        d.status.unreported += u64::from(!push_within_capacity(&mut self.kept, e));
         Ok(())
     }
 
@@ -413,16 +405,8 @@ impl Values {
                     sampled_ns: t,
                 };
                 d.status.changes += 1;
-                if self.frame.len() < self.frame.capacity() {
-                    self.frame.push(e);
-                } else {
-                    d.status.dropped += 1;
-                }
-                if self.kept.len() < self.kept.capacity() {
-                    self.kept.push(e);
-                } else {
-                    d.status.unreported += 1;
-                }
+                d.status.dropped += u64::from(!push_within_capacity(&mut self.frame, e));
+                d.status.unreported += u64::from(!push_within_capacity(&mut self.kept, e));
             }
         }
     }
@@ -455,4 +439,14 @@ impl Values {
         self.kept.iter().for_each(f);
         self.kept.clear();
     }
+}
+
+/// Pushes `e` if `v` has room for it without growing (the cyclic path does not allocate);
+/// whether it did.
+fn push_within_capacity(v: &mut Vec<InputSignalValue>, e: InputSignalValue) -> bool {
+    let room = v.len() < v.capacity();
+    if room {
+        v.push(e);
+    }
+    room
 }
